@@ -1,0 +1,94 @@
+// fleetmap: the command-line program. Thin: parses flags, calls the libraries, reports.
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "cli/command.h"
+#include "core/error.h"
+
+namespace {
+
+// Exit codes: 0 success, 1 a failure while running, 2 bad input or usage.
+constexpr int kExitFailure = 1;
+constexpr int kExitBadInput = 2;
+
+std::string command_path(const CLI::App* app) {
+  std::string path;
+  for (const CLI::App* a = app; a != nullptr; a = a->get_parent()) {
+    path = a->get_name() + (path.empty() ? "" : " " + path);
+  }
+  return path;
+}
+
+const CLI::App* deepest_parsed(const CLI::App* app) {
+  for (const CLI::App* sub : app->get_subcommands()) {
+    if (sub->parsed()) return deepest_parsed(sub);
+  }
+  return app;
+}
+
+// CLI11 reports an unknown subcommand as "a subcommand is required"; name the word instead.
+void check_subcommand_words(const CLI::App& app, int argc, char** argv) {
+  const CLI::App* current = &app;
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.empty() || word[0] == '-') return;
+    const auto subs = current->get_subcommands([](const CLI::App*) { return true; });
+    if (subs.empty()) return;
+    const CLI::App* next = nullptr;
+    std::string names;
+    for (const CLI::App* s : subs) {
+      if (s->get_name() == word) next = s;
+      names += (names.empty() ? "" : ", ") + s->get_name();
+    }
+    if (next == nullptr) {
+      throw CLI::ValidationError(current->get_name(), "unknown command '" + word + "' (commands: " + names + ")");
+    }
+    current = next;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  namespace fm = fleetmap;
+  CLI::App app{
+      "fleetmap: multi-robot exploration and mapping. A team of simulated robots explores a 2D map,\n"
+      "builds and merges occupancy grids, and plans paths on the result. See `fleetmap COMMAND --help`."};
+  app.name("fleetmap");
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("fleetmap 0.1.0"));
+
+  std::vector<fm::cli::Command> commands;
+  commands.push_back(fm::cli::add_maps_command(app));
+
+  try {
+    check_subcommand_words(app, argc, argv);
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "%s: %s (see --help)\n", command_path(deepest_parsed(&app)).c_str(), e.what());
+    return kExitBadInput;
+  }
+
+  try {
+    for (const auto& c : commands) {
+      if (c.app->parsed()) return c.run();
+    }
+  } catch (const fm::InputError& e) {
+    std::fprintf(stderr, "fleetmap: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fleetmap: error: %s\n", e.what());
+    return kExitFailure;
+  }
+  return kExitFailure;
+}

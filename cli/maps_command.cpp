@@ -1,0 +1,86 @@
+// `fleetmap maps list | show`: the built-in maps, and a picture of any map.
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "cli/command.h"
+#include "core/error.h"
+#include "maps/builtin_maps.h"
+#include "mapping/map_io.h"
+#include "mapping/render.h"
+
+namespace fleetmap::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ShowOptions {
+  std::string map;
+  std::string out;
+  std::string title;
+  double resolution = 0.05;
+  long long max_cells = 64'000'000;
+};
+
+int run_list() {
+  std::printf("%-13s %11s %17s %11s  %s\n", "name", "cells", "metres", "free m^2", "description");
+  for (const auto& info : maps::builtin_maps()) {
+    const auto grid = maps::load_map_source(info.name);
+    const double free_m2 = double(grid.count(mapping::CellState::Free)) * grid.resolution() * grid.resolution();
+    char cells[32], metres[48];
+    std::snprintf(cells, sizeof cells, "%dx%d", grid.width(), grid.height());
+    std::snprintf(metres, sizeof metres, "%.1f x %.1f m", grid.geometry().width_m(), grid.geometry().height_m());
+    std::printf("%-13s %11s %17s %11.1f  %s\n", info.name.c_str(), cells, metres, free_m2, info.description.c_str());
+  }
+  std::printf("\nFiles: %s (PNG + map_server YAML). Use a name wherever a map is asked for.\n",
+              maps::builtin_maps_dir().c_str());
+  return 0;
+}
+
+int run_show(const ShowOptions& o) {
+  mapping::MapLoadOptions load;
+  load.default_resolution = o.resolution;
+  load.max_cells = o.max_cells;
+  const auto grid = maps::load_map_source(o.map, load);
+  fs::path out = o.out;
+  if (out.empty()) out = fs::path(o.map).stem().string() + "_map.png";
+  std::error_code ec;
+  if (fs::exists(o.map) && fs::equivalent(out, o.map, ec)) {
+    throw InputError(out.string() + ": --out would overwrite the input map; choose another file");
+  }
+  mapping::RenderOptions render;
+  render.title = o.title.empty() ? fs::path(o.map).stem().string() : o.title;
+  mapping::write_image(out, mapping::render_map(grid, {}, render));
+  const double free_m2 = double(grid.count(mapping::CellState::Free)) * grid.resolution() * grid.resolution();
+  std::printf("%s: %dx%d cells, %.2f m/cell, %.1f x %.1f m, free %.1f m^2\nwrote %s\n", o.map.c_str(), grid.width(),
+              grid.height(), grid.resolution(), grid.geometry().width_m(), grid.geometry().height_m(), free_m2,
+              out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Command add_maps_command(CLI::App& root) {
+  CLI::App* maps = root.add_subcommand("maps", "List the built-in maps, or draw any map to a PNG");
+  maps->require_subcommand(1);
+  CLI::App* list = maps->add_subcommand("list", "Print every built-in map with its size and free area");
+  CLI::App* show = maps->add_subcommand("show", "Render a map (built-in name, PNG/PGM image or map_server YAML) to a PNG");
+  auto o = std::make_shared<ShowOptions>();
+  show->add_option("map", o->map, "Built-in map name, image file or map_server YAML")->required();
+  show->add_option("--out,-o", o->out, "Output PNG (default: <map name>_map.png in the current folder)");
+  show->add_option("--title", o->title, "Title in the legend panel (default: the map name)");
+  show->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  show->add_option("--max-cells", o->max_cells, "Refuse maps with more cells than this")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  return {maps, [list, show, o]() {
+            if (list->parsed()) return run_list();
+            if (show->parsed()) return run_show(*o);
+            return 2;
+          }};
+}
+
+}  // namespace fleetmap::cli

@@ -1,0 +1,300 @@
+#include "mapping/map_io.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/imgcodecs.hpp>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+#include "core/error.h"
+#include "core/file_io.h"
+
+namespace fleetmap::mapping {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string where(const std::string& source, const YAML::Node& node) {
+  const auto mark = node.Mark();
+  return mark.line >= 0 ? source + ":" + std::to_string(mark.line + 1) : source;
+}
+
+std::string scalar_text(const YAML::Node& node) {
+  if (node.IsScalar()) return node.Scalar();
+  if (node.IsSequence()) return "a list";
+  if (node.IsMap()) return "a mapping";
+  return "nothing";
+}
+
+double parse_number(const YAML::Node& node, const std::string& key, const std::string& source) {
+  double v = 0.0;
+  if (!node.IsScalar() || !YAML::convert<double>::decode(node, v) || !std::isfinite(v)) {
+    throw InputError(where(source, node) + ": key '" + key + "': expected a finite number, got '" +
+                     scalar_text(node) + "'");
+  }
+  return v;
+}
+
+bool parse_flag(const YAML::Node& node, const std::string& key, const std::string& source) {
+  if (node.IsScalar()) {
+    const std::string s = node.Scalar();
+    if (s == "0") return false;
+    if (s == "1") return true;
+    bool b = false;
+    if (YAML::convert<bool>::decode(node, b)) return b;
+  }
+  throw InputError(where(source, node) + ": key '" + key + "': expected 0, 1, true or false, got '" +
+                   scalar_text(node) + "'");
+}
+
+// Reads width and height from a PNG or PNM header without decoding the image.
+std::optional<std::pair<std::int64_t, std::int64_t>> peek_image_size(const std::string& bytes) {
+  static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes.size() >= 24 && std::equal(kPng, kPng + 8, reinterpret_cast<const unsigned char*>(bytes.data()))) {
+    const auto be32 = [&](std::size_t at) {
+      const auto* p = reinterpret_cast<const unsigned char*>(bytes.data() + at);
+      return (std::int64_t{p[0]} << 24) | (std::int64_t{p[1]} << 16) | (std::int64_t{p[2]} << 8) | p[3];
+    };
+    return std::pair{be32(16), be32(20)};
+  }
+  if (bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '6') {
+    std::int64_t dims[2] = {0, 0};
+    std::size_t i = 2;
+    for (int k = 0; k < 2; ++k) {
+      while (i < bytes.size() && (std::isspace(static_cast<unsigned char>(bytes[i])) || bytes[i] == '#')) {
+        if (bytes[i] == '#') {
+          while (i < bytes.size() && bytes[i] != '\n') ++i;
+        } else {
+          ++i;
+        }
+      }
+      if (i >= bytes.size() || !std::isdigit(static_cast<unsigned char>(bytes[i]))) return std::nullopt;
+      while (i < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[i])) && dims[k] < (std::int64_t{1} << 40)) {
+        dims[k] = dims[k] * 10 + (bytes[i] - '0');
+        ++i;
+      }
+    }
+    return std::pair{dims[0], dims[1]};
+  }
+  return std::nullopt;
+}
+
+void check_size(const fs::path& path, std::int64_t w, std::int64_t h, const MapLoadOptions& options) {
+  if (w <= 0 || h <= 0) {
+    throw InputError(path.string() + ": image has no pixels (" + std::to_string(w) + "x" + std::to_string(h) + ")");
+  }
+  if (w * h > options.max_cells) {
+    throw InputError(path.string() + ": image is " + std::to_string(w) + "x" + std::to_string(h) + " = " +
+                     std::to_string(w * h) + " cells, over the size limit of " +
+                     std::to_string(options.max_cells) + " cells");
+  }
+}
+
+cv::Mat read_image(const fs::path& path, const MapLoadOptions& options) {
+  const std::string bytes = core::read_file(path);
+  if (bytes.empty()) throw InputError(path.string() + ": empty file, expected a PNG or PGM image");
+  if (const auto size = peek_image_size(bytes)) check_size(path, size->first, size->second, options);
+  cv::Mat image;
+  try {
+    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
+                         cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception&) {
+    image.release();
+  }
+  if (image.empty()) throw InputError(path.string() + ": cannot decode image (not a valid PNG/PGM, or truncated)");
+  check_size(path, image.cols, image.rows, options);
+  if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
+  if (image.depth() != CV_8U || image.channels() > 4) {
+    throw InputError(path.string() + ": unsupported image format (expected 8- or 16-bit grey, RGB or RGBA)");
+  }
+  return image;
+}
+
+}  // namespace
+
+MapYaml parse_map_yaml(std::string_view text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(text));
+  } catch (const YAML::Exception& e) {
+    throw InputError(source + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML (" + e.msg + ")");
+  }
+  if (!root.IsMap()) throw InputError(source + ": expected a map_server YAML mapping with 'image' and 'resolution'");
+
+  static const std::vector<std::string> kKeys = {"image", "resolution", "origin", "negate",
+                                                 "occupied_thresh", "free_thresh", "mode"};
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end()) {
+      throw InputError(where(source, kv.first) + ": unknown key '" + key +
+                       "' (valid: image, resolution, origin, negate, occupied_thresh, free_thresh, mode)");
+    }
+  }
+
+  MapYaml y;
+  if (!root["image"]) throw InputError(source + ": missing key 'image' (the map image file)");
+  if (!root["image"].IsScalar() || root["image"].Scalar().empty()) {
+    throw InputError(where(source, root["image"]) + ": key 'image': expected a file name");
+  }
+  y.image = root["image"].Scalar();
+
+  if (!root["resolution"]) throw InputError(source + ": missing key 'resolution' (metres per cell)");
+  y.resolution = parse_number(root["resolution"], "resolution", source);
+  if (!(y.resolution > 0.0)) {
+    throw InputError(where(source, root["resolution"]) + ": key 'resolution': expected a positive number of metres per cell, got '" +
+                     root["resolution"].Scalar() + "'");
+  }
+
+  if (const auto o = root["origin"]) {
+    if (!o.IsSequence() || o.size() != 3) {
+      throw InputError(where(source, o) + ": key 'origin': expected [x, y, yaw], got " + scalar_text(o));
+    }
+    y.origin = core::Pose2(parse_number(o[0], "origin", source), parse_number(o[1], "origin", source),
+                           parse_number(o[2], "origin", source));
+  }
+  if (const auto n = root["negate"]) y.negate = parse_flag(n, "negate", source);
+  const auto threshold = [&](const char* key, double& value) {
+    if (const auto n = root[key]) {
+      value = parse_number(n, key, source);
+      if (!(value >= 0.0 && value <= 1.0)) {
+        throw InputError(where(source, n) + ": key '" + key + "': expected a number in [0, 1], got '" + n.Scalar() + "'");
+      }
+    }
+  };
+  threshold("occupied_thresh", y.occupied_thresh);
+  threshold("free_thresh", y.free_thresh);
+  if (y.free_thresh > y.occupied_thresh) {
+    throw InputError(source + ": free_thresh (" + std::to_string(y.free_thresh) + ") is above occupied_thresh (" +
+                     std::to_string(y.occupied_thresh) + ")");
+  }
+  if (const auto m = root["mode"]) {
+    const std::string s = m.IsScalar() ? m.Scalar() : "";
+    if (s == "trinary") y.mode = MapMode::Trinary;
+    else if (s == "scale") y.mode = MapMode::Scale;
+    else if (s == "raw") y.mode = MapMode::Raw;
+    else throw InputError(where(source, m) + ": key 'mode': expected trinary, scale or raw, got '" + scalar_text(m) + "'");
+  }
+  return y;
+}
+
+std::string format_map_yaml(const MapYaml& y) {
+  char buf[512];
+  const char* mode = y.mode == MapMode::Trinary ? "trinary" : (y.mode == MapMode::Scale ? "scale" : "raw");
+  std::snprintf(buf, sizeof buf,
+                "image: %s\nmode: %s\nresolution: %.6f\norigin: [%.6f, %.6f, %.6f]\nnegate: %d\n"
+                "occupied_thresh: %.3f\nfree_thresh: %.3f\n",
+                y.image.string().c_str(), mode, y.resolution, y.origin.x, y.origin.y, y.origin.theta,
+                y.negate ? 1 : 0, y.occupied_thresh, y.free_thresh);
+  return buf;
+}
+
+OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta, const OccupancyGridOptions& grid_options) {
+  if (image.empty() || image.depth() != CV_8U || image.channels() > 4) {
+    throw Error("grid_from_image: expected a non-empty 8-bit image with 1 to 4 channels");
+  }
+  OccupancyGrid grid(core::GridGeometry(meta.resolution, image.cols, image.rows, meta.origin), grid_options);
+  const int channels = image.channels();
+  const bool has_alpha = channels == 2 || channels == 4;
+  const int colour_channels = has_alpha ? channels - 1 : channels;
+  const float lo = grid.min_log_odds(), hi = grid.max_log_odds();
+  for (int row = 0; row < image.rows; ++row) {
+    const std::uint8_t* p = image.ptr<std::uint8_t>(row);
+    const int y = image.rows - 1 - row;  // image top row is the map's last row
+    for (int x = 0; x < image.cols; ++x, p += channels) {
+      int sum = 0;
+      for (int k = 0; k < colour_channels; ++k) sum += p[k];
+      double colour = static_cast<double>(sum) / colour_channels;
+      const bool opaque = !has_alpha || p[channels - 1] == 255;
+      if (meta.negate) colour = 255.0 - colour;
+      std::optional<double> probability;  // nullopt: unknown
+      if (meta.mode == MapMode::Raw) {
+        const int v = static_cast<int>(std::lround(colour));
+        if (v <= 100) probability = v / 100.0;
+      } else {
+        const double occ = (255.0 - colour) / 255.0;
+        if (occ > meta.occupied_thresh) probability = 1.0;
+        else if (occ < meta.free_thresh) probability = 0.0;
+        else if (meta.mode == MapMode::Scale && opaque) {
+          const double ratio = (occ - meta.free_thresh) / (meta.occupied_thresh - meta.free_thresh);
+          probability = (1.0 + 98.0 * ratio) / 100.0;
+        }
+      }
+      float l = 0.0f;
+      if (probability) {
+        l = *probability <= 0.0 ? lo
+            : *probability >= 1.0 ? hi
+                                  : std::clamp(static_cast<float>(probability_to_log_odds(*probability)), lo, hi);
+      }
+      grid.set_log_odds({x, y}, l);
+    }
+  }
+  return grid;
+}
+
+cv::Mat grid_to_image(const OccupancyGrid& grid) {
+  cv::Mat image(grid.height(), grid.width(), CV_8UC1);
+  for (int row = 0; row < grid.height(); ++row) {
+    std::uint8_t* p = image.ptr<std::uint8_t>(row);
+    const int y = grid.height() - 1 - row;
+    for (int x = 0; x < grid.width(); ++x) {
+      switch (grid.state({x, y})) {
+        case CellState::Free: p[x] = 254; break;
+        case CellState::Occupied: p[x] = 0; break;
+        case CellState::Unknown: p[x] = 205; break;
+      }
+    }
+  }
+  return image;
+}
+
+OccupancyGrid load_map(const fs::path& path, const MapLoadOptions& options) {
+  const std::string ext = path.extension().string();
+  if (ext == ".yaml" || ext == ".yml") {
+    const MapYaml meta = parse_map_yaml(core::read_file(path, 1 << 20), path.string());
+    const fs::path image_path = meta.image.is_absolute() ? meta.image : path.parent_path() / meta.image;
+    if (!fs::exists(image_path)) {
+      throw InputError(path.string() + ": key 'image': file '" + image_path.string() + "' does not exist");
+    }
+    return grid_from_image(read_image(image_path, options), meta, options.grid);
+  }
+  if (!(options.default_resolution > 0.0)) {
+    throw InputError(path.string() + ": resolution must be positive, got " + std::to_string(options.default_resolution));
+  }
+  MapYaml meta;
+  meta.resolution = options.default_resolution;
+  return grid_from_image(read_image(path, options), meta, options.grid);
+}
+
+void write_image(const fs::path& path, const cv::Mat& image) {
+  std::vector<std::uint8_t> buffer;
+  std::string ext = path.extension().string();
+  if (ext.empty()) throw InputError(path.string() + ": output image needs an extension (.png, .pgm, ...)");
+  bool ok = false;
+  try {
+    ok = cv::imencode(ext, image, buffer);
+  } catch (const cv::Exception&) {
+    ok = false;
+  }
+  if (!ok) throw InputError(path.string() + ": cannot encode an image as '" + ext + "'");
+  core::write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(buffer.data()), buffer.size()));
+}
+
+void save_map_image(const OccupancyGrid& grid, const fs::path& path) { write_image(path, grid_to_image(grid)); }
+
+void save_map_yaml(const OccupancyGrid& grid, const fs::path& yaml_path) {
+  fs::path image_name = yaml_path.stem();
+  image_name += ".pgm";
+  save_map_image(grid, yaml_path.parent_path() / image_name);
+  MapYaml meta;
+  meta.image = image_name;
+  meta.resolution = grid.resolution();
+  meta.origin = grid.geometry().origin();
+  core::write_file_atomic(yaml_path, format_map_yaml(meta));
+}
+
+}  // namespace fleetmap::mapping

@@ -1,0 +1,61 @@
+#pragma once
+// Map files: PNG/PGM images and ROS map_server YAML, with map_server's semantics
+// (image row 0 is the top, cell row 0 the bottom; occ = (255 - mean(RGB)) / 255, inverted by
+// `negate`; Occupied when occ > occupied_thresh, Free when occ < free_thresh).
+#include <opencv2/core/mat.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "core/transform2.h"
+#include "mapping/occupancy_grid.h"
+
+namespace fleetmap::mapping {
+
+enum class MapMode { Trinary, Scale, Raw };
+
+// The keys of a map_server YAML file, with map_server's defaults.
+struct MapYaml {
+  std::filesystem::path image;  // as written: relative paths are relative to the YAML's folder
+  double resolution = 0.05;     // metres per cell
+  core::Pose2 origin;           // pose of the lower-left corner of the map
+  bool negate = false;
+  double occupied_thresh = 0.65;
+  double free_thresh = 0.196;
+  MapMode mode = MapMode::Trinary;
+};
+
+struct MapLoadOptions {
+  // Larger images are refused before they are decoded (64 M cells = 8000 x 8000).
+  std::int64_t max_cells = 64'000'000;
+  // A bare image has no YAML: it gets this resolution and origin (0, 0, 0).
+  double default_resolution = 0.05;
+  OccupancyGridOptions grid;
+};
+
+// Parses a map_server YAML text. `source` names it in errors. Unknown keys, missing `image` or
+// `resolution`, and bad values throw InputError naming the source, the key and its line.
+MapYaml parse_map_yaml(std::string_view text, const std::string& source);
+// The YAML text map_saver writes (the image path as given).
+std::string format_map_yaml(const MapYaml& yaml);
+
+// Builds a grid from a decoded image (8-bit, 1 to 4 channels) with map_server's rules.
+OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta,
+                              const OccupancyGridOptions& grid_options = {});
+// The map_saver image: 254 free, 0 occupied, 205 unknown, 8-bit single channel, top row first.
+cv::Mat grid_to_image(const OccupancyGrid& grid);
+
+// Loads a map from a map_server YAML (.yaml / .yml) or an image (PNG, PGM, ...).
+// Throws InputError naming the file for anything missing, unreadable, empty or too large.
+OccupancyGrid load_map(const std::filesystem::path& path, const MapLoadOptions& options = {});
+
+// Encodes `image` (extension picks the format) and writes it atomically.
+void write_image(const std::filesystem::path& path, const cv::Mat& image);
+// Saves the map_saver image of the grid as PNG or PGM (by extension).
+void save_map_image(const OccupancyGrid& grid, const std::filesystem::path& path);
+// Saves `<yaml_path stem>.pgm` beside the YAML and the YAML that map_server loads back.
+void save_map_yaml(const OccupancyGrid& grid, const std::filesystem::path& yaml_path);
+
+}  // namespace fleetmap::mapping

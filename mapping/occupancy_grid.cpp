@@ -1,0 +1,92 @@
+#include "mapping/occupancy_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <ostream>
+
+#include "core/error.h"
+#include "mapping/grid_traversal.h"
+
+namespace fleetmap::mapping {
+
+std::ostream& operator<<(std::ostream& os, CellState s) {
+  switch (s) {
+    case CellState::Unknown: return os << "Unknown";
+    case CellState::Free: return os << "Free";
+    case CellState::Occupied: return os << "Occupied";
+  }
+  return os << "CellState(?)";
+}
+
+double probability_to_log_odds(double p) { return std::log(p / (1.0 - p)); }
+double log_odds_to_probability(double l) { return 1.0 - 1.0 / (1.0 + std::exp(l)); }
+
+OccupancyGrid::OccupancyGrid(const GridGeometry& geometry, const OccupancyGridOptions& options)
+    : geometry_(geometry), options_(options),
+      log_odds_(static_cast<std::size_t>(geometry.cell_count()), 0.0f) {
+  const auto in_open_unit = [](double p) { return p > 0.0 && p < 1.0; };
+  if (!in_open_unit(options.hit_probability) || !in_open_unit(options.miss_probability) ||
+      !in_open_unit(options.min_probability) || !in_open_unit(options.max_probability) ||
+      !(options.miss_probability < 0.5 && options.hit_probability > 0.5) ||
+      !(options.min_probability < options.free_threshold &&
+        options.free_threshold <= 0.5 && 0.5 <= options.occupied_threshold &&
+        options.occupied_threshold < options.max_probability)) {
+    throw Error(
+        "occupancy grid options: need 0 < min < free_threshold <= 0.5 <= occupied_threshold < max < 1 "
+        "and miss < 0.5 < hit");
+  }
+  hit_log_odds_ = static_cast<float>(probability_to_log_odds(options.hit_probability));
+  miss_log_odds_ = static_cast<float>(probability_to_log_odds(options.miss_probability));
+  min_log_odds_ = static_cast<float>(probability_to_log_odds(options.min_probability));
+  max_log_odds_ = static_cast<float>(probability_to_log_odds(options.max_probability));
+  occupied_log_odds_ = static_cast<float>(probability_to_log_odds(options.occupied_threshold));
+  free_log_odds_ = static_cast<float>(probability_to_log_odds(options.free_threshold));
+}
+
+void OccupancyGrid::set_state(const Cell& c, CellState s) {
+  const float l = s == CellState::Free ? min_log_odds_ : (s == CellState::Occupied ? max_log_odds_ : 0.0f);
+  set_log_odds(c, l);
+}
+
+void OccupancyGrid::set_log_odds(const Cell& c, float l) {
+  if (contains(c)) log_odds_[static_cast<std::size_t>(geometry_.index(c))] = l;
+}
+
+void OccupancyGrid::update(const Cell& c, float delta) {
+  if (!contains(c)) return;
+  float& l = log_odds_[static_cast<std::size_t>(geometry_.index(c))];
+  l = std::clamp(l + delta, min_log_odds_, max_log_odds_);
+}
+
+int OccupancyGrid::integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit) {
+  const auto end_cell = geometry_.world_to_cell(to);
+  int updated = 0;
+  traverse_segment(geometry_, from, to, [&](const Cell& c, double) {
+    const bool is_end = end_cell && c == *end_cell;
+    update(c, is_end && hit ? hit_log_odds_ : miss_log_odds_);
+    ++updated;
+    return !is_end;
+  });
+  return updated;
+}
+
+std::int64_t OccupancyGrid::count(CellState s) const {
+  std::int64_t n = 0;
+  for (std::size_t i = 0; i < log_odds_.size(); ++i) n += state_at(static_cast<int>(i)) == s;
+  return n;
+}
+
+bool OccupancyGrid::same_states(const OccupancyGrid& other) const {
+  if (!(geometry_ == other.geometry_)) return false;
+  for (std::size_t i = 0; i < log_odds_.size(); ++i) {
+    if (state_at(static_cast<int>(i)) != other.state_at(static_cast<int>(i))) return false;
+  }
+  return true;
+}
+
+std::ostream& operator<<(std::ostream& os, const OccupancyGrid& g) {
+  return os << "OccupancyGrid(" << g.geometry() << ", " << g.count(CellState::Free) << " free, "
+            << g.count(CellState::Occupied) << " occupied)";
+}
+
+}  // namespace fleetmap::mapping

@@ -1,0 +1,97 @@
+#pragma once
+// A log-odds occupancy grid (Moravec & Elfes; the clamped update of OctoMap).
+#include <Eigen/Core>
+#include <cstdint>
+#include <iosfwd>
+#include <vector>
+
+#include "core/grid_geometry.h"
+
+namespace fleetmap::mapping {
+
+using core::Cell;
+using core::GridGeometry;
+
+enum class CellState : std::uint8_t { Unknown = 0, Free = 1, Occupied = 2 };
+
+std::ostream& operator<<(std::ostream& os, CellState s);
+
+// The inverse sensor model and the thresholds that turn a probability into a state.
+// The defaults make one beam enough to call a cell free or occupied, and a single
+// contradicting beam enough to make it unknown again.
+struct OccupancyGridOptions {
+  double hit_probability = 0.75;   // the cell a beam ends in
+  double miss_probability = 0.30;  // the cells a beam crosses
+  double min_probability = 0.12;   // clamping keeps the map able to change (as OctoMap)
+  double max_probability = 0.97;
+  double occupied_threshold = 0.65;  // Occupied when P(occ) > this (map_server occupied_thresh)
+  double free_threshold = 0.35;      // Free when P(occ) < this
+
+  bool operator==(const OccupancyGridOptions&) const = default;
+};
+
+double probability_to_log_odds(double p);
+double log_odds_to_probability(double l);
+
+class OccupancyGrid {
+ public:
+  OccupancyGrid() = default;
+  // All cells Unknown (log-odds 0). Throws fleetmap::Error on inconsistent options.
+  explicit OccupancyGrid(const GridGeometry& geometry, const OccupancyGridOptions& options = {});
+
+  const GridGeometry& geometry() const { return geometry_; }
+  const OccupancyGridOptions& options() const { return options_; }
+  int width() const { return geometry_.width(); }
+  int height() const { return geometry_.height(); }
+  double resolution() const { return geometry_.resolution(); }
+  bool contains(const Cell& c) const { return geometry_.contains(c); }
+
+  // Cells outside the grid are Unknown.
+  CellState state(const Cell& c) const { return contains(c) ? state_at(geometry_.index(c)) : CellState::Unknown; }
+  CellState state_at(int index) const {
+    const float l = log_odds_[static_cast<std::size_t>(index)];
+    return l > occupied_log_odds_ ? CellState::Occupied
+                                  : (l < free_log_odds_ ? CellState::Free : CellState::Unknown);
+  }
+  bool is_free(const Cell& c) const { return state(c) == CellState::Free; }
+  float log_odds(const Cell& c) const { return log_odds_[static_cast<std::size_t>(geometry_.index(c))]; }
+  float log_odds_at(int index) const { return log_odds_[static_cast<std::size_t>(index)]; }
+  double probability(const Cell& c) const { return log_odds_to_probability(log_odds(c)); }
+
+  // Sets a cell to a firm state: the clamping bound for Free/Occupied, 0 for Unknown.
+  void set_state(const Cell& c, CellState s);
+  void set_log_odds(const Cell& c, float l);
+  // Adds `delta` to a cell's log-odds, clamped to the bounds. Ignores cells outside the grid.
+  void update(const Cell& c, float delta);
+  void update_hit(const Cell& c) { update(c, hit_log_odds_); }
+  void update_miss(const Cell& c) { update(c, miss_log_odds_); }
+
+  // One range beam from `from` to `to` (metres): every cell the segment crosses before its end
+  // cell gets a miss; the end cell gets a hit when `hit`, or a miss when the beam reached its
+  // maximum range without a return. Each cell is updated once; the part outside the grid is
+  // ignored. Returns the number of cells updated.
+  int integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit);
+
+  std::int64_t count(CellState s) const;
+  std::int64_t known_count() const { return count(CellState::Free) + count(CellState::Occupied); }
+
+  const std::vector<float>& log_odds_data() const { return log_odds_; }
+  float hit_log_odds() const { return hit_log_odds_; }
+  float miss_log_odds() const { return miss_log_odds_; }
+  float min_log_odds() const { return min_log_odds_; }
+  float max_log_odds() const { return max_log_odds_; }
+
+  // Same geometry and the same state in every cell (log-odds may differ).
+  bool same_states(const OccupancyGrid& other) const;
+
+ private:
+  GridGeometry geometry_;
+  OccupancyGridOptions options_;
+  std::vector<float> log_odds_;
+  float hit_log_odds_ = 0, miss_log_odds_ = 0, min_log_odds_ = 0, max_log_odds_ = 0;
+  float occupied_log_odds_ = 0, free_log_odds_ = 0;
+};
+
+std::ostream& operator<<(std::ostream& os, const OccupancyGrid& g);
+
+}  // namespace fleetmap::mapping

@@ -1,0 +1,47 @@
+#pragma once
+// The built-in maps: seed 003's four 200x200 environments (Fig. 5: empty, unstructured, office,
+// corridor) and more (cave, maze, warehouse, campus). Each is a PNG + map_server YAML pair in
+// maps/, made by generate_builtin_map(); regenerating gives the committed files bit for bit.
+#include <opencv2/core/mat.hpp>
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mapping/map_io.h"
+#include "mapping/occupancy_grid.h"
+
+namespace fleetmap::maps {
+
+struct BuiltinMapInfo {
+  std::string name;
+  std::string description;
+};
+
+// In the order `fleetmap maps list` shows them.
+const std::vector<BuiltinMapInfo>& builtin_maps();
+bool is_builtin_map(std::string_view name);
+// "empty, unstructured, ..." for messages.
+std::string builtin_map_names();
+
+struct GeneratedMap {
+  cv::Mat image;          // 8-bit grey, 254 free, 0 occupied, top row first
+  mapping::MapYaml yaml;  // image: <name>.png
+};
+
+// Deterministic: the same image and YAML on every call. Throws InputError for unknown names.
+GeneratedMap generate_builtin_map(std::string_view name);
+// The bytes of the committed files: the PNG encoding of the image, and the YAML text.
+std::string encode_png(const cv::Mat& image);
+
+// Where the built-in map files live: $FLEETMAP_MAPS_DIR if set, else the source tree's maps/,
+// else <executable>/../share/fleetmap/maps.
+std::filesystem::path builtin_maps_dir();
+
+// Loads a map named by the user: an existing PNG/PGM/YAML file, or a built-in map name.
+// Throws InputError that names the input, listing the built-in names when it is neither.
+mapping::OccupancyGrid load_map_source(const std::string& name_or_path,
+                                       const mapping::MapLoadOptions& options = {});
+
+}  // namespace fleetmap::maps

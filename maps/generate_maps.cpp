@@ -1,0 +1,27 @@
+// Writes every built-in map (PNG + YAML) into a folder, by default the maps/ folder beside this
+// file. The committed files are this program's output; tests/maps checks they still match.
+//   build/maps/fleetmap_generate_maps [OUT_DIR]
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+
+#include "core/file_io.h"
+#include "maps/builtin_maps.h"
+
+int main(int argc, char** argv) {
+  namespace fm = fleetmap;
+  try {
+    const std::filesystem::path out = argc > 1 ? std::filesystem::path(argv[1]) : fm::maps::builtin_maps_dir();
+    for (const auto& info : fm::maps::builtin_maps()) {
+      const auto m = fm::maps::generate_builtin_map(info.name);
+      fm::core::write_file_atomic(out / (info.name + ".png"), fm::maps::encode_png(m.image));
+      fm::core::write_file_atomic(out / (info.name + ".yaml"), fm::mapping::format_map_yaml(m.yaml));
+      std::printf("%-13s %4dx%-4d -> %s\n", info.name.c_str(), m.image.cols, m.image.rows,
+                  (out / (info.name + ".png")).c_str());
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fleetmap_generate_maps: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
