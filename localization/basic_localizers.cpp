@@ -1,0 +1,72 @@
+// `ideal` and `odometry`: the two localizers that need no filter.
+#include <cmath>
+
+#include "localization/localizer.h"
+#include "localization/localizers.h"
+
+namespace fleetmap::localization {
+
+core::Pose2 integrate_motion(const core::Pose2& p, const Odometry& u) {
+  const double dtheta = u.omega * u.dt;
+  if (std::abs(dtheta) < 1e-9) {
+    return {p.x + u.v * u.dt * std::cos(p.theta), p.y + u.v * u.dt * std::sin(p.theta), p.theta};
+  }
+  const double r = u.v / u.omega;
+  return {p.x + r * (std::sin(p.theta + dtheta) - std::sin(p.theta)),
+          p.y - r * (std::cos(p.theta + dtheta) - std::cos(p.theta)), p.theta + dtheta};
+}
+
+namespace {
+
+// The simulator's true pose: the upper bound every other localizer is compared with.
+class IdealLocalizer final : public Localizer {
+ public:
+  explicit IdealLocalizer(const LocalizerContext& c) : pose_(c.initial_pose) {}
+  std::string name() const override { return "ideal"; }
+  void predict(const Odometry& u) override { pose_ = integrate_motion(pose_, u); }
+  void observe_truth(const core::Pose2& truth) override { pose_ = truth; }
+  core::Pose2 pose() const override { return pose_; }
+  Eigen::Matrix3d covariance() const override { return Eigen::Matrix3d::Zero(); }
+
+ private:
+  core::Pose2 pose_;
+};
+
+// Dead reckoning: integrates odometry; the covariance grows with the process noise.
+class OdometryLocalizer final : public Localizer {
+ public:
+  explicit OdometryLocalizer(const LocalizerContext& c) : pose_(c.initial_pose), options_(c.options) {
+    covariance_ = Eigen::Vector3d(c.options.initial_xy * c.options.initial_xy, c.options.initial_xy * c.options.initial_xy,
+                                  c.options.initial_theta * c.options.initial_theta)
+                      .asDiagonal();
+  }
+  std::string name() const override { return "odometry"; }
+  void predict(const Odometry& u) override {
+    // Linearised propagation of the pose covariance through the motion model.
+    Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+    const double a = pose_.theta + 0.5 * u.omega * u.dt;
+    f(0, 2) = -u.v * u.dt * std::sin(a);
+    f(1, 2) = u.v * u.dt * std::cos(a);
+    const Eigen::Vector3d q(options_.process_noise_xy * options_.process_noise_xy,
+                            options_.process_noise_xy * options_.process_noise_xy,
+                            options_.process_noise_theta * options_.process_noise_theta);
+    covariance_ = f * covariance_ * f.transpose() + Eigen::Matrix3d(q.asDiagonal());
+    pose_ = integrate_motion(pose_, u);
+  }
+  core::Pose2 pose() const override { return pose_; }
+  Eigen::Matrix3d covariance() const override { return covariance_; }
+
+ private:
+  core::Pose2 pose_;
+  LocalizerOptions options_;
+  Eigen::Matrix3d covariance_;
+};
+
+}  // namespace
+
+std::unique_ptr<Localizer> make_ideal_localizer(const LocalizerContext& c) { return std::make_unique<IdealLocalizer>(c); }
+std::unique_ptr<Localizer> make_odometry_localizer(const LocalizerContext& c) {
+  return std::make_unique<OdometryLocalizer>(c);
+}
+
+}  // namespace fleetmap::localization

@@ -1,0 +1,113 @@
+#pragma once
+// One interface for every way a robot knows where it is. The simulator calls, each step:
+// predict(odometry) -> update_landmarks / update_scan / update_robot (when it has such readings)
+// -> pose() / covariance(). Localizers are chosen by name (`--localization`, scenario files)
+// through make_localizer(); tests iterate over localizer_names().
+#include <Eigen/Core>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/random.h"
+#include "core/transform2.h"
+#include "mapping/occupancy_grid.h"
+
+namespace fleetmap::localization {
+
+// The odometry of one step: commanded (or wheel-measured) speeds over the period dt.
+struct Odometry {
+  double v = 0.0;      // m/s, forward
+  double omega = 0.0;  // rad/s, counter-clockwise
+  double dt = 1.0;     // s
+};
+
+// Differential-drive motion: the exact arc for (v, omega) over dt.
+core::Pose2 integrate_motion(const core::Pose2& pose, const Odometry& u);
+
+// A point landmark seen from the robot: range (m) and bearing (rad, robot frame).
+struct LandmarkObservation {
+  int id = -1;  // the landmark's identity when the sensor reports it, -1 when unknown
+  double range = 0.0;
+  double bearing = 0.0;
+};
+
+// A point landmark of a known map.
+struct Landmark {
+  int id = 0;
+  Eigen::Vector2d position = Eigen::Vector2d::Zero();
+};
+
+// A 2D laser scan in the robot frame.
+struct RangeScan {
+  std::vector<double> angles;                // rad, robot frame
+  std::vector<std::optional<double>> ranges;  // nullopt: no return within max_range
+  double max_range = 0.0;
+};
+
+// Another robot detected by this one, with what that robot believes of itself.
+struct RobotObservation {
+  int other = -1;
+  double range = 0.0;
+  double bearing = 0.0;  // rad, in this robot's frame
+  core::Pose2 other_pose;             // the other robot's own estimate
+  Eigen::Matrix3d other_covariance = Eigen::Matrix3d::Zero();
+};
+
+// Noise models and filter settings shared by the localizers; each uses what it needs.
+struct LocalizerOptions {
+  // Odometry noise per step (standard deviations), the model's Q: seed 000 uses 0.001 m and 0.01 deg.
+  double process_noise_xy = 0.001;         // m
+  double process_noise_theta = 0.000174533;  // rad (0.01 deg)
+  // Landmark sensor noise (standard deviations).
+  double range_noise = 0.02;     // m
+  double bearing_noise = 0.0175;  // rad
+  // Initial pose uncertainty (standard deviations); seed 000: P0 = diag(0.05^2, 0.05^2, 0.0175^2).
+  double initial_xy = 0.05;
+  double initial_theta = 0.0175;
+  // Data association: by the sensor's landmark identities, or by nearest neighbour with a
+  // Mahalanobis gate (chi-square, 2 dof) when identities are unknown.
+  bool known_associations = true;
+  double association_gate = 9.21;  // chi2(2) at 99%
+  // Robot-robot detections update the estimate (off by default).
+  bool use_robot_detections = false;
+};
+
+// What a localizer may be given at the start.
+struct LocalizerContext {
+  core::Pose2 initial_pose;             // where the robot starts, in its map frame
+  std::vector<Landmark> known_landmarks;  // for `ekf` (seed 003 §V: fixed artificial landmarks)
+  LocalizerOptions options;
+  std::uint64_t seed = 0;
+};
+
+class Localizer {
+ public:
+  virtual ~Localizer() = default;
+  virtual std::string name() const = 0;
+
+  virtual void predict(const Odometry& u) = 0;
+  virtual void update_landmarks(const std::vector<LandmarkObservation>& /*observations*/) {}
+  virtual void update_scan(const RangeScan& /*scan*/, const mapping::OccupancyGrid& /*own_map*/) {}
+  virtual void update_robot(const RobotObservation& /*observation*/) {}
+  // Only the `ideal` localizer uses the simulator's truth.
+  virtual void observe_truth(const core::Pose2& /*truth*/) {}
+
+  virtual core::Pose2 pose() const = 0;
+  virtual Eigen::Matrix3d covariance() const = 0;
+
+  // Counters for metrics.json (e.g. "rejected_associations").
+  virtual std::vector<std::pair<std::string, double>> counters() const { return {}; }
+  // Landmark estimates held in the state, if any (for pictures and metrics).
+  virtual std::vector<Landmark> landmark_estimates() const { return {}; }
+};
+
+// The registered names, in the order --help lists them.
+std::vector<std::string> localizer_names();
+// One line per localizer, for --help and README.
+std::string localizer_help();
+// Throws InputError naming the valid names for an unknown one.
+std::unique_ptr<Localizer> make_localizer(const std::string& name, const LocalizerContext& context);
+
+}  // namespace fleetmap::localization

@@ -1,0 +1,48 @@
+#include <functional>
+
+#include "core/error.h"
+#include "localization/localizer.h"
+#include "localization/localizers.h"
+
+namespace fleetmap::localization {
+
+namespace {
+
+struct Entry {
+  std::string name;
+  std::string help;
+  std::function<std::unique_ptr<Localizer>(const LocalizerContext&)> make;
+};
+
+const std::vector<Entry>& registry() {
+  static const std::vector<Entry> kEntries = {
+      {"ideal", "the simulator's true pose (an upper bound to compare with)", make_ideal_localizer},
+      {"odometry", "dead reckoning from the noisy motion, never corrected", make_odometry_localizer},
+  };
+  return kEntries;
+}
+
+}  // namespace
+
+std::vector<std::string> localizer_names() {
+  std::vector<std::string> names;
+  for (const auto& e : registry()) names.push_back(e.name);
+  return names;
+}
+
+std::string localizer_help() {
+  std::string s;
+  for (const auto& e : registry()) s += "  " + e.name + ": " + e.help + "\n";
+  return s;
+}
+
+std::unique_ptr<Localizer> make_localizer(const std::string& name, const LocalizerContext& context) {
+  for (const auto& e : registry()) {
+    if (e.name == name) return e.make(context);
+  }
+  std::string names;
+  for (const auto& e : registry()) names += (names.empty() ? "" : ", ") + e.name;
+  throw InputError("unknown localization '" + name + "' (valid: " + names + ")");
+}
+
+}  // namespace fleetmap::localization

@@ -1,0 +1,13 @@
+#pragma once
+// The factories behind the localizer registry (localizer_registry.cpp). Add a localizer by
+// writing its file, declaring its factory here and adding one row to the registry table.
+#include <memory>
+
+#include "localization/localizer.h"
+
+namespace fleetmap::localization {
+
+std::unique_ptr<Localizer> make_ideal_localizer(const LocalizerContext& context);
+std::unique_ptr<Localizer> make_odometry_localizer(const LocalizerContext& context);
+
+}  // namespace fleetmap::localization
