@@ -33,10 +33,12 @@ struct LandmarkObservation {
   double bearing = 0.0;
 };
 
-// A point landmark of a known map.
+// A point landmark: of a known map, or an estimate held in a filter's state (landmark_estimates()).
 struct Landmark {
   int id = 0;
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
+  // The estimate's covariance (m^2); zero for a landmark of a known map.
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
 };
 
 // A 2D laser scan in the robot frame.
@@ -46,7 +48,8 @@ struct RangeScan {
   double max_range = 0.0;
 };
 
-// Another robot detected by this one, with what that robot believes of itself.
+// Another robot detected by this one, with what that robot believes of itself. other_pose and
+// other_covariance must be expressed in this robot's map frame.
 struct RobotObservation {
   int other = -1;
   double range = 0.0;
@@ -70,6 +73,14 @@ struct LocalizerOptions {
   // Mahalanobis gate (chi-square, 2 dof) when identities are unknown.
   bool known_associations = true;
   double association_gate = 9.21;  // chi2(2) at 99%
+  // `ekf-slam`, unknown identities: a reading whose smallest squared Mahalanobis distance to every
+  // landmark in the state exceeds this starts a new landmark; one between association_gate and
+  // this is rejected as ambiguous (and counted). A true reading exceeds it once in a million, so
+  // a long run does not duplicate its landmarks.
+  double slam_new_landmark_gate = 27.63;  // chi2(2) at 1 - 1e-6
+  // `ekf-slam`: a landmark not observed for more than this many predict steps leaves the state
+  // (its rows and columns are removed, seed 000 §3.1); 0 keeps every landmark.
+  int slam_forget_after_steps = 0;
   // Robot-robot detections update the estimate (off by default).
   bool use_robot_detections = false;
 };
@@ -97,7 +108,9 @@ class Localizer {
   virtual core::Pose2 pose() const = 0;
   virtual Eigen::Matrix3d covariance() const = 0;
 
-  // Counters for metrics.json (e.g. "rejected_associations").
+  // Counters for metrics.json. `ekf` and `ekf-slam`: "landmark_updates", "rejected_associations",
+  // "robot_updates", "rejected_robot_detections"; `ekf-slam` also "landmarks_in_state",
+  // "landmarks_added", "landmarks_removed".
   virtual std::vector<std::pair<std::string, double>> counters() const { return {}; }
   // Landmark estimates held in the state, if any (for pictures and metrics).
   virtual std::vector<Landmark> landmark_estimates() const { return {}; }

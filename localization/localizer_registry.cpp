@@ -18,6 +18,10 @@ const std::vector<Entry>& registry() {
   static const std::vector<Entry> kEntries = {
       {"ideal", "the simulator's true pose (an upper bound to compare with)", make_ideal_localizer},
       {"odometry", "dead reckoning from the noisy motion, never corrected", make_odometry_localizer},
+      {"ekf", "EKF on the pose with range-bearing readings of known landmarks (by id, or nearest neighbour gated)",
+       make_ekf_localizer},
+      {"ekf-slam", "EKF-SLAM: pose and point landmarks learnt as they are seen (seed 000 eq. (4)-(5))",
+       make_ekf_slam_localizer},
   };
   return kEntries;
 }

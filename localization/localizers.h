@@ -9,5 +9,7 @@ namespace fleetmap::localization {
 
 std::unique_ptr<Localizer> make_ideal_localizer(const LocalizerContext& context);
 std::unique_ptr<Localizer> make_odometry_localizer(const LocalizerContext& context);
+std::unique_ptr<Localizer> make_ekf_localizer(const LocalizerContext& context);       // ekf_localizer.cpp
+std::unique_ptr<Localizer> make_ekf_slam_localizer(const LocalizerContext& context);  // ekf_slam_localizer.cpp
 
 }  // namespace fleetmap::localization
