@@ -66,9 +66,10 @@ LocalizationSummary LocalizationMetrics::summary(double confidence) const {
   s.steps = steps_;
   s.position_rmse = std::sqrt(position_sq_ / n);
   s.heading_rmse = std::sqrt(heading_sq_ / n);
-  s.nees_band = average_chi_square_band(3, steps_, confidence);
-  if (nees_steps_ == steps_) {
-    s.average_nees = nees_sum_ / n;
+  s.nees_steps = nees_steps_;
+  if (nees_steps_ > 0) {
+    s.nees_band = average_chi_square_band(3, nees_steps_, confidence);
+    s.average_nees = nees_sum_ / static_cast<double>(nees_steps_);
     s.nees_inside_band = s.nees_band.contains(*s.average_nees);
   }
   s.seed000_mu = mu_sum_ / n;

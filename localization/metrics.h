@@ -43,9 +43,11 @@ struct LocalizationSummary {
   long steps = 0;
   double position_rmse = 0.0;  // m: sqrt(mean(ex^2 + ey^2))
   double heading_rmse = 0.0;   // rad
-  // The mean NEES over the steps; nullopt when some step's covariance is not positive definite.
+  // The mean NEES over the nees_steps steps whose covariance is positive definite (a start with
+  // P0 = 0, or `ideal`, has none); nullopt when there is no such step.
   std::optional<double> average_nees;
-  ChiSquareBand nees_band;  // 95% band of the mean of `steps` chi2(3) values
+  long nees_steps = 0;
+  ChiSquareBand nees_band;  // the band of the mean of `nees_steps` chi2(3) values (0, 0 if none)
   bool nees_inside_band = false;
   // Seed 000's mu: 1/(k_f + 1) sum_{k=0}^{k_f} e^T P e over the same steps (add step 0 to match
   // the paper's sum).

@@ -84,6 +84,7 @@ TEST(LocalizationMetrics, SummarisesARun) {
   EXPECT_NEAR(s.heading_rmse, std::sqrt(1e-4 / 3.0), 1e-12);
   ASSERT_TRUE(s.average_nees.has_value());
   EXPECT_NEAR(*s.average_nees, 2.0, 1e-9);
+  EXPECT_EQ(s.nees_steps, 3);
   EXPECT_NEAR(s.nees_band.lower, average_chi_square_band(3, 3).lower, 1e-12);
   EXPECT_TRUE(s.nees_inside_band);
   EXPECT_NEAR(s.seed000_mu, (0.01 * 0.01 + 0.04 * 0.01 + 1e-4 * 1e-4) / 3.0, 1e-15);
@@ -98,6 +99,23 @@ TEST(LocalizationMetrics, ReportsNoNeesForAZeroCovarianceAndNeedsASample) {
   EXPECT_FALSE(s.nees_inside_band);
   EXPECT_EQ(s.position_rmse, 0.0);
   EXPECT_EQ(s.seed000_mu, 0.0);
+  EXPECT_EQ(s.nees_steps, 0);
+}
+
+// A start known exactly (P0 = 0) has no NEES; the steps after it still do.
+TEST(LocalizationMetrics, AveragesTheNeesOverTheStepsWithAPositiveDefiniteCovariance) {
+  LocalizationMetrics m;
+  m.add({0, 0, 0}, {0, 0, 0}, Eigen::Matrix3d::Zero());
+  const Eigen::Matrix3d p = Eigen::Matrix3d::Identity() * 0.01;
+  m.add({0, 0, 0}, {0.1, 0.0, 0.0}, p);  // NEES 1
+  m.add({0, 0, 0}, {0.0, 0.2, 0.0}, p);  // NEES 4
+  const LocalizationSummary s = m.summary();
+  EXPECT_EQ(s.steps, 3);
+  EXPECT_EQ(s.nees_steps, 2);
+  ASSERT_TRUE(s.average_nees.has_value());
+  EXPECT_NEAR(*s.average_nees, 2.5, 1e-12);
+  EXPECT_NEAR(s.nees_band.upper, average_chi_square_band(3, 2).upper, 1e-12);
+  EXPECT_NEAR(s.position_rmse, std::sqrt(0.05 / 3.0), 1e-12);
 }
 
 TEST(LocalizationMetrics, FlagsAnOverconfidentRun) {
