@@ -16,5 +16,6 @@ struct Command {
 };
 
 Command add_maps_command(CLI::App& root);
+Command add_plan_command(CLI::App& root);
 
 }  // namespace fleetmap::cli
