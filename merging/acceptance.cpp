@@ -1,0 +1,111 @@
+#include "merging/acceptance.h"
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <unordered_set>
+
+namespace fleetmap::merging {
+
+Acceptance acceptance_index(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
+                            const core::Transform2& b_to_a) {
+  Acceptance acc;
+  const Eigen::Matrix2d r = b_to_a.rotation_matrix();
+  const Eigen::Vector2d t = b_to_a.translation();
+  const int wa = a.width(), ha = a.height();
+  for (int y = 0; y < b.height(); ++y) {
+    const int row = y * b.width();
+    // The row's cells move along a line: start and step in a's coordinates.
+    const Eigen::Vector2d start = r * Eigen::Vector2d(0.0, y) + t, step = r.col(0);
+    for (int x = 0; x < b.width(); ++x) {
+      const mapping::CellState sb = b.state_at(row + x);
+      if (sb == mapping::CellState::Unknown) continue;
+      const Eigen::Vector2d p = start + double(x) * step;
+      const int ax = nearest_cell(p.x()), ay = nearest_cell(p.y());
+      if (ax < 0 || ay < 0 || ax >= wa || ay >= ha) continue;
+      const mapping::CellState sa = a.state_at(ay * wa + ax);
+      if (sa == mapping::CellState::Unknown) continue;
+      if (sa == sb) ++acc.agree;
+      else ++acc.disagree;
+    }
+  }
+  return acc;
+}
+
+namespace {
+
+struct Tally {
+  int matched = 0, contradicted = 0;
+  std::unordered_set<std::int64_t> blocks;   // 4 x 4 blocks of the source map already counted
+  std::vector<Eigen::Vector2d> positions;    // matched walls, in a's frame
+  std::vector<Eigen::Matrix2d> structures;   // their local structure, in a's frame
+};
+
+// Counts `from`'s wall cells moved into `to` by t.
+void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transform2& t, const core::Transform2& to_a,
+           bool from_b, const QualityOptions& options, Tally& out) {
+  const GridLevel& target = to.level(0);
+  const Eigen::Matrix2f r = t.rotation_matrix().cast<float>();
+  const Eigen::Vector2f tr = t.translation().cast<float>();
+  const Eigen::Matrix2d ra = to_a.rotation_matrix() * t.rotation_matrix();
+  for (const auto& w : from.walls()) {
+    const Eigen::Vector2f p = r * w.position + tr;
+    const int x = nearest_cell(p.x()), y = nearest_cell(p.y());
+    if (x < 0 || y < 0 || x >= target.width() || y >= target.height() || !target.known(x, y)) continue;
+    const float d = target.distance_at(p.x(), p.y(), 1e4f);
+    if (d <= options.match_distance) {
+      ++out.matched;
+      // Neighbouring wall cells say the same thing: one sample per 4 x 4 block of the source.
+      const std::int64_t key = (std::int64_t(int(w.position.x()) / 4) << 32) ^ std::int64_t(int(w.position.y()) / 4) ^
+                               (from_b ? std::int64_t(1) << 62 : 0);
+      if (!out.blocks.insert(key).second) continue;
+      out.positions.push_back(to_a.apply(p.cast<double>()));
+      out.structures.push_back(ra * w.structure.cast<double>() * ra.transpose());
+    } else if (d >= options.contradiction_distance && target.is_free(x, y)) {
+      ++out.contradicted;
+    }
+  }
+  for (const auto& w : from.level(0).interior_points) {
+    const Eigen::Vector2f p = r * w + tr;
+    const int x = nearest_cell(p.x()), y = nearest_cell(p.y());
+    if (x < 0 || y < 0 || x >= target.width() || y >= target.height() || !target.is_free(x, y)) continue;
+    if (target.distance_at(p.x(), p.y(), 1e4f) >= options.contradiction_distance) ++out.contradicted;
+  }
+}
+
+}  // namespace
+
+AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a,
+                                    const QualityOptions& options) {
+  Tally t;
+  tally(b, a, b_to_a, core::Transform2::identity(), true, options, t);
+  tally(a, b, b_to_a.inverse(), b_to_a, false, options, t);
+  AlignmentQuality q;
+  q.matched = t.matched;
+  q.contradicted = t.contradicted;
+  q.score = t.matched - options.contradiction_weight * t.contradicted;
+  q.agreement = t.matched + t.contradicted > 0 ? double(t.matched) / double(t.matched + t.contradicted) : 0.0;
+  if (t.positions.size() < 3) return q;
+  Eigen::Vector2d c = Eigen::Vector2d::Zero();
+  for (const auto& p : t.positions) c += p;
+  c /= double(t.positions.size());
+  double r2 = 0.0;
+  for (const auto& p : t.positions) r2 += (p - c).squaredNorm();
+  const double radius = std::sqrt(r2 / double(t.positions.size()));
+  q.overlap_radius = radius;
+  q.overlap_centre = c;
+  if (radius < 1e-6) return q;
+  // Information of (tx, ty, theta * radius): G = [I | perp(p - c) / radius], H = sum G^T S G.
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  for (std::size_t i = 0; i < t.positions.size(); ++i) {
+    const Eigen::Vector2d d = (t.positions[i] - c) / radius;
+    Eigen::Matrix<double, 2, 3> g;
+    g << 1.0, 0.0, -d.y(), 0.0, 1.0, d.x();
+    h += g.transpose() * t.structures[i] * g;
+  }
+  // Both maps contribute a copy of each matched wall; count each wall once.
+  h *= 0.5;
+  q.constraint = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(h, Eigen::EigenvaluesOnly).eigenvalues()(0);
+  return q;
+}
+
+}  // namespace fleetmap::merging

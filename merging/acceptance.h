@@ -1,0 +1,55 @@
+#pragma once
+// The acceptance index of seed 003 (after Birk & Carpin 2006): how much two maps agree when one
+// is placed on the other, and the wall-based quality every merge method is judged by.
+#include <Eigen/Core>
+
+#include <cstdint>
+
+#include "core/transform2.h"
+#include "mapping/occupancy_grid.h"
+#include "merging/prepared_grid.h"
+
+namespace fleetmap::merging {
+
+// agr and dis of seed 003 over the cells known in both maps: a cell of b (at its centre, moved by
+// b_to_a, rounded to the nearest cell of a) agrees when both have the same state, disagrees when
+// one is free and the other occupied. omega = agr / (agr + dis), 0 (not NaN) without common cells.
+struct Acceptance {
+  std::int64_t agree = 0;
+  std::int64_t disagree = 0;
+  std::int64_t common() const { return agree + disagree; }
+  double omega() const { return common() > 0 ? double(agree) / double(common()) : 0.0; }
+};
+
+Acceptance acceptance_index(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
+                            const core::Transform2& b_to_a);
+
+struct QualityOptions {
+  double match_distance = 1.5;          // cells: a wall cell matches a wall of the other map this close
+  double contradiction_distance = 3.0;  // cells: a wall cell on the other map's free space this far
+                                        // from its walls contradicts it
+  // score = matched - weight * contradicted: an answer whose walls agree less than
+  // weight / (1 + weight) (10: 91%) scores below zero, however large its overlap.
+  double contradiction_weight = 20.0;
+};
+
+// How well the walls of two maps fit under a transform, counted both ways (b's walls in a, and
+// a's walls in b) over the cells that land on known cells of the other map.
+struct AlignmentQuality {
+  int matched = 0;       // wall cells near a wall of the other map
+  int contradicted = 0;  // wall cells, and interior cells of filled obstacles (every second row and
+                         // column), on the other map's free space far from its walls
+  double score = 0.0;      // matched - contradiction_weight * contradicted
+  double agreement = 0.0;  // matched / (matched + contradicted); 0 without either
+  // Smallest eigenvalue of the information the matched walls give about (tx, ty, theta * radius):
+  // how many wall cells' worth pin the weakest direction down. A straight wall alone, or one
+  // round obstacle, leaves a direction free and gives ~0.
+  double constraint = 0.0;
+  double overlap_radius = 0.0;  // RMS distance of the matched walls from their centroid, in cells
+  Eigen::Vector2d overlap_centre = Eigen::Vector2d::Zero();  // that centroid, in a's cells
+};
+
+AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a,
+                                    const QualityOptions& options = {});
+
+}  // namespace fleetmap::merging

@@ -1,0 +1,113 @@
+#pragma once
+// Aligning two occupancy grids when their relative pose is unknown, with a confidence and a
+// refusal ("no reliable overlap") below a threshold: a wrong merge is worse than none.
+//
+// Methods propose candidate transforms; one common pipeline then refines every candidate
+// (refine.h), scores it by how the two maps' walls fit (acceptance.h) and decides. Methods are
+// chosen by name through the explicit table merge_methods(); "auto" tries them in order.
+//
+// Transforms map b's cell coordinates (x = column, y = row from the bottom, cell centres at
+// integers) into a's: a = R(theta) b + t. Both grids are taken to have the same cell size.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/random.h"
+#include "core/transform2.h"
+#include "mapping/occupancy_grid.h"
+#include "merging/acceptance.h"
+#include "merging/feature_matching.h"
+#include "merging/hypothesis.h"
+#include "merging/overlap_search.h"
+#include "merging/prepared_grid.h"
+#include "merging/refine.h"
+
+namespace fleetmap::merging {
+
+// confidence = agreement factor * support factor * distinctiveness, each in [0, 1]:
+// - agreement factor: the share of matched walls among matched + contradicting walls, mapped
+//   linearly from zero_agreement (0) to full_agreement (1);
+// - support factor: AlignmentQuality::constraint / full_constraint, at most 1 (a straight wall or a
+//   single round obstacle leaves a direction free and gives 0);
+// - distinctiveness: 1 - S2 / S1, with S1 the best candidate's score and S2 the best score of a
+//   plausible different answer (rotation off by more than distinct_rotation_deg, or displacement at
+//   the overlap centre above distinct_distance cells). Repeated or symmetric places give ~0.
+//   A different answer is plausible when its contradictions are what the best answer's own rate
+//   (at least min_contradiction_rate) predicts: with z = (c - rate n) / sqrt(rate n + 1) over its n
+//   tested walls, it counts fully for z <= 2 and not at all for z >= 4.
+struct ConfidenceOptions {
+  double zero_agreement = 0.8;
+  double full_agreement = 0.95;
+  double full_constraint = 40.0;
+  double distinct_distance = 4.0;
+  double distinct_rotation_deg = 2.0;
+  double min_contradiction_rate = 0.005;
+};
+
+struct MergeOptions {
+  std::string method = "auto";   // a name of merge_method_names()
+  double min_confidence = 0.5;   // below: not merged, "no reliable overlap"
+  bool refine = true;            // refine candidates to sub-cell accuracy (off: the methods' raw answers)
+  int coarse_candidates = 8;     // candidates kept after the coarse levels
+  int fine_candidates = 4;       // candidates taken to full resolution
+  double sweep_step_deg = 4.0;   // `overlap`'s second pass: rotation sweep step
+  // Before merging, search for other placements (b turned by quarter turns from the answer, all
+  // translations) so that symmetric or repeated places lower the distinctiveness whatever method
+  // proposed the answer.
+  bool probe_symmetries = true;
+  std::uint64_t seed = 1;        // RANSAC sampling
+  OverlapSearchOptions overlap;
+  FeatureMatchingOptions features;
+  RefineOptions refinement;
+  QualityOptions quality;
+  ConfidenceOptions confidence;
+  PrepareOptions prepare;
+};
+
+struct MergeResult {
+  bool merged = false;            // confidence >= min_confidence
+  core::Transform2 transform;     // b's cells into a's cells; the best candidate even when not merged
+  double acceptance = 0.0;        // omega of seed 003 at `transform`
+  double confidence = 0.0;        // in [0, 1]
+  double distinctiveness = 0.0;
+  AlignmentQuality quality;
+  // The best plausible different answer (what makes distinctiveness low), when there is one.
+  std::optional<core::Transform2> alternative;
+  std::string method;             // the method whose candidate won; empty when there was none
+  std::string reason;             // why not merged; empty when merged
+  int candidates = 0;             // candidates the methods proposed
+};
+
+// One pass of a method: proposes candidates for the common pipeline.
+using ProposeFn = std::vector<Hypothesis> (*)(const PreparedGrid& a, const PreparedGrid& b, const MergeOptions& options,
+                                              core::Random& random);
+
+// A method runs its passes in order, each adding candidates, until the decision is to merge.
+struct MergeMethod {
+  std::string name;
+  std::string help;
+  std::vector<ProposeFn> passes;
+};
+
+// The registry: every method by name. `auto` runs overlap's first pass, then everything else.
+const std::vector<MergeMethod>& merge_methods();
+// "auto" and the registry's names, for --help and errors.
+std::vector<std::string> merge_method_names();
+// One line per name: "  name: help".
+std::string merge_method_help();
+// Throws InputError naming the valid names unless `name` is one of merge_method_names().
+void check_merge_method(const std::string& name);
+
+// Aligns b to a. Never throws for hard inputs (no walls, no overlap): the result says why it did
+// not merge. Throws InputError for an unknown method name.
+MergeResult align_maps(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
+                       const MergeOptions& options = {});
+// The same on grids prepared once (N-map merging prepares each map once for all its pairs).
+MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const MergeOptions& options = {});
+
+// The common pipeline on given candidates: refine, score, decide.
+MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vector<Hypothesis>& candidates,
+                   const MergeOptions& options);
+
+}  // namespace fleetmap::merging

@@ -1,0 +1,95 @@
+#include "merging/multi_merge.h"
+
+#include <memory>
+
+#include "core/error.h"
+
+namespace fleetmap::merging {
+
+MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& grids, const MergeOptions& options,
+                            const std::function<void(int, int)>& progress) {
+  check_merge_method(options.method);
+  const int n = int(grids.size());
+  MultiMergeResult out;
+  out.to_first.assign(std::size_t(n), std::nullopt);
+  out.parent.assign(std::size_t(n), -1);
+  out.confidence.assign(std::size_t(n), 0.0);
+  out.method.assign(std::size_t(n), "");
+  out.reason.assign(std::size_t(n), "");
+  if (n == 0) return out;
+  std::vector<std::unique_ptr<PreparedGrid>> prepared;
+  for (const auto* g : grids) prepared.push_back(std::make_unique<PreparedGrid>(*g, options.prepare));
+  const int total = n * (n - 1) / 2;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      out.pairs.push_back({i, j, align_prepared(*prepared[std::size_t(i)], *prepared[std::size_t(j)], options)});
+      if (progress) progress(int(out.pairs.size()), total);
+    }
+  }
+  // Prim's algorithm on the reliable pairs, heaviest confidence first, from the first map.
+  out.to_first[0] = core::Transform2::identity();
+  out.confidence[0] = 1.0;
+  std::vector<bool> in_tree(std::size_t(n), false);
+  in_tree[0] = true;
+  std::vector<bool> tree_pair(out.pairs.size(), false);
+  while (true) {
+    int best = -1;
+    for (int e = 0; e < int(out.pairs.size()); ++e) {
+      const auto& p = out.pairs[std::size_t(e)];
+      if (!p.result.merged || in_tree[std::size_t(p.a)] == in_tree[std::size_t(p.b)]) continue;
+      if (best < 0 || p.result.confidence > out.pairs[std::size_t(best)].result.confidence) best = e;
+    }
+    if (best < 0) break;
+    tree_pair[std::size_t(best)] = true;
+    const auto& p = out.pairs[std::size_t(best)];
+    // The new map is b (placed through a) or a (placed through b, with the inverse).
+    const bool new_is_b = in_tree[std::size_t(p.a)];
+    const int from = new_is_b ? p.a : p.b, to = new_is_b ? p.b : p.a;
+    const core::Transform2 to_from = new_is_b ? p.result.transform : p.result.transform.inverse();
+    out.to_first[std::size_t(to)] = *out.to_first[std::size_t(from)] * to_from;
+    out.parent[std::size_t(to)] = from;
+    out.confidence[std::size_t(to)] = p.result.confidence;
+    out.method[std::size_t(to)] = p.result.method;
+    in_tree[std::size_t(to)] = true;
+  }
+  for (int i = 1; i < n; ++i) {
+    if (in_tree[std::size_t(i)]) continue;
+    // The most confident refusal between this map and a placed one explains it best.
+    const PairAlignment* closest = nullptr;
+    for (const auto& p : out.pairs) {
+      if ((p.a == i && in_tree[std::size_t(p.b)]) || (p.b == i && in_tree[std::size_t(p.a)])) {
+        if (closest == nullptr || p.result.confidence > closest->result.confidence) closest = &p;
+      }
+    }
+    out.reason[std::size_t(i)] = closest != nullptr && !closest->result.reason.empty()
+                                     ? closest->result.reason
+                                     : "no reliable overlap with any map linked to the first";
+  }
+  // Loop check: reliable pairs the tree did not use.
+  for (std::size_t e = 0; e < out.pairs.size(); ++e) {
+    const auto& p = out.pairs[e];
+    if (tree_pair[e] || !p.result.merged || !out.to_first[std::size_t(p.a)] || !out.to_first[std::size_t(p.b)]) continue;
+    const core::Transform2 implied = out.to_first[std::size_t(p.a)]->inverse() * *out.to_first[std::size_t(p.b)];
+    const Eigen::Vector2d at_b = p.result.transform.inverse().apply(p.result.quality.overlap_centre);
+    out.max_loop_gap = std::max(out.max_loop_gap, (implied.apply(at_b) - p.result.transform.apply(at_b)).norm());
+  }
+  return out;
+}
+
+FusedMap fuse_merged(const std::vector<const mapping::OccupancyGrid*>& grids, const MultiMergeResult& merged) {
+  if (grids.size() != merged.to_first.size()) throw Error("fuse_merged: one merge result per grid expected");
+  std::vector<const mapping::OccupancyGrid*> placed;
+  std::vector<core::Transform2> transforms;
+  std::vector<int> inputs;
+  for (std::size_t i = 0; i < grids.size(); ++i) {
+    if (!merged.to_first[i]) continue;
+    placed.push_back(grids[i]);
+    transforms.push_back(*merged.to_first[i]);
+    inputs.push_back(int(i));
+  }
+  FusedMap fused = fuse_grids(placed, transforms);
+  fused.inputs = std::move(inputs);
+  return fused;
+}
+
+}  // namespace fleetmap::merging

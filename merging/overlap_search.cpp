@@ -1,0 +1,155 @@
+#include "merging/overlap_search.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/angle.h"
+#include "merging/hough_spectrum.h"
+
+namespace fleetmap::merging {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+int common_level(const PreparedGrid& a, const PreparedGrid& b, int cells) {
+  const int top = std::min(a.level_count(), b.level_count()) - 1;
+  return std::min(top, std::max(a.level_for_size(cells), b.level_for_size(cells)));
+}
+
+cv::Mat as_float(const cv::Mat& mask) {
+  cv::Mat f;
+  mask.convertTo(f, CV_32F, 1.0 / 255.0);
+  return f;
+}
+
+// Free cells at least 1.5 cells from any wall: where a wall of the other map contradicts.
+cv::Mat clear_free(const GridLevel& level) {
+  cv::Mat far = level.wall_distance > 1.5f;
+  return as_float(level.free & far);
+}
+
+cv::Mat padded_dft(const cv::Mat& img, cv::Size size) {
+  cv::Mat padded = cv::Mat::zeros(size, CV_32F);
+  img.copyTo(padded(cv::Rect(0, 0, img.cols, img.rows)));
+  cv::Mat spectrum;
+  cv::dft(padded, spectrum);
+  return spectrum;
+}
+
+struct Peak {
+  cv::Point at;
+  double value;
+};
+
+// The `count` highest maxima of `s`, each suppressing a square of radius `radius` around it.
+std::vector<Peak> top_peaks(cv::Mat s, int count, int radius) {
+  std::vector<Peak> peaks;
+  for (int i = 0; i < count; ++i) {
+    double max_v = 0.0;
+    cv::Point max_at;
+    cv::minMaxLoc(s, nullptr, &max_v, nullptr, &max_at);
+    if (!(max_v > 0.0)) break;
+    peaks.push_back({max_at, max_v});
+    const cv::Rect r(max_at.x - radius, max_at.y - radius, 2 * radius + 1, 2 * radius + 1);
+    s(r & cv::Rect(0, 0, s.cols, s.rows)).setTo(-1e30);
+  }
+  return peaks;
+}
+
+}  // namespace
+
+std::vector<double> spectral_rotation_candidates(const PreparedGrid& a, const PreparedGrid& b,
+                                                 const OverlapSearchOptions& options) {
+  const int level = common_level(a, b, options.spectrum_cells);
+  const int bins = std::max(8, options.angle_bins);
+  const auto hs_a = hough_spectrum(a.level(level).wall_points, bins);
+  const auto hs_b = hough_spectrum(b.level(level).wall_points, bins);
+  const auto cc = circular_cross_correlation(hs_a, hs_b);
+  // Peaks closer than 3 degrees are one peak.
+  const int separation = std::max(1, int(std::lround(3.0 * bins / 180.0)));
+  std::vector<double> rotations;
+  for (double theta : correlation_peaks(cc, options.spectrum_peaks, separation)) {
+    rotations.push_back(core::normalize_angle(theta));
+    rotations.push_back(core::normalize_angle(theta + kPi));
+  }
+  return rotations;
+}
+
+std::vector<Hypothesis> overlap_hypotheses(const PreparedGrid& a, const PreparedGrid& b,
+                                           const OverlapSearchOptions& options) {
+  std::vector<double> rotations = spectral_rotation_candidates(a, b, options);
+  if (options.sweep_step_deg > 0.0) {
+    const double step = core::deg2rad(options.sweep_step_deg);
+    const std::size_t spectral = rotations.size();
+    for (double theta = -kPi + step; theta <= kPi + 1e-9; theta += step) {
+      bool near = false;
+      for (std::size_t i = 0; i < spectral; ++i) {
+        if (std::abs(core::normalize_angle(theta - rotations[i])) < 0.75 * step) near = true;
+      }
+      if (!near) rotations.push_back(core::normalize_angle(theta));
+    }
+  }
+  return overlap_hypotheses_at(a, b, rotations, options);
+}
+
+std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const PreparedGrid& b,
+                                              const std::vector<double>& rotations,
+                                              const OverlapSearchOptions& options) {
+  const int level = common_level(a, b, options.search_cells);
+  const GridLevel& la = a.level(level);
+  const GridLevel& lb = b.level(level);
+  const double w = options.contradiction_weight;
+
+  // a's side of the score, transformed once: walls near walls count for, occupied cells on clear
+  // free space against.
+  const cv::Mat walls_a = as_float(la.walls), occupied_a = as_float(la.occupied);
+  cv::Mat walls_a_near;
+  cv::dilate(walls_a, walls_a_near, cv::Mat::ones(3, 3, CV_8U));
+  const cv::Mat walls_b = as_float(lb.walls), occupied_b = as_float(lb.occupied), clear_b = clear_free(lb);
+
+  // b turned by any angle fits a D x D canvas centred on b's centre.
+  const int d = int(std::ceil(std::hypot(double(lb.width()), double(lb.height())))) + 2;
+  const cv::Size size(cv::getOptimalDFTSize(la.width() + d), cv::getOptimalDFTSize(la.height() + d));
+  const cv::Mat g_walls = padded_dft(walls_a_near, size);
+  const cv::Mat g_clear = padded_dft(clear_free(la), size);
+  const cv::Mat g_occupied = padded_dft(occupied_a, size);
+  const Eigen::Vector2d centre_b((lb.width() - 1) / 2.0, (lb.height() - 1) / 2.0);
+  const Eigen::Vector2d centre_canvas((d - 1) / 2.0, (d - 1) / 2.0);
+  const int radius = std::max(1, options.peak_separation);
+
+  std::vector<Hypothesis> out;
+  cv::Mat turned_walls, turned_occupied, turned_clear, product, product2, s;
+  for (double theta : rotations) {
+    const core::Transform2 rot(0.0, 0.0, theta);
+    const Eigen::Vector2d shift = centre_canvas - rot.apply(centre_b);
+    const Eigen::Matrix2d r = rot.rotation_matrix();
+    const cv::Mat m = (cv::Mat_<double>(2, 3) << r(0, 0), r(0, 1), shift.x(), r(1, 0), r(1, 1), shift.y());
+    cv::warpAffine(walls_b, turned_walls, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+    cv::warpAffine(occupied_b, turned_occupied, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+    cv::warpAffine(clear_b, turned_clear, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+    // S(t) = sum_q walls_b(q) walls_a_near(q + t)
+    //        - w sum_q [occupied_b(q) clear_a(q + t) + clear_b(q) occupied_a(q + t)], all t at once.
+    cv::mulSpectrums(g_walls, padded_dft(turned_walls, size), product, 0, true);
+    cv::mulSpectrums(g_clear, padded_dft(turned_occupied, size), product2, 0, true);
+    product -= w * product2;
+    cv::mulSpectrums(g_occupied, padded_dft(turned_clear, size), product2, 0, true);
+    product -= w * product2;
+    cv::idft(product, s, cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+    for (const auto& p : top_peaks(s, options.translation_peaks, radius)) {
+      // A shift index beyond a's extent wraps around to a negative shift.
+      const int tx = p.at.x >= la.width() ? p.at.x - size.width : p.at.x;
+      const int ty = p.at.y >= la.height() ? p.at.y - size.height : p.at.y;
+      const core::Transform2 coarse(shift + Eigen::Vector2d(tx, ty), theta);
+      out.push_back({from_level(coarse, la.factor), p.value, level, "overlap"});
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const Hypothesis& x, const Hypothesis& y) { return x.score > y.score; });
+  if (int(out.size()) > options.max_hypotheses) out.resize(std::size_t(std::max(0, options.max_hypotheses)));
+  return out;
+}
+
+}  // namespace fleetmap::merging

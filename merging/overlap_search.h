@@ -1,0 +1,41 @@
+#pragma once
+// The `overlap` method: seed 003's search for the rotation and translation that best overlap two
+// grids (after Birk & Carpin 2006), made global and fast. Rotations come from Hough spectra
+// (Carpin 2008), translations from an FFT correlation of the wall agreement on a coarse pyramid
+// level; the common refine step then takes every candidate to sub-cell accuracy.
+#include <vector>
+
+#include "merging/hypothesis.h"
+#include "merging/prepared_grid.h"
+
+namespace fleetmap::merging {
+
+struct OverlapSearchOptions {
+  int search_cells = 160;      // the translation search runs on the finest level whose larger side is at most this
+  int spectrum_cells = 320;    // the Hough spectra use the finest level whose larger side is at most this
+  int angle_bins = 360;        // spectrum resolution over [0, pi)
+  int spectrum_peaks = 4;      // correlation peaks kept; each gives the rotations theta and theta + pi
+  int translation_peaks = 6;   // correlation maxima kept per rotation (repeated places give several)
+  int peak_separation = 4;     // cells of the search level between kept maxima
+  double contradiction_weight = 1.0;  // walls on clear free space count against a translation this much
+  // Besides the spectral candidates, rotations every `sweep_step_deg` (0: none). Costs time; the
+  // method's second pass uses it when the spectral candidates find nothing reliable (maps without
+  // dominant straight walls have flat spectra).
+  double sweep_step_deg = 0.0;
+  int max_hypotheses = 40;     // the best candidates by correlation score, over all rotations
+};
+
+// Candidate transforms, best first by the coarse correlation score.
+std::vector<Hypothesis> overlap_hypotheses(const PreparedGrid& a, const PreparedGrid& b,
+                                           const OverlapSearchOptions& options);
+
+// The translation search alone, at the given rotations (radians, b into a).
+std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const PreparedGrid& b,
+                                              const std::vector<double>& rotations,
+                                              const OverlapSearchOptions& options);
+
+// Rotation candidates (radians, b into a) from the Hough spectra, best first, before the sweep.
+std::vector<double> spectral_rotation_candidates(const PreparedGrid& a, const PreparedGrid& b,
+                                                 const OverlapSearchOptions& options);
+
+}  // namespace fleetmap::merging

@@ -1,0 +1,185 @@
+#include "merging/prepared_grid.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+namespace fleetmap::merging {
+
+namespace {
+
+// Max pooling by 2: occupied if any fine cell is; free if any is free and none is occupied.
+void downsample(const cv::Mat& occ, const cv::Mat& fre, cv::Mat& occ_out, cv::Mat& free_out) {
+  const int w = (occ.cols + 1) / 2, h = (occ.rows + 1) / 2;
+  occ_out = cv::Mat::zeros(h, w, CV_8U);
+  free_out = cv::Mat::zeros(h, w, CV_8U);
+  for (int y = 0; y < occ.rows; ++y) {
+    const auto* o = occ.ptr<std::uint8_t>(y);
+    const auto* f = fre.ptr<std::uint8_t>(y);
+    auto* oo = occ_out.ptr<std::uint8_t>(y / 2);
+    auto* fo = free_out.ptr<std::uint8_t>(y / 2);
+    for (int x = 0; x < occ.cols; ++x) {
+      oo[x / 2] |= o[x];
+      fo[x / 2] |= f[x];
+    }
+  }
+  free_out.setTo(0, occ_out);
+}
+
+void finish_level(GridLevel& level, const PrepareOptions& options) {
+  // Walls: occupied cells touching free space (8-neighbourhood).
+  cv::Mat free_near;
+  cv::dilate(level.free, free_near, cv::Mat::ones(3, 3, CV_8U));
+  level.walls = level.occupied & free_near;
+  // Distance to the nearest wall cell; a map without walls is "far" everywhere.
+  if (cv::countNonZero(level.walls) == 0) {
+    level.wall_distance = cv::Mat(level.walls.size(), CV_32F, cv::Scalar(1e4));
+  } else {
+    cv::Mat not_wall = level.walls == 0;
+    cv::distanceTransform(not_wall, level.wall_distance, cv::DIST_L2, cv::DIST_MASK_5, CV_32F);
+  }
+  std::vector<cv::Point> pts;
+  cv::findNonZero(level.walls, pts);
+  const std::size_t cap = static_cast<std::size_t>(std::max(1, options.max_refine_points));
+  const double stride = pts.size() > cap ? double(pts.size()) / double(cap) : 1.0;
+  level.wall_points.clear();
+  for (double i = 0.0; i < double(pts.size()); i += stride) {
+    const auto& p = pts[static_cast<std::size_t>(i)];
+    level.wall_points.emplace_back(float(p.x), float(p.y));
+  }
+  cv::Mat interior = level.occupied & ~level.walls;
+  pts.clear();
+  cv::findNonZero(interior, pts);
+  std::vector<Eigen::Vector2f> sampled;
+  for (const auto& p : pts) {
+    if (p.x % 2 == 0 && p.y % 2 == 0) sampled.emplace_back(float(p.x), float(p.y));
+  }
+  const double istride = sampled.size() > cap ? double(sampled.size()) / double(cap) : 1.0;
+  level.interior_points.clear();
+  for (double i = 0.0; i < double(sampled.size()); i += istride) level.interior_points.push_back(sampled[std::size_t(i)]);
+}
+
+}  // namespace
+
+float GridLevel::distance_at(float x, float y, float outside) const {
+  if (!(x >= 0.0f && y >= 0.0f && x <= float(width() - 1) && y <= float(height() - 1))) return outside;
+  const int x0 = std::min(int(x), std::max(0, width() - 2));
+  const int y0 = std::min(int(y), std::max(0, height() - 2));
+  const int x1 = std::min(x0 + 1, width() - 1), y1 = std::min(y0 + 1, height() - 1);
+  const float fx = x - float(x0), fy = y - float(y0);
+  const float* r0 = wall_distance.ptr<float>(y0);
+  const float* r1 = wall_distance.ptr<float>(y1);
+  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x1]);
+}
+
+float GridLevel::distance_gradient_at(float x, float y, float outside, float& gx, float& gy) const {
+  gx = gy = 0.0f;
+  if (!(x >= 0.0f && y >= 0.0f && x <= float(width() - 1) && y <= float(height() - 1))) return outside;
+  const int x0 = std::min(int(x), std::max(0, width() - 2));
+  const int y0 = std::min(int(y), std::max(0, height() - 2));
+  const int x1 = std::min(x0 + 1, width() - 1), y1 = std::min(y0 + 1, height() - 1);
+  const float fx = x - float(x0), fy = y - float(y0);
+  const float* r0 = wall_distance.ptr<float>(y0);
+  const float* r1 = wall_distance.ptr<float>(y1);
+  const float a = r0[x0], b = r0[x1], c = r1[x0], d = r1[x1];
+  gx = (1 - fy) * (b - a) + fy * (d - c);
+  gy = (1 - fx) * (c - a) + fx * (d - b);
+  return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
+}
+
+PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOptions& options) : grid_(&grid) {
+  GridLevel base;
+  base.factor = 1;
+  base.occupied = cv::Mat::zeros(std::max(grid.height(), 1), std::max(grid.width(), 1), CV_8U);
+  base.free = cv::Mat::zeros(base.occupied.size(), CV_8U);
+  for (int y = 0; y < grid.height(); ++y) {
+    auto* o = base.occupied.ptr<std::uint8_t>(y);
+    auto* f = base.free.ptr<std::uint8_t>(y);
+    const int row = y * grid.width();
+    for (int x = 0; x < grid.width(); ++x) {
+      switch (grid.state_at(row + x)) {
+        case mapping::CellState::Occupied: o[x] = 255; ++known_cells_; break;
+        case mapping::CellState::Free: f[x] = 255; ++known_cells_; break;
+        case mapping::CellState::Unknown: break;
+      }
+    }
+  }
+  if (options.min_obstacle_cells > 1) {
+    cv::Mat labels, stats, centroids;
+    const int n = cv::connectedComponentsWithStats(base.occupied, labels, stats, centroids, 8, CV_32S);
+    std::vector<std::uint8_t> speck(std::size_t(n), 0);
+    bool any = false;
+    for (int i = 1; i < n; ++i) {
+      if (stats.at<int>(i, cv::CC_STAT_AREA) < options.min_obstacle_cells) speck[std::size_t(i)] = 1, any = true;
+    }
+    if (any) {
+      for (int y = 0; y < labels.rows; ++y) {
+        const int* l = labels.ptr<int>(y);
+        auto* o = base.occupied.ptr<std::uint8_t>(y);
+        for (int x = 0; x < labels.cols; ++x) {
+          if (speck[std::size_t(l[x])]) o[x] = 0, --known_cells_;
+        }
+      }
+    }
+  }
+  finish_level(base, options);
+  levels_.push_back(std::move(base));
+  while (std::max(levels_.back().width(), levels_.back().height()) / 2 >= options.min_level_size) {
+    GridLevel next;
+    next.factor = levels_.back().factor * 2;
+    downsample(levels_.back().occupied, levels_.back().free, next.occupied, next.free);
+    finish_level(next, options);
+    levels_.push_back(std::move(next));
+  }
+
+  // Every full-resolution wall cell with the covariance of its wall neighbours (radius 3).
+  const GridLevel& l0 = levels_.front();
+  std::vector<cv::Point> pts;
+  cv::findNonZero(l0.walls, pts);
+  walls_.reserve(pts.size());
+  constexpr int kR = 3;
+  for (const auto& p : pts) {
+    double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+    for (int dy = -kR; dy <= kR; ++dy) {
+      const int y = p.y + dy;
+      if (y < 0 || y >= l0.height()) continue;
+      const auto* row = l0.walls.ptr<std::uint8_t>(y);
+      for (int dx = -kR; dx <= kR; ++dx) {
+        const int x = p.x + dx;
+        if (x < 0 || x >= l0.width() || dx * dx + dy * dy > kR * kR || row[x] == 0) continue;
+        n += 1;
+        sx += dx, sy += dy, sxx += dx * dx, sxy += dx * dy, syy += dy * dy;
+      }
+    }
+    WallPoint w;
+    w.position = Eigen::Vector2f(float(p.x), float(p.y));
+    Eigen::Matrix2d c;
+    c << sxx / n - (sx / n) * (sx / n), sxy / n - (sx / n) * (sy / n), sxy / n - (sx / n) * (sy / n),
+        syy / n - (sy / n) * (sy / n);
+    const double trace = c.trace();
+    if (trace > 1e-9) w.structure = (Eigen::Matrix2d::Identity() - c / trace).cast<float>();
+    walls_.push_back(w);
+  }
+}
+
+int PreparedGrid::level_for_size(int cells) const {
+  for (int k = 0; k < level_count(); ++k) {
+    if (std::max(levels_[std::size_t(k)].width(), levels_[std::size_t(k)].height()) <= cells) return k;
+  }
+  return level_count() - 1;
+}
+
+core::Transform2 to_level(const core::Transform2& fine, int factor) {
+  const double s = factor, c = (s - 1.0) / 2.0;
+  const Eigen::Vector2d cc(c, c);
+  return {(fine.rotation_matrix() * cc + fine.translation() - cc) / s, fine.rotation()};
+}
+
+core::Transform2 from_level(const core::Transform2& coarse, int factor) {
+  const double s = factor, c = (s - 1.0) / 2.0;
+  const Eigen::Vector2d cc(c, c);
+  return {s * coarse.translation() + cc - coarse.rotation_matrix() * cc, coarse.rotation()};
+}
+
+}  // namespace fleetmap::merging

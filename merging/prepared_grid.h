@@ -1,0 +1,92 @@
+#pragma once
+// A grid prepared for alignment: a pyramid of cell masks, the wall cells a range sensor sees,
+// distance fields to them, and their local structure. Every merge method and the common
+// refine / score / decide steps work on two PreparedGrids.
+//
+// Images here have one pixel per cell with column = cell x and row = cell y (row 0 at the
+// bottom, unlike a picture), so image coordinates are cell coordinates. A cell's centre is at
+// integer coordinates. Masks are CV_8U with 0 / 255.
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include <cstdint>
+#include <vector>
+
+#include "core/transform2.h"
+#include "mapping/occupancy_grid.h"
+
+namespace fleetmap::merging {
+
+// One pyramid level. Level k has cells of 2^k x 2^k fine cells; a coarse cell is occupied when
+// any of its fine cells is, free when one is free and none occupied (max pooling keeps thin walls).
+struct GridLevel {
+  int factor = 1;              // fine cells per cell of this level, along each axis
+  cv::Mat occupied;            // CV_8U mask
+  cv::Mat free;                // CV_8U mask
+  cv::Mat walls;               // occupied cells with a free 8-neighbour
+  cv::Mat wall_distance;       // CV_32F: distance in cells from each cell centre to the nearest wall cell
+  std::vector<Eigen::Vector2f> wall_points;  // centres of the wall cells (subsampled on big maps)
+  // Centres of occupied cells that are not walls (inside filled obstacles), every second row and
+  // column: on the other map's clear free space they contradict an alignment too.
+  std::vector<Eigen::Vector2f> interior_points;
+
+  int width() const { return occupied.cols; }
+  int height() const { return occupied.rows; }
+  bool known(int x, int y) const { return occupied.at<std::uint8_t>(y, x) != 0 || free.at<std::uint8_t>(y, x) != 0; }
+  bool is_free(int x, int y) const { return free.at<std::uint8_t>(y, x) != 0; }
+  // Bilinear wall distance at a continuous cell position; `outside` beyond the level's edges.
+  float distance_at(float x, float y, float outside) const;
+  // The same with the gradient of the bilinear patch (0 beyond the edges).
+  float distance_gradient_at(float x, float y, float outside, float& gx, float& gy) const;
+};
+
+// The nearest cell to a continuous coordinate, or -1 when it lies before the first cell.
+// (std::lround is a library call; this is on every hot path.)
+inline int nearest_cell(float v) { return v >= -0.5f ? int(v + 0.5f) : -1; }
+inline int nearest_cell(double v) { return v >= -0.5 ? int(v + 0.5) : -1; }
+
+// Local shape of the walls around a fine wall point: S = I - C / trace(C), with C the covariance of
+// the wall cells within 3 cells. S is n n^T on a straight wall (n its normal) and I / 2 at a corner
+// or a blob: the directions in which the point pins an alignment down.
+struct WallPoint {
+  Eigen::Vector2f position = Eigen::Vector2f::Zero();
+  Eigen::Matrix2f structure = Eigen::Matrix2f::Identity() * 0.5f;
+};
+
+struct PrepareOptions {
+  // Occupied specks smaller than this (8-connected cells) are noise: left out as unknown. Both
+  // robots see a real obstacle; a speck seen by one only would count against a right alignment.
+  int min_obstacle_cells = 3;
+  int min_level_size = 24;         // stop the pyramid when the larger side would drop below this
+  int max_refine_points = 12000;   // wall points kept per level for refinement (evenly subsampled)
+};
+
+class PreparedGrid {
+ public:
+  explicit PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOptions& options = {});
+
+  int width() const { return levels_.front().width(); }
+  int height() const { return levels_.front().height(); }
+  int level_count() const { return static_cast<int>(levels_.size()); }
+  const GridLevel& level(int k) const { return levels_.at(static_cast<std::size_t>(k)); }
+  // Every wall cell at full resolution, with its local structure (for scoring).
+  const std::vector<WallPoint>& walls() const { return walls_; }
+  std::int64_t known_cells() const { return known_cells_; }
+  const mapping::OccupancyGrid& grid() const { return *grid_; }
+
+  // The finest level whose larger side is at most `cells` (the coarsest level if none is).
+  int level_for_size(int cells) const;
+
+ private:
+  const mapping::OccupancyGrid* grid_;
+  std::vector<GridLevel> levels_;
+  std::vector<WallPoint> walls_;
+  std::int64_t known_cells_ = 0;
+};
+
+// A transform between fine cell coordinates expressed between the cells of level `factor`
+// (centre of coarse cell X is fine coordinate factor * X + (factor - 1) / 2), and back.
+core::Transform2 to_level(const core::Transform2& fine, int factor);
+core::Transform2 from_level(const core::Transform2& coarse, int factor);
+
+}  // namespace fleetmap::merging

@@ -1,0 +1,110 @@
+#include "merging/refine.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+namespace fleetmap::merging {
+
+namespace {
+
+struct Residual {
+  Eigen::Vector2d position;  // in a's (level) frame: where the wall point lies
+  Eigen::Vector2d gradient;  // of the distance, in the frame of the map the distance is read from
+  double r = 0.0;
+  bool from_b = true;
+};
+
+// The wall points of `from` moved by t into `to`, with the distance to `to`'s walls.
+void collect(const GridLevel& from, const GridLevel& to, const core::Transform2& t, const core::Transform2& to_a,
+             bool from_b, double cutoff, std::vector<Residual>& out, int& inliers, int& outliers) {
+  const Eigen::Matrix2f r = t.rotation_matrix().cast<float>();
+  const Eigen::Vector2f tr = t.translation().cast<float>();
+  constexpr float kFar = 1e4f;
+  for (const auto& w : from.wall_points) {
+    const Eigen::Vector2f p = r * w + tr;
+    const int x = nearest_cell(p.x()), y = nearest_cell(p.y());
+    if (x < 0 || y < 0 || x >= to.width() || y >= to.height() || !to.known(x, y)) continue;
+    float gx = 0.0f, gy = 0.0f;
+    const float d = to.distance_gradient_at(p.x(), p.y(), kFar, gx, gy);
+    if (d <= 1.0f) ++inliers;
+    else if (d >= 2.5f && to.is_free(x, y)) ++outliers;
+    if (d > cutoff) continue;
+    Residual res;
+    res.position = to_a.apply(p.cast<double>());
+    res.gradient = Eigen::Vector2d(gx, gy);
+    res.r = d;
+    res.from_b = from_b;
+    out.push_back(res);
+  }
+  for (const auto& w : from.interior_points) {
+    const Eigen::Vector2f p = r * w + tr;
+    const int x = nearest_cell(p.x()), y = nearest_cell(p.y());
+    if (x < 0 || y < 0 || x >= to.width() || y >= to.height() || !to.is_free(x, y)) continue;
+    if (to.distance_at(p.x(), p.y(), kFar) >= 2.5f) ++outliers;
+  }
+}
+
+}  // namespace
+
+LevelFit refine_at_level(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a, int level,
+                         const RefineOptions& options) {
+  const GridLevel& la = a.level(level);
+  const GridLevel& lb = b.level(level);
+  core::Transform2 t = to_level(b_to_a, la.factor);
+  LevelFit fit;
+  std::vector<Residual> res;
+  for (int it = 0; it <= options.iterations; ++it) {
+    res.clear();
+    fit.inliers = fit.outliers = 0;
+    const core::Transform2 inv = t.inverse();
+    collect(lb, la, t, core::Transform2::identity(), true, options.inlier_distance, res, fit.inliers, fit.outliers);
+    collect(la, lb, inv, t, false, options.inlier_distance, res, fit.inliers, fit.outliers);
+    if (it == options.iterations || res.size() < 3) break;
+    Eigen::Vector2d c = Eigen::Vector2d::Zero();
+    for (const auto& r : res) c += r.position;
+    c /= double(res.size());
+    // Update T <- L(delta) T, L(delta)(x) = R(dtheta) (x - c) + c + dt, linearised around 0.
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    const Eigen::Matrix2d rt = t.rotation_matrix().transpose();
+    for (const auto& r : res) {
+      const Eigen::Vector2d d = r.position - c;
+      Eigen::Matrix<double, 2, 3> m;
+      m << 1.0, 0.0, -d.y(), 0.0, 1.0, d.x();
+      // b's points move with the update; a's points move by the inverse, seen from b's frame.
+      const Eigen::RowVector3d j =
+          r.from_b ? Eigen::RowVector3d(r.gradient.transpose() * m) : Eigen::RowVector3d(-(r.gradient.transpose() * rt) * m);
+      const double w = r.r <= 1.0 ? 1.0 : 1.0 / r.r;  // Huber weights
+      h += w * j.transpose() * j;
+      g += w * j.transpose() * r.r;
+    }
+    h.diagonal() += Eigen::Vector3d::Constant(1e-3 * h.trace() / 3.0 + 1e-9);
+    const Eigen::Vector3d delta = -h.ldlt().solve(g);
+    if (!delta.allFinite()) break;
+    const double dth = std::clamp(delta(2), -0.05, 0.05);
+    Eigen::Vector2d dt = delta.head<2>();
+    if (dt.norm() > 2.0) dt *= 2.0 / dt.norm();
+    const core::Transform2 rot(0.0, 0.0, dth);
+    const core::Transform2 step(c + dt - rot.apply(c), dth);
+    t = step * t;
+    if (dt.norm() < options.converged_cells && std::abs(dth) * options.converged_radius < options.converged_cells) {
+      // Converged: one more pass to report the counts at the final transform.
+      it = options.iterations - 1;
+    }
+  }
+  fit.b_to_a = from_level(t, la.factor);
+  fit.score = fit.inliers - options.contradiction_weight * fit.outliers;
+  return fit;
+}
+
+LevelFit refine_alignment(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a, int from_level,
+                          const RefineOptions& options) {
+  LevelFit fit;
+  fit.b_to_a = b_to_a;
+  const int top = std::min({from_level, a.level_count() - 1, b.level_count() - 1});
+  for (int k = top; k >= 0; --k) fit = refine_at_level(a, b, fit.b_to_a, k, options);
+  return fit;
+}
+
+}  // namespace fleetmap::merging

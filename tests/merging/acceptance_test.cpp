@@ -1,0 +1,68 @@
+#include "merging/acceptance.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/merging/merging_test_support.h"
+
+namespace fleetmap::merging {
+namespace {
+
+using testing::grid_from_text;
+
+TEST(AcceptanceIndex, CountsAgreementAndDisagreementOverCommonCells) {
+  const auto a = grid_from_text({"#..", ".#.", "  ."});
+  const auto b = grid_from_text({"#.#", "...", "..."});
+  // Identity: common cells are those known in both. a (bottom row first): y0 "  .", y1 ".#.", y2 "#..".
+  // Agree: (2,0) free-free, (0,1), (2,1), (0,2), (1,2). Disagree: (1,1) occ-free, (2,2) free-occ.
+  const Acceptance acc = acceptance_index(a, b, core::Transform2::identity());
+  EXPECT_EQ(acc.agree, 5);
+  EXPECT_EQ(acc.disagree, 2);
+  EXPECT_DOUBLE_EQ(acc.omega(), 5.0 / 7.0);
+}
+
+TEST(AcceptanceIndex, IsZeroNotNanWithoutCommonCells) {
+  const auto a = grid_from_text({"#.", ".."});
+  const auto b = grid_from_text({"..", ".#"});
+  const Acceptance far = acceptance_index(a, b, core::Transform2(100.0, 0.0, 0.0));
+  EXPECT_EQ(far.common(), 0);
+  EXPECT_EQ(far.omega(), 0.0);
+  const auto unknown = grid_from_text({"  ", "  "});
+  EXPECT_EQ(acceptance_index(a, unknown, core::Transform2::identity()).omega(), 0.0);
+}
+
+TEST(AcceptanceIndex, FollowsTheTransform) {
+  // b is a shifted one column to the right: a's column x is b's column x + 1.
+  const auto a = grid_from_text({"#..#", ".#..", "..#."});
+  const auto b = grid_from_text({" #..#", " .#..", " ..#."});
+  EXPECT_DOUBLE_EQ(acceptance_index(a, b, core::Transform2(-1.0, 0.0, 0.0)).omega(), 1.0);
+  EXPECT_LT(acceptance_index(a, b, core::Transform2::identity()).omega(), 0.7);
+}
+
+TEST(AlignmentQuality, RewardsTheRightPlacementOverAShiftedOne) {
+  const auto source = testing::source_map("office");
+  core::Random random(3);
+  CropPairOptions o = testing::half_overlap_crops(source);
+  const CropPair pair = make_crop_pair(source, o, random);
+  const PreparedGrid a(pair.a), b(pair.b);
+  const AlignmentQuality right = evaluate_alignment(a, b, pair.b_to_a);
+  const AlignmentQuality shifted = evaluate_alignment(a, b, core::Transform2(7.0, 0.0, 0.0) * pair.b_to_a);
+  EXPECT_GT(right.agreement, 0.99);
+  EXPECT_GT(right.matched, 300);
+  EXPECT_GT(right.score, shifted.score);
+  EXPECT_GT(shifted.contradicted, 10 * std::max(1, right.contradicted));
+  // A room's worth of walls in every direction.
+  EXPECT_GT(right.constraint, 10.0);
+}
+
+TEST(AlignmentQuality, AStraightWallLeavesADirectionFree) {
+  std::vector<std::string> rows(30, std::string(60, '.'));
+  rows[15] = std::string(60, '#');
+  const auto g = grid_from_text(rows);
+  const PreparedGrid a(g), b(g);
+  const AlignmentQuality q = evaluate_alignment(a, b, core::Transform2::identity());
+  EXPECT_GT(q.matched, 100);
+  EXPECT_NEAR(q.constraint, 0.0, 1.0);
+}
+
+}  // namespace
+}  // namespace fleetmap::merging

@@ -1,0 +1,145 @@
+// One harness for every merge method (STYLE: tests iterate over the registry).
+#include "merging/merge.h"
+
+#include <gtest/gtest.h>
+
+#include <tuple>
+
+#include "core/angle.h"
+#include "merging/evaluation.h"
+#include "tests/merging/merging_test_support.h"
+#include "tests/test_support.h"
+
+namespace fleetmap::merging {
+namespace {
+
+// The issue's tolerances: a merge must put b within a degree and a cell of the truth.
+constexpr double kMaxRotationDeg = 1.0;
+constexpr double kMaxTranslationCells = 1.0;
+
+// Maps whose 50%-overlap crops are ambiguous, so a method may (must, for `empty`) refuse them:
+// - empty: a bare square room; two views of it fit in a continuum of places (slide one along a
+//   wall into the other's unknown part) and under the room's 90-degree turns;
+// - warehouse: three identical rack blocks 80 cells apart, symmetric under a half turn; crops whose
+//   common part shows racks only fit in several places.
+bool ambiguous_map(const std::string& map) { return map == "empty" || map == "warehouse"; }
+
+std::vector<std::string> registry_and_auto() { return merge_method_names(); }
+
+class MethodOnBuiltinMap : public ::testing::TestWithParam<std::tuple<std::string, std::string>> {};
+
+// For every built-in map: crops turned by random angles and shifted, at 50% overlap. Every merge
+// is within a degree and a cell; overlap (alone or in auto) merges every pair of every map with
+// structure; the empty room is always refused.
+TEST_P(MethodOnBuiltinMap, HalfOverlapCropsAreMergedAccuratelyOrRefused) {
+  const auto& [method, map] = GetParam();
+  const auto source = testing::source_map(map);
+  core::Random random(std::hash<std::string>{}(map) % 1000);
+  MergeOptions options;
+  options.method = method;
+  constexpr int kPairs = 4;
+  int merged = 0;
+  for (int i = 0; i < kPairs; ++i) {
+    const CropPair pair = make_crop_pair(source, testing::half_overlap_crops(source), random);
+    const MergeResult r = align_maps(pair.a, pair.b, options);
+    EXPECT_GE(r.confidence, 0.0);
+    EXPECT_LE(r.confidence, 1.0);
+    if (!r.merged) {
+      EXPECT_NE(r.reason.find("no reliable overlap"), std::string::npos) << r.reason;
+      continue;
+    }
+    ++merged;
+    const TransformError e = transform_error(r.transform, pair.b_to_a, pair.overlap_centre_b);
+    EXPECT_LT(e.rotation_deg, kMaxRotationDeg) << map << " pair " << i << " truth " << pair.b_to_a << " got " << r.transform;
+    EXPECT_LT(e.translation_cells, kMaxTranslationCells) << map << " pair " << i;
+    EXPECT_GT(r.acceptance, 0.95) << map << " pair " << i;
+    EXPECT_TRUE(r.reason.empty());
+  }
+  if (map == "empty") {
+    EXPECT_EQ(merged, 0);
+  }
+  if (method != "features" && !ambiguous_map(map)) {
+    EXPECT_EQ(merged, kPairs) << map;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllMethodsAllMaps, MethodOnBuiltinMap,
+                         ::testing::Combine(::testing::ValuesIn(registry_and_auto()),
+                                            ::testing::ValuesIn(testing::builtin_map_names_for_tests())),
+                         [](const auto& info) { return std::get<0>(info.param) + "_" + std::get<1>(info.param); });
+
+class MethodOnDisjointMaps : public ::testing::TestWithParam<std::string> {};
+
+// Maps that do not overlap are refused, never merged: disjoint crops of one map (the same style of
+// walls everywhere) and crops of two different maps.
+TEST_P(MethodOnDisjointMaps, NoOverlapIsNeverMerged) {
+  MergeOptions options;
+  options.method = GetParam();
+  core::Random random(77);
+  for (const char* map : {"office", "maze", "cave", "campus"}) {
+    const auto source = testing::source_map(map);
+    CropPairOptions o;
+    o.width = o.height = std::string(map) == "campus" ? 200 : 90;
+    o.overlap = 0.0;
+    o.min_inside = 0.8;
+    for (int i = 0; i < 2; ++i) {
+      const CropPair pair = make_crop_pair(source, o, random);
+      const MergeResult r = align_maps(pair.a, pair.b, options);
+      EXPECT_FALSE(r.merged) << map << " disjoint pair " << i << " confidence " << r.confidence;
+    }
+  }
+  const auto office = testing::source_map("office"), cave = testing::source_map("cave");
+  const auto maze = testing::source_map("maze");
+  const auto a = crop_grid(office, 20, 20, 140, 140);
+  for (const auto* other : {&cave, &maze}) {
+    const auto b = resample_grid(*other, core::Transform2(30, 30, 0.7), 140, 140);
+    const MergeResult r = align_maps(a, b, options);
+    EXPECT_FALSE(r.merged) << "confidence " << r.confidence;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllMethods, MethodOnDisjointMaps, ::testing::ValuesIn(registry_and_auto()));
+
+TEST(MergeRegistry, NamesAutoFirstThenTheTable) {
+  const auto names = merge_method_names();
+  ASSERT_GE(names.size(), 3u);
+  EXPECT_EQ(names[0], "auto");
+  EXPECT_EQ(names[1], "overlap");
+  EXPECT_EQ(names[2], "features");
+  for (const auto& m : merge_methods()) {
+    EXPECT_FALSE(m.passes.empty()) << m.name;
+    EXPECT_NE(merge_method_help().find(m.name + ":"), std::string::npos);
+  }
+}
+
+TEST(MergeRegistry, UnknownMethodIsAnInputErrorNamingTheValidOnes) {
+  MergeOptions options;
+  options.method = "spectral-magic";
+  const auto g = testing::grid_from_text({"#.", ".#"});
+  fleetmap::testing::expect_input_error([&] { align_maps(g, g, options); },
+                                        {"spectral-magic", "auto", "overlap", "features"});
+}
+
+TEST(AlignMaps, MapsWithoutWallsAreRefusedWithAReason) {
+  const auto free_only = testing::grid_from_text({"....", "....", "...."});
+  const auto unknown = testing::grid_from_text({"    ", "    "});
+  const auto office = testing::source_map("office");
+  for (const auto* g : {&free_only, &unknown}) {
+    const MergeResult r = align_maps(office, *g);
+    EXPECT_FALSE(r.merged);
+    EXPECT_EQ(r.confidence, 0.0);
+    EXPECT_NE(r.reason.find("second map has no walls"), std::string::npos) << r.reason;
+  }
+}
+
+TEST(AlignMaps, IdenticalMapsAlignAtTheIdentity) {
+  const auto office = testing::source_map("office");
+  const MergeResult r = align_maps(office, office);
+  ASSERT_TRUE(r.merged) << r.reason;
+  EXPECT_TRUE(r.transform.is_approx(core::Transform2::identity(), 0.05)) << r.transform;
+  EXPECT_NEAR(r.acceptance, 1.0, 1e-9);
+  EXPECT_EQ(r.method, "overlap");
+}
+
+}  // namespace
+}  // namespace fleetmap::merging

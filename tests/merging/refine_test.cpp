@@ -1,0 +1,33 @@
+#include "merging/refine.h"
+
+#include <gtest/gtest.h>
+
+#include "core/angle.h"
+#include "merging/evaluation.h"
+#include "tests/merging/merging_test_support.h"
+
+namespace fleetmap::merging {
+namespace {
+
+// From a start a few cells and degrees off, refinement reaches the truth to a fraction of a cell:
+// the crops are exact copies of one map, so only resampling of the turned crop limits it.
+TEST(Refine, ConvergesFromAFewCellsOffToSubCellAccuracy) {
+  core::Random random(11);
+  for (const char* name : {"office", "cave", "maze"}) {
+    const auto source = testing::source_map(name);
+    const CropPair pair = make_crop_pair(source, testing::half_overlap_crops(source), random);
+    const PreparedGrid a(pair.a), b(pair.b);
+    for (int trial = 0; trial < 3; ++trial) {
+      const core::Transform2 nudge(random.uniform(-3, 3), random.uniform(-3, 3), core::deg2rad(random.uniform(-2, 2)));
+      const LevelFit fit = refine_alignment(a, b, nudge * pair.b_to_a, 2);
+      const TransformError e = transform_error(fit.b_to_a, pair.b_to_a, pair.overlap_centre_b);
+      EXPECT_LT(e.rotation_deg, 0.5) << name;
+      EXPECT_LT(e.translation_cells, 0.5) << name;
+      EXPECT_GT(fit.inliers, 100) << name;
+      EXPECT_LE(fit.outliers, fit.inliers / 100) << name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fleetmap::merging
