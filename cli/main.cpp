@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
 
   std::vector<fm::cli::Command> commands;
   commands.push_back(fm::cli::add_maps_command(app));
+  commands.push_back(fm::cli::add_merge_command(app));
   commands.push_back(fm::cli::add_plan_command(app));
 
   try {

@@ -1,0 +1,240 @@
+// `fleetmap merge`: several robots' map images become one, with each input's transform into the
+// first input's pixel grid, a confidence, and a picture.
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cli/command.h"
+#include "core/angle.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "maps/builtin_maps.h"
+#include "mapping/map_io.h"
+#include "mapping/render.h"
+#include "merging/fusion.h"
+#include "merging/merge.h"
+#include "merging/multi_merge.h"
+#include "merging/rendezvous.h"
+
+namespace fleetmap::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kConvention =
+    "pixel (u, v) of an input (u = column, v = row from the top) lies at R(theta) (u, v) + (tx, ty) in the first "
+    "input's pixel grid, R(theta) = [[cos, -sin], [sin, cos]]";
+
+struct MergeCommandOptions {
+  std::vector<std::string> maps;
+  std::string method = "auto";
+  std::string out = "merged.png";
+  std::string json;
+  double min_confidence = 0.5;
+  std::uint64_t seed = 1;
+  double resolution = 0.05;
+};
+
+// An input's transform into the first input's pixel grid, as the convention states it.
+core::Transform2 to_first_pixels(const core::Transform2& cells, const mapping::OccupancyGrid& first,
+                                 const mapping::OccupancyGrid& input) {
+  return merging::flip_rows(cells, first.height(), input.height());
+}
+
+nlohmann::json transform_json(const std::string& map, const core::Transform2& pixels, const merging::MergeResult& pair,
+                              double confidence, const std::string& method, const std::string& via) {
+  nlohmann::json j;
+  j["map"] = map;
+  j["merged"] = true;
+  j["tx"] = pixels.translation().x();
+  j["ty"] = pixels.translation().y();
+  j["theta_deg"] = core::rad2deg(pixels.rotation());
+  j["acceptance"] = pair.acceptance;
+  j["confidence"] = confidence;
+  j["method"] = method;
+  j["via"] = via;
+  return j;
+}
+
+// The fused map in map colours, each known cell tinted by the inputs that saw it: free cells
+// lightly, occupied cells strongly; cells where inputs disagree in red.
+cv::Mat tinted(const merging::FusedMap& fused) {
+  const auto& g = fused.grid;
+  cv::Mat img(g.height(), g.width(), CV_8UC3);
+  for (int y = 0; y < g.height(); ++y) {
+    auto* row = img.ptr<cv::Vec3b>(g.height() - 1 - y);
+    for (int x = 0; x < g.width(); ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(g.width()) + std::size_t(x);
+      const auto state = g.state({x, y});
+      if (state == mapping::CellState::Unknown) {
+        row[x] = cv::Vec3b(205, 205, 205);
+        continue;
+      }
+      cv::Vec3d tint(0, 0, 0);
+      int n = 0;
+      for (std::size_t k = 0; k < fused.inputs.size() && k < 32; ++k) {
+        if (!(fused.sources[i] & (1u << k))) continue;
+        const mapping::Color c = mapping::palette_color(fused.inputs[k]);
+        tint += cv::Vec3d(c.b, c.g, c.r);
+        ++n;
+      }
+      if (n > 0) tint /= n;
+      if (state == mapping::CellState::Free) {
+        row[x] = cv::Vec3b(cv::saturate_cast<uchar>(255 * 0.75 + tint[0] * 0.25),
+                           cv::saturate_cast<uchar>(255 * 0.75 + tint[1] * 0.25),
+                           cv::saturate_cast<uchar>(255 * 0.75 + tint[2] * 0.25));
+      } else {
+        row[x] = cv::Vec3b(cv::saturate_cast<uchar>(tint[0] * 0.55), cv::saturate_cast<uchar>(tint[1] * 0.55),
+                           cv::saturate_cast<uchar>(tint[2] * 0.55));
+      }
+      if (fused.conflicts[i]) row[x] = cv::Vec3b(40, 39, 214);
+    }
+  }
+  return img;
+}
+
+cv::Mat picture(const merging::FusedMap& fused, const std::vector<std::string>& names) {
+  mapping::Overlays overlays;
+  for (int input : fused.inputs) {
+    mapping::CellsOverlay legend_only;
+    legend_only.color = mapping::palette_color(input);
+    legend_only.label = std::to_string(input + 1) + ": " + fs::path(names[std::size_t(input)]).filename().string();
+    overlays.cells.push_back(legend_only);
+  }
+  if (fused.conflict_cells > 0) {
+    mapping::CellsOverlay conflicts;
+    conflicts.color = {214, 39, 40};
+    conflicts.label = "free vs occupied";
+    overlays.cells.push_back(conflicts);
+  }
+  mapping::RenderOptions render;
+  render.title = "merged: " + std::to_string(fused.inputs.size()) + " of " + std::to_string(names.size()) + " maps";
+  return mapping::decorate(tinted(fused), fused.grid.geometry(), overlays, render);
+}
+
+int run_merge(const MergeCommandOptions& o) {
+  if (o.maps.size() < 2) {
+    throw InputError("merge needs at least two maps, got one: " + o.maps.front());
+  }
+  merging::check_merge_method(o.method);
+  std::error_code ec;
+  for (const std::string& out : {o.out, o.json}) {
+    for (const auto& m : o.maps) {
+      if (!out.empty() && fs::exists(m) && fs::equivalent(out, m, ec)) {
+        throw InputError(out + ": would overwrite the input map; choose another file");
+      }
+    }
+  }
+  mapping::MapLoadOptions load;
+  load.default_resolution = o.resolution;
+  std::vector<mapping::OccupancyGrid> grids;
+  for (const auto& m : o.maps) {
+    grids.push_back(maps::load_map_source(m, load));
+    const auto& g = grids.back();
+    if (g.known_count() == 0) throw InputError(m + ": every cell is unknown; there is nothing to merge");
+    const double r0 = grids.front().resolution();
+    if (std::abs(g.resolution() - r0) > 1e-9 * r0) {
+      throw InputError(m + ": resolution " + std::to_string(g.resolution()) + " m differs from " + o.maps.front() +
+                       "'s " + std::to_string(r0) + " m; merge maps of one resolution");
+    }
+  }
+  std::vector<const mapping::OccupancyGrid*> pointers;
+  for (const auto& g : grids) pointers.push_back(&g);
+
+  merging::MergeOptions options;
+  options.method = o.method;
+  options.min_confidence = o.min_confidence;
+  options.seed = o.seed;
+  const merging::MultiMergeResult merged = merging::merge_maps(pointers, options);
+
+  // The pair that placed each input, for its acceptance.
+  const auto pair_of = [&](int i, int parent) -> const merging::MergeResult& {
+    for (const auto& p : merged.pairs) {
+      if ((p.a == parent && p.b == i) || (p.a == i && p.b == parent)) return p.result;
+    }
+    throw Error("merge: no pair result for a placed map");
+  };
+  nlohmann::json j;
+  j["convention"] = kConvention;
+  j["reference"] = o.maps.front();
+  j["method"] = o.method;
+  j["transforms"] = nlohmann::json::array();
+  int placed = 1;
+  std::printf("%s: the reference (first input)\n", o.maps.front().c_str());
+  for (std::size_t i = 1; i < grids.size(); ++i) {
+    const auto& name = o.maps[i];
+    if (!merged.to_first[i]) {
+      nlohmann::json t;
+      t["map"] = name;
+      t["merged"] = false;
+      t["reason"] = merged.reason[i];
+      j["transforms"].push_back(t);
+      std::printf("%s: not merged: %s\n", name.c_str(), merged.reason[i].c_str());
+      continue;
+    }
+    ++placed;
+    const core::Transform2 pixels = to_first_pixels(*merged.to_first[i], grids.front(), grids[i]);
+    const int parent = merged.parent[i];
+    const auto& pair = pair_of(int(i), parent);
+    j["transforms"].push_back(transform_json(name, pixels, pair, merged.confidence[i], merged.method[i],
+                                             o.maps[std::size_t(parent)]));
+    std::printf("%s: tx %.2f ty %.2f px, theta %.3f deg, acceptance %.3f, confidence %.2f (%s, via %s)\n",
+                name.c_str(), pixels.translation().x(), pixels.translation().y(), core::rad2deg(pixels.rotation()),
+                pair.acceptance, merged.confidence[i], merged.method[i].c_str(), o.maps[std::size_t(parent)].c_str());
+  }
+  j["merged_maps"] = placed;
+  j["max_loop_gap_px"] = merged.max_loop_gap;
+
+  const merging::FusedMap fused = merging::fuse_merged(pointers, merged);
+  j["conflict_cells"] = fused.conflict_cells;
+  if (!o.json.empty()) core::write_file_atomic(o.json, j.dump(2) + "\n");
+  if (!o.out.empty()) mapping::write_image(o.out, picture(fused, o.maps));
+  if (!o.out.empty()) std::printf("wrote %s\n", o.out.c_str());
+  if (!o.json.empty()) std::printf("wrote %s\n", o.json.c_str());
+  if (placed < int(grids.size())) {
+    std::fprintf(stderr, "fleetmap merge: %d of %zu maps merged; the others have no reliable overlap\n", placed,
+                 grids.size());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Command add_merge_command(CLI::App& root) {
+  CLI::App* merge = root.add_subcommand("merge", "Merge map images of several robots into one map");
+  merge->footer(std::string("Convention: ") + kConvention +
+                ".\n\nMethods:\n" + merging::merge_method_help() +
+                "\nEvery answer has a confidence in [0, 1]; below --min-confidence a map is not merged (\"no reliable\n"
+                "overlap\"): a wrong merge is worse than none. More than two maps: every pair is aligned, and the most\n"
+                "confident pairs chain each map to the first.\n"
+                "--json holds `transforms`: per input after the first, map, merged, tx, ty (pixels), theta_deg,\n"
+                "acceptance, confidence, method, via (the input it was aligned to); or merged: false and the reason.\n"
+                "The picture tints each input's cells in its own colour; red cells are free in one map, occupied in\n"
+                "another. Exit codes: 0 all merged, 1 some map not merged, 2 bad input.");
+  auto o = std::make_shared<MergeCommandOptions>();
+  merge->add_option("maps", o->maps, "Two or more maps: PNG/PGM images or map_server YAML files (the first is the reference)")
+      ->required();
+  merge->add_option("--method", o->method, "Alignment method: auto, overlap or features (see below)")
+      ->capture_default_str()
+      ->check(CLI::IsMember(merging::merge_method_names()));
+  merge->add_option("--out,-o", o->out, "Merged map picture (PNG)")->capture_default_str();
+  merge->add_option("--json", o->json, "Write the transforms and confidences to this JSON (default: none)");
+  merge->add_option("--min-confidence", o->min_confidence, "Refuse merges below this confidence")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  merge->add_option("--seed", o->seed, "Seed of the RANSAC sampling (features)")->capture_default_str();
+  merge->add_option("--resolution", o->resolution, "Metres per cell for bare images without YAML")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  return {merge, [o]() { return run_merge(*o); }};
+}
+
+}  // namespace fleetmap::cli

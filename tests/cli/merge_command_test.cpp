@@ -1,0 +1,154 @@
+// End-to-end: `fleetmap merge` as a user runs it.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+
+#include "core/angle.h"
+#include "maps/builtin_maps.h"
+#include "mapping/map_io.h"
+#include "mapping/render.h"
+#include "merging/evaluation.h"
+#include "merging/rendezvous.h"
+#include "tests/cli_run.h"
+
+namespace fleetmap::cli {
+namespace {
+
+using fleetmap::testing::run_fleetmap;
+using fleetmap::testing::slurp;
+using fleetmap::testing::TempDir;
+
+struct PixelTruth {
+  double tx, ty, theta_deg;
+};
+
+// Two crops of the built-in office, the second turned and shifted, saved as map_saver PNGs. The
+// truth is in the command's pixel convention.
+PixelTruth write_pair(const TempDir& dir, const std::string& a_name, const std::string& b_name, std::uint64_t seed) {
+  const auto office = maps::load_map_source("office");
+  core::Random random(seed);
+  merging::CropPairOptions o;
+  o.width = o.height = 140;
+  o.overlap = 0.5;
+  const merging::CropPair pair = merging::make_crop_pair(office, o, random);
+  mapping::save_map_image(pair.a, dir / a_name);
+  mapping::save_map_image(pair.b, dir / b_name);
+  const core::Transform2 px = merging::flip_rows(pair.b_to_a, pair.a.height(), pair.b.height());
+  return {px.translation().x(), px.translation().y(), core::rad2deg(px.rotation())};
+}
+
+TEST(MergeCommand, MergesTwoMapsInThePixelConvention) {
+  TempDir dir;
+  const PixelTruth truth = write_pair(dir, "a.png", "b.png", 5);
+  const auto r = run_fleetmap("merge a.png b.png --out out/merged.png --json out/result.json", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("wrote out/merged.png"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(slurp(dir / "out" / "result.json"));
+  ASSERT_EQ(j["transforms"].size(), 1u);
+  const auto& t = j["transforms"][0];
+  EXPECT_EQ(t["map"], "b.png");
+  EXPECT_EQ(t["merged"], true);
+  // Within a degree; within a cell at the crop (the translation is at the image origin, so allow
+  // the rotation error over the crop's extent too).
+  const double dtheta = std::abs(core::rad2deg(core::normalize_angle(core::deg2rad(t["theta_deg"].get<double>() - truth.theta_deg))));
+  EXPECT_LT(dtheta, 1.0);
+  EXPECT_LT(std::hypot(t["tx"].get<double>() - truth.tx, t["ty"].get<double>() - truth.ty), 1.0 + core::deg2rad(dtheta) * 200.0);
+  EXPECT_GT(t["acceptance"].get<double>(), 0.95);
+  EXPECT_GE(t["confidence"].get<double>(), 0.5);
+  EXPECT_LE(t["confidence"].get<double>(), 1.0);
+  EXPECT_EQ(t["method"], "overlap");
+  EXPECT_EQ(t["via"], "a.png");
+  EXPECT_NE(j["convention"].get<std::string>().find("R(theta) (u, v) + (tx, ty)"), std::string::npos);
+
+  // The picture tints each input in its own palette colour (legend swatches included).
+  const cv::Mat img = cv::imread((dir / "out" / "merged.png").string());
+  ASSERT_FALSE(img.empty());
+  const auto has_colour = [&](const mapping::Color& c) {
+    for (int y = 0; y < img.rows; ++y) {
+      for (int x = 0; x < img.cols; ++x) {
+        const auto& p = img.at<cv::Vec3b>(y, x);
+        if (p[0] == c.b && p[1] == c.g && p[2] == c.r) return true;
+      }
+    }
+    return false;
+  };
+  EXPECT_TRUE(has_colour(mapping::palette_color(0)));
+  EXPECT_TRUE(has_colour(mapping::palette_color(1)));
+}
+
+TEST(MergeCommand, AMapWithoutOverlapIsReportedNotMerged) {
+  TempDir dir;
+  write_pair(dir, "a.png", "b.png", 6);
+  // A piece of the maze shares nothing with the office.
+  const auto maze = maps::load_map_source("maze");
+  mapping::save_map_image(merging::crop_grid(maze, 30, 30, 120, 120), dir / "maze.png");
+  const auto r = run_fleetmap("merge a.png maze.png b.png --method overlap --json r.json --out m.png", dir);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("2 of 3 maps merged"), std::string::npos) << r.err;
+  const auto j = nlohmann::json::parse(slurp(dir / "r.json"));
+  ASSERT_EQ(j["transforms"].size(), 2u);
+  EXPECT_EQ(j["transforms"][0]["map"], "maze.png");
+  EXPECT_EQ(j["transforms"][0]["merged"], false);
+  EXPECT_NE(j["transforms"][0]["reason"].get<std::string>().find("no reliable overlap"), std::string::npos);
+  EXPECT_FALSE(j["transforms"][0].contains("tx"));
+  EXPECT_EQ(j["transforms"][1]["merged"], true);
+  EXPECT_TRUE(std::filesystem::exists(dir / "m.png"));
+}
+
+TEST(MergeCommand, ReadsMapServerYaml) {
+  TempDir dir;
+  write_pair(dir, "a.png", "b.png", 7);
+  dir.write("b.yaml", "image: b.png\nresolution: 0.05\norigin: [1.0, 2.0, 0.0]\n");
+  const auto r = run_fleetmap("merge a.png b.yaml --json r.json --out m.png", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir / "r.json"))["transforms"][0]["map"], "b.yaml");
+}
+
+TEST(MergeCommand, HelpStatesTheConventionAndEveryFlagWithItsDefault) {
+  TempDir dir;
+  const auto r = run_fleetmap("merge --help", dir);
+  ASSERT_EQ(r.exit_code, 0);
+  for (const char* part : {"R(theta) (u, v) + (tx, ty)", "u = column", "row from the top", "--method",
+                           "=auto", "--out", "=merged.png", "--json", "default: none", "--min-confidence", "=0.5",
+                           "--seed", "--resolution", "=0.05", "overlap:", "features:", "auto:", "merged: false"}) {
+    EXPECT_NE(r.out.find(part), std::string::npos) << part;
+  }
+}
+
+TEST(MergeCommand, BadInputGetsOneLineNamingItAndExitCode2) {
+  TempDir dir;
+  write_pair(dir, "a.png", "b.png", 8);
+  auto r = run_fleetmap("merge a.png missing.png", dir);
+  EXPECT_ONE_LINE_ERROR(r, "missing.png");
+  EXPECT_EQ(r.exit_code, 2);
+  dir.write("junk.png", "not an image at all");
+  r = run_fleetmap("merge a.png junk.png", dir);
+  EXPECT_ONE_LINE_ERROR(r, "junk.png");
+  EXPECT_EQ(r.exit_code, 2);
+  cv::imwrite((dir / "unknown.png").string(), cv::Mat(50, 50, CV_8UC1, cv::Scalar(205)));
+  r = run_fleetmap("merge a.png unknown.png", dir);
+  EXPECT_ONE_LINE_ERROR(r, "unknown.png: every cell is unknown");
+  EXPECT_EQ(r.exit_code, 2);
+  r = run_fleetmap("merge a.png", dir);
+  EXPECT_ONE_LINE_ERROR(r, "at least two maps, got one: a.png");
+  EXPECT_EQ(r.exit_code, 2);
+  r = run_fleetmap("merge a.png b.png --method magic", dir);
+  EXPECT_ONE_LINE_ERROR(r, "magic");
+  EXPECT_EQ(r.exit_code, 2);
+  r = run_fleetmap("merge a.png b.png --out a.png", dir);
+  EXPECT_ONE_LINE_ERROR(r, "would overwrite the input map");
+  EXPECT_EQ(r.exit_code, 2);
+  dir.write("coarse.yaml", "image: b.png\nresolution: 0.1\n");
+  r = run_fleetmap("merge a.png coarse.yaml", dir);
+  EXPECT_ONE_LINE_ERROR(r, "coarse.yaml: resolution");
+  EXPECT_EQ(r.exit_code, 2);
+  r = run_fleetmap("merge", dir);
+  EXPECT_ONE_LINE_ERROR(r, "maps");
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+}  // namespace
+}  // namespace fleetmap::cli
