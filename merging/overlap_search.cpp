@@ -15,9 +15,11 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-int common_level(const PreparedGrid& a, const PreparedGrid& b, int cells) {
+int common_level(const PreparedGrid& a, const PreparedGrid& b, int cells, int max_factor) {
   const int top = std::min(a.level_count(), b.level_count()) - 1;
-  return std::min(top, std::max(a.level_for_size(cells), b.level_for_size(cells)));
+  int level = std::min(top, std::max(a.level_for_size(cells), b.level_for_size(cells)));
+  while (level > 0 && a.level(level).factor > max_factor) --level;
+  return level;
 }
 
 cv::Mat as_float(const cv::Mat& mask) {
@@ -64,10 +66,9 @@ std::vector<Peak> top_peaks(cv::Mat s, int count, int radius) {
 
 std::vector<double> spectral_rotation_candidates(const PreparedGrid& a, const PreparedGrid& b,
                                                  const OverlapSearchOptions& options) {
-  const int level = common_level(a, b, options.spectrum_cells);
   const int bins = std::max(8, options.angle_bins);
-  const auto hs_a = hough_spectrum(a.level(level).wall_points, bins);
-  const auto hs_b = hough_spectrum(b.level(level).wall_points, bins);
+  const auto hs_a = hough_spectrum(a.level(0).wall_points, bins);
+  const auto hs_b = hough_spectrum(b.level(0).wall_points, bins);
   const auto cc = circular_cross_correlation(hs_a, hs_b);
   // Peaks closer than 3 degrees are one peak.
   const int separation = std::max(1, int(std::lround(3.0 * bins / 180.0)));
@@ -99,7 +100,7 @@ std::vector<Hypothesis> overlap_hypotheses(const PreparedGrid& a, const Prepared
 std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const PreparedGrid& b,
                                               const std::vector<double>& rotations,
                                               const OverlapSearchOptions& options) {
-  const int level = common_level(a, b, options.search_cells);
+  const int level = common_level(a, b, options.search_cells, options.max_factor);
   const GridLevel& la = a.level(level);
   const GridLevel& lb = b.level(level);
   const double w = options.contradiction_weight;

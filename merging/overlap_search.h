@@ -12,7 +12,9 @@ namespace fleetmap::merging {
 
 struct OverlapSearchOptions {
   int search_cells = 160;      // the translation search runs on the finest level whose larger side is at most this
-  int spectrum_cells = 320;    // the Hough spectra use the finest level whose larger side is at most this
+  // ... but never coarser than this many fine cells per cell: rooms must stay a few cells wide
+  // (8 cells of 5 cm are 40 cm), however large the map.
+  int max_factor = 8;
   int angle_bins = 360;        // spectrum resolution over [0, pi)
   int spectrum_peaks = 4;      // correlation peaks kept; each gives the rotations theta and theta + pi
   int translation_peaks = 6;   // correlation maxima kept per rotation (repeated places give several)
@@ -34,7 +36,8 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
                                               const std::vector<double>& rotations,
                                               const OverlapSearchOptions& options);
 
-// Rotation candidates (radians, b into a) from the Hough spectra, best first, before the sweep.
+// Rotation candidates (radians, b into a) from the Hough spectra of the full-resolution walls
+// (coarse levels would add the horizontal and vertical steps of pooled slanted walls), best first.
 std::vector<double> spectral_rotation_candidates(const PreparedGrid& a, const PreparedGrid& b,
                                                  const OverlapSearchOptions& options);
 

@@ -39,25 +39,30 @@ void finish_level(GridLevel& level, const PrepareOptions& options) {
     cv::Mat not_wall = level.walls == 0;
     cv::distanceTransform(not_wall, level.wall_distance, cv::DIST_L2, cv::DIST_MASK_5, CV_32F);
   }
+  // At most `cap` points, chosen by a hash of the cell: spread evenly in space without following
+  // the raster order (taking every k-th point of a row scan would leave rows, and the Hough
+  // spectrum would see horizontal lines).
+  const std::size_t cap = static_cast<std::size_t>(std::max(1, options.max_refine_points));
+  const auto sample = [cap](const std::vector<cv::Point>& pts, std::vector<Eigen::Vector2f>& out) {
+    out.clear();
+    const std::uint32_t keep = pts.size() > cap ? std::uint32_t((std::uint64_t(cap) << 16) / pts.size()) : 1u << 16;
+    for (const auto& p : pts) {
+      std::uint32_t h = std::uint32_t(p.x) * 73856093u ^ std::uint32_t(p.y) * 19349663u;
+      h ^= h >> 13, h *= 0x5bd1e995u, h ^= h >> 15;
+      if ((h & 0xffffu) < keep) out.emplace_back(float(p.x), float(p.y));
+    }
+  };
   std::vector<cv::Point> pts;
   cv::findNonZero(level.walls, pts);
-  const std::size_t cap = static_cast<std::size_t>(std::max(1, options.max_refine_points));
-  const double stride = pts.size() > cap ? double(pts.size()) / double(cap) : 1.0;
-  level.wall_points.clear();
-  for (double i = 0.0; i < double(pts.size()); i += stride) {
-    const auto& p = pts[static_cast<std::size_t>(i)];
-    level.wall_points.emplace_back(float(p.x), float(p.y));
-  }
+  sample(pts, level.wall_points);
   cv::Mat interior = level.occupied & ~level.walls;
   pts.clear();
   cv::findNonZero(interior, pts);
-  std::vector<Eigen::Vector2f> sampled;
+  std::vector<cv::Point> even;
   for (const auto& p : pts) {
-    if (p.x % 2 == 0 && p.y % 2 == 0) sampled.emplace_back(float(p.x), float(p.y));
+    if (p.x % 2 == 0 && p.y % 2 == 0) even.push_back(p);
   }
-  const double istride = sampled.size() > cap ? double(sampled.size()) / double(cap) : 1.0;
-  level.interior_points.clear();
-  for (double i = 0.0; i < double(sampled.size()); i += istride) level.interior_points.push_back(sampled[std::size_t(i)]);
+  sample(even, level.interior_points);
 }
 
 }  // namespace

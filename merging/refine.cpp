@@ -79,7 +79,9 @@ LevelFit refine_at_level(const PreparedGrid& a, const PreparedGrid& b, const cor
       h += w * j.transpose() * j;
       g += w * j.transpose() * r.r;
     }
-    h.diagonal() += Eigen::Vector3d::Constant(1e-3 * h.trace() / 3.0 + 1e-9);
+    // Marquardt damping, relative to each diagonal entry: the rotation entry grows with the
+    // square of the map size, so a damping shared by all entries would stall the translation.
+    h.diagonal() = h.diagonal() * (1.0 + 1e-3) + Eigen::Vector3d::Constant(1e-9);
     const Eigen::Vector3d delta = -h.ldlt().solve(g);
     if (!delta.allFinite()) break;
     const double dth = std::clamp(delta(2), -0.05, 0.05);
