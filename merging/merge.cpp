@@ -71,7 +71,10 @@ std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGr
     for (const auto& h : candidates) {
       if (std::min(h.level, top) == k) active.push_back({h, LevelFit{h.b_to_a, 0, 0, 0.0}});
     }
-    for (auto& c : active) c.fit = refine_at_level(a, b, c.fit.b_to_a, k, options.refinement);
+    // Many candidates enter at the top level; a few steps there are enough to rank them.
+    RefineOptions level_options = options.refinement;
+    if (k == start) level_options.iterations = std::min(level_options.iterations, options.first_level_iterations);
+    for (auto& c : active) c.fit = refine_at_level(a, b, c.fit.b_to_a, k, level_options);
     prune(active, b, options.confidence, std::size_t(k >= 2 ? options.coarse_candidates : options.fine_candidates));
   }
   return active;

@@ -51,6 +51,7 @@ struct MergeOptions {
   bool refine = true;            // refine candidates to sub-cell accuracy (off: the methods' raw answers)
   int coarse_candidates = 8;     // candidates kept after the coarse levels
   int fine_candidates = 4;       // candidates taken to full resolution
+  int first_level_iterations = 4;  // refinement steps at the level where the candidates enter
   double sweep_step_deg = 4.0;   // `overlap`'s second pass: rotation sweep step
   // Before merging, search for other placements (b turned by quarter turns from the answer, all
   // translations) so that symmetric or repeated places lower the distinctiveness whatever method

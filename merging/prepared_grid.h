@@ -58,7 +58,7 @@ struct PrepareOptions {
   // robots see a real obstacle; a speck seen by one only would count against a right alignment.
   int min_obstacle_cells = 3;
   int min_level_size = 24;         // stop the pyramid when the larger side would drop below this
-  int max_refine_points = 12000;   // wall points kept per level for refinement (evenly subsampled)
+  int max_refine_points = 6000;    // wall points kept per level for refinement (evenly subsampled)
 };
 
 class PreparedGrid {
