@@ -63,6 +63,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("fleetmap 0.1.0"));
 
   std::vector<fm::cli::Command> commands;
+  commands.push_back(fm::cli::add_explore_command(app));
   commands.push_back(fm::cli::add_maps_command(app));
   commands.push_back(fm::cli::add_merge_command(app));
   commands.push_back(fm::cli::add_plan_command(app));

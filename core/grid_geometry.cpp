@@ -13,7 +13,8 @@ std::ostream& operator<<(std::ostream& os, const Cell& c) {
 }
 
 GridGeometry::GridGeometry(double resolution, int width, int height, const Pose2& origin)
-    : resolution_(resolution), width_(width), height_(height), origin_(origin) {
+    : resolution_(resolution), width_(width), height_(height), origin_(origin),
+      world_to_origin_(origin.as_transform().inverse()) {
   if (!(resolution > 0.0) || !std::isfinite(resolution)) {
     throw Error("grid resolution must be a positive number of metres per cell, got " +
                 std::to_string(resolution));
@@ -25,7 +26,7 @@ GridGeometry::GridGeometry(double resolution, int width, int height, const Pose2
 }
 
 Eigen::Vector2d GridGeometry::world_to_grid(const Eigen::Vector2d& p) const {
-  return origin_.as_transform().inverse().apply(p) / resolution_;
+  return world_to_origin_.apply(p) / resolution_;
 }
 
 Eigen::Vector2d GridGeometry::grid_to_world(const Eigen::Vector2d& g) const {

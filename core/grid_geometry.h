@@ -53,13 +53,16 @@ class GridGeometry {
   Eigen::Vector2d grid_to_world(const Eigen::Vector2d& g) const;
   Eigen::Vector2d cell_center(const Cell& c) const;
 
-  bool operator==(const GridGeometry&) const = default;
+  bool operator==(const GridGeometry& o) const {
+    return resolution_ == o.resolution_ && width_ == o.width_ && height_ == o.height_ && origin_ == o.origin_;
+  }
 
  private:
   double resolution_ = 1.0;
   int width_ = 0;
   int height_ = 0;
   Pose2 origin_;
+  Transform2 world_to_origin_;  // origin_.as_transform().inverse(), cached: world_to_grid is hot
 };
 
 std::ostream& operator<<(std::ostream& os, const GridGeometry& g);

@@ -12,45 +12,13 @@
 
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/yaml_reader.h"
 
 namespace fleetmap::mapping {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string where(const std::string& source, const YAML::Node& node) {
-  const auto mark = node.Mark();
-  return mark.line >= 0 ? source + ":" + std::to_string(mark.line + 1) : source;
-}
-
-std::string scalar_text(const YAML::Node& node) {
-  if (node.IsScalar()) return node.Scalar();
-  if (node.IsSequence()) return "a list";
-  if (node.IsMap()) return "a mapping";
-  return "nothing";
-}
-
-double parse_number(const YAML::Node& node, const std::string& key, const std::string& source) {
-  double v = 0.0;
-  if (!node.IsScalar() || !YAML::convert<double>::decode(node, v) || !std::isfinite(v)) {
-    throw InputError(where(source, node) + ": key '" + key + "': expected a finite number, got '" +
-                     scalar_text(node) + "'");
-  }
-  return v;
-}
-
-bool parse_flag(const YAML::Node& node, const std::string& key, const std::string& source) {
-  if (node.IsScalar()) {
-    const std::string s = node.Scalar();
-    if (s == "0") return false;
-    if (s == "1") return true;
-    bool b = false;
-    if (YAML::convert<bool>::decode(node, b)) return b;
-  }
-  throw InputError(where(source, node) + ": key '" + key + "': expected 0, 1, true or false, got '" +
-                   scalar_text(node) + "'");
-}
 
 // Reads width and height from a PNG or PNM header without decoding the image.
 std::optional<std::pair<std::int64_t, std::int64_t>> peek_image_size(const std::string& bytes) {
@@ -118,67 +86,41 @@ cv::Mat read_image(const fs::path& path, const MapLoadOptions& options) {
 }  // namespace
 
 MapYaml parse_map_yaml(std::string_view text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    throw InputError(source + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML (" + e.msg + ")");
-  }
+  const YAML::Node root = core::parse_yaml(std::string(text), source);
   if (!root.IsMap()) throw InputError(source + ": expected a map_server YAML mapping with 'image' and 'resolution'");
-
-  static const std::vector<std::string> kKeys = {"image", "resolution", "origin", "negate",
-                                                 "occupied_thresh", "free_thresh", "mode"};
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    if (std::find(kKeys.begin(), kKeys.end(), key) == kKeys.end()) {
-      throw InputError(where(source, kv.first) + ": unknown key '" + key +
-                       "' (valid: image, resolution, origin, negate, occupied_thresh, free_thresh, mode)");
-    }
-  }
-
+  core::YamlMap m(root, source);
   MapYaml y;
-  if (!root["image"]) throw InputError(source + ": missing key 'image' (the map image file)");
-  if (!root["image"].IsScalar() || root["image"].Scalar().empty()) {
-    throw InputError(where(source, root["image"]) + ": key 'image': expected a file name");
-  }
-  y.image = root["image"].Scalar();
-
-  if (!root["resolution"]) throw InputError(source + ": missing key 'resolution' (metres per cell)");
-  y.resolution = parse_number(root["resolution"], "resolution", source);
+  if (!m.has("image")) throw InputError(source + ": missing key 'image' (the map image file)");
+  y.image = m.text("image", "");
+  if (y.image.empty()) throw InputError(m.where("image") + ": expected a file name");
+  if (!m.has("resolution")) throw InputError(source + ": missing key 'resolution' (metres per cell)");
+  y.resolution = m.number("resolution", 0.0);
   if (!(y.resolution > 0.0)) {
-    throw InputError(where(source, root["resolution"]) + ": key 'resolution': expected a positive number of metres per cell, got '" +
-                     root["resolution"].Scalar() + "'");
+    throw InputError(m.where("resolution") + ": expected a positive number of metres per cell, got " +
+                     core::describe_node(*m.node("resolution")));
   }
-
-  if (const auto o = root["origin"]) {
-    if (!o.IsSequence() || o.size() != 3) {
-      throw InputError(where(source, o) + ": key 'origin': expected [x, y, yaw], got " + scalar_text(o));
+  if (const auto o = m.node("origin")) {
+    if (!o->IsSequence() || o->size() != 3) {
+      throw InputError(m.where("origin") + ": expected [x, y, yaw], got " + core::describe_node(*o));
     }
-    y.origin = core::Pose2(parse_number(o[0], "origin", source), parse_number(o[1], "origin", source),
-                           parse_number(o[2], "origin", source));
+    const auto v = m.numbers("origin", 3);
+    y.origin = core::Pose2(v[0], v[1], v[2]);
   }
-  if (const auto n = root["negate"]) y.negate = parse_flag(n, "negate", source);
-  const auto threshold = [&](const char* key, double& value) {
-    if (const auto n = root[key]) {
-      value = parse_number(n, key, source);
-      if (!(value >= 0.0 && value <= 1.0)) {
-        throw InputError(where(source, n) + ": key '" + key + "': expected a number in [0, 1], got '" + n.Scalar() + "'");
-      }
-    }
-  };
-  threshold("occupied_thresh", y.occupied_thresh);
-  threshold("free_thresh", y.free_thresh);
+  if (const auto n = m.node("negate")) {
+    // map_server writes 0 / 1; true / false are accepted too.
+    const std::string s = n->IsScalar() ? n->Scalar() : "";
+    if (s == "0" || s == "1") y.negate = s == "1";
+    else y.negate = m.boolean("negate", false);
+  }
+  y.occupied_thresh = m.number("occupied_thresh", y.occupied_thresh, 0.0, 1.0);
+  y.free_thresh = m.number("free_thresh", y.free_thresh, 0.0, 1.0);
   if (y.free_thresh > y.occupied_thresh) {
     throw InputError(source + ": free_thresh (" + std::to_string(y.free_thresh) + ") is above occupied_thresh (" +
                      std::to_string(y.occupied_thresh) + ")");
   }
-  if (const auto m = root["mode"]) {
-    const std::string s = m.IsScalar() ? m.Scalar() : "";
-    if (s == "trinary") y.mode = MapMode::Trinary;
-    else if (s == "scale") y.mode = MapMode::Scale;
-    else if (s == "raw") y.mode = MapMode::Raw;
-    else throw InputError(where(source, m) + ": key 'mode': expected trinary, scale or raw, got '" + scalar_text(m) + "'");
-  }
+  const std::string mode = m.choice("mode", "trinary", {"trinary", "scale", "raw"});
+  y.mode = mode == "trinary" ? MapMode::Trinary : (mode == "scale" ? MapMode::Scale : MapMode::Raw);
+  m.finish();
   return y;
 }
 

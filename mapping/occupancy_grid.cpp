@@ -5,7 +5,6 @@
 #include <ostream>
 
 #include "core/error.h"
-#include "mapping/grid_traversal.h"
 
 namespace fleetmap::mapping {
 
@@ -49,25 +48,18 @@ void OccupancyGrid::set_state(const Cell& c, CellState s) {
 }
 
 void OccupancyGrid::set_log_odds(const Cell& c, float l) {
-  if (contains(c)) log_odds_[static_cast<std::size_t>(geometry_.index(c))] = l;
+  if (!contains(c)) return;
+  float& cell = log_odds_[static_cast<std::size_t>(geometry_.index(c))];
+  observed_count_ += (cell == 0.0f) - (l == 0.0f);
+  cell = l;
 }
 
 void OccupancyGrid::update(const Cell& c, float delta) {
   if (!contains(c)) return;
   float& l = log_odds_[static_cast<std::size_t>(geometry_.index(c))];
+  const float before = l;
   l = std::clamp(l + delta, min_log_odds_, max_log_odds_);
-}
-
-int OccupancyGrid::integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit) {
-  const auto end_cell = geometry_.world_to_cell(to);
-  int updated = 0;
-  traverse_segment(geometry_, from, to, [&](const Cell& c, double) {
-    const bool is_end = end_cell && c == *end_cell;
-    update(c, is_end && hit ? hit_log_odds_ : miss_log_odds_);
-    ++updated;
-    return !is_end;
-  });
-  return updated;
+  observed_count_ += (before == 0.0f) - (l == 0.0f);
 }
 
 std::int64_t OccupancyGrid::count(CellState s) const {

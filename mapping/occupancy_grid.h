@@ -1,11 +1,13 @@
 #pragma once
 // A log-odds occupancy grid (Moravec & Elfes; the clamped update of OctoMap).
 #include <Eigen/Core>
+#include <algorithm>
 #include <cstdint>
 #include <iosfwd>
 #include <vector>
 
 #include "core/grid_geometry.h"
+#include "mapping/grid_traversal.h"
 
 namespace fleetmap::mapping {
 
@@ -54,6 +56,8 @@ class OccupancyGrid {
                                   : (l < free_log_odds_ ? CellState::Free : CellState::Unknown);
   }
   bool is_free(const Cell& c) const { return state(c) == CellState::Free; }
+  // Ever touched by evidence. A cell can be observed and still Unknown when its evidence conflicts.
+  bool observed(const Cell& c) const { return contains(c) && log_odds(c) != 0.0f; }
   float log_odds(const Cell& c) const { return log_odds_[static_cast<std::size_t>(geometry_.index(c))]; }
   float log_odds_at(int index) const { return log_odds_[static_cast<std::size_t>(index)]; }
   double probability(const Cell& c) const { return log_odds_to_probability(log_odds(c)); }
@@ -70,9 +74,17 @@ class OccupancyGrid {
   // cell gets a miss; the end cell gets a hit when `hit`, or a miss when the beam reached its
   // maximum range without a return. Each cell is updated once; the part outside the grid is
   // ignored. Returns the number of cells updated.
-  int integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit);
+  int integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit) {
+    return integrate_ray(from, to, hit, [](int, bool) {});
+  }
+  // The same, calling `on_cell(index, changed)` for every cell it updates; `changed` is false when
+  // the cell was already at its clamping bound.
+  template <typename OnCell>
+  int integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit, OnCell&& on_cell);
 
   std::int64_t count(CellState s) const;
+  // Cells ever touched by evidence, kept up to date on every write (cheap to ask every step).
+  std::int64_t observed_count() const { return observed_count_; }
   std::int64_t known_count() const { return count(CellState::Free) + count(CellState::Occupied); }
 
   const std::vector<float>& log_odds_data() const { return log_odds_; }
@@ -88,10 +100,29 @@ class OccupancyGrid {
   GridGeometry geometry_;
   OccupancyGridOptions options_;
   std::vector<float> log_odds_;
+  std::int64_t observed_count_ = 0;
   float hit_log_odds_ = 0, miss_log_odds_ = 0, min_log_odds_ = 0, max_log_odds_ = 0;
   float occupied_log_odds_ = 0, free_log_odds_ = 0;
 };
 
 std::ostream& operator<<(std::ostream& os, const OccupancyGrid& g);
+
+template <typename OnCell>
+int OccupancyGrid::integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit, OnCell&& on_cell) {
+  const auto end_cell = geometry_.world_to_cell(to);
+  int updated = 0;
+  traverse_segment(geometry_, from, to, [&](const Cell& c, double) {
+    const bool is_end = end_cell && c == *end_cell;
+    const int i = geometry_.index(c);
+    float& l = log_odds_[static_cast<std::size_t>(i)];
+    const float before = l;
+    l = std::clamp(l + (is_end && hit ? hit_log_odds_ : miss_log_odds_), min_log_odds_, max_log_odds_);
+    observed_count_ += (before == 0.0f) - (l == 0.0f);
+    on_cell(i, l != before);
+    ++updated;
+    return !is_end;
+  });
+  return updated;
+}
 
 }  // namespace fleetmap::mapping

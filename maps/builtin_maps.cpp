@@ -50,7 +50,8 @@ void keep_largest_free_region(cv::Mat& img) {
 }
 
 // Morphological opening of the free space by a disc of radius r, keeping one connected region:
-// removes passages and nooks narrower than 2r, so a robot of radius r reaches every free cell.
+// removes passages and nooks narrower than 2r cells, so a robot of radius r (and some margin)
+// reaches every free cell.
 void open_free_space(cv::Mat& img, int r) {
   const cv::Mat disc = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1));
   cv::Mat free = img == kFree, core;
@@ -173,7 +174,7 @@ cv::Mat make_unstructured() {
     }
   }
   border(img, 2);
-  open_free_space(img, 3);
+  open_free_space(img, 4);
   return img;
 }
 
@@ -241,7 +242,7 @@ cv::Mat make_cave() {
   cv::Mat img(200, 200, CV_8UC1, cv::Scalar(kFree));
   img.setTo(kWall, smooth > 0.5f);
   border(img, 2);
-  open_free_space(img, 3);
+  open_free_space(img, 4);
   return img;
 }
 

@@ -1,0 +1,65 @@
+#pragma once
+// Coordination strategies: which robot goes to which frontier target. One interface, chosen by
+// name (`--strategy`, scenario files) through make_strategy(); tests iterate strategy_names().
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "exploration/frontiers.h"
+
+namespace fleetmap::exploration {
+
+struct StrategyOptions {
+  // Weight of travel cost against utility (Burgard et al. 2005's beta; seed 003 eq. (3)).
+  double beta = 1.0;
+  // `directional`: how strongly a robot prefers targets in its own direction (0: not at all).
+  double directional_weight = 0.5;
+};
+
+struct AssignmentRobot {
+  int team_index = 0;  // this robot's place in the team, 0..team_size-1
+  int team_size = 1;
+  Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+  std::vector<double> cost_m;  // wave cost to each target's goal, metres; +inf when unreachable
+};
+
+struct AssignmentInput {
+  std::vector<Target> targets;
+  std::vector<AssignmentRobot> robots;       // the robots to assign now
+  std::vector<Eigen::Vector2d> claimed;      // goals other robots already drive to (known by talking)
+  double sensor_range_m = 4.0;               // utility of targets near an assigned one drops within it
+};
+
+class CoordinationStrategy {
+ public:
+  virtual ~CoordinationStrategy() = default;
+  virtual std::string name() const = 0;
+  // Joint strategies reassign every robot they can talk to whenever one needs a new target;
+  // the others assign only the robot that needs one.
+  virtual bool joint() const = 0;
+  // Per robot of the input: the index of its target, or -1 for none. Joint strategies give each
+  // target to one robot at most; with more robots than targets the others get -1 and wait (a team
+  // that sends its spare robots after taken targets jams in the last corridor).
+  virtual std::vector<int> assign(const AssignmentInput& input) const = 0;
+};
+
+std::vector<std::string> strategy_names();
+// One line per strategy with its source, for --help and README.
+std::string strategy_help();
+// Throws InputError listing the valid names for an unknown one.
+std::unique_ptr<CoordinationStrategy> make_strategy(const std::string& name, const StrategyOptions& options = {});
+
+// ---- helpers shared by the strategies ----
+
+// Burgard's visibility model: the chance that a target at distance d from an assigned one is
+// explored by it, 1 - d / range inside the sensor range and 0 beyond.
+double visibility_overlap(double distance_m, double sensor_range_m);
+// Utilities start at 1 and drop by visibility_overlap for every claimed goal.
+std::vector<double> initial_utilities(const AssignmentInput& input);
+// The largest finite cost in the input (1 when there is none), to scale costs into [0, 1].
+double cost_scale(const AssignmentInput& input);
+// Each robot without a target takes its cheapest reachable one (taken or not).
+void nearest_targets(const AssignmentInput& input, std::vector<int>& assignment);
+
+}  // namespace fleetmap::exploration

@@ -1,0 +1,388 @@
+#include "exploration/team_explorer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+namespace fleetmap::exploration {
+
+namespace {
+
+Cell robot_cell(const ExplorerRobot& r) { return r.map->geometry().world_to_cell_unbounded(r.pose.position()); }
+
+WaveGrid wave_grid(const mapping::OccupancyGrid& map, const std::vector<std::uint8_t>& passable,
+                   std::vector<float>& occupancy, const WaveOptions& options) {
+  WaveGrid g{map.width(), map.height(), passable, {}};
+  if (options.occupancy_weight > 0.0) {
+    occupancy.resize(passable.size());
+    for (std::size_t i = 0; i < occupancy.size(); ++i) occupancy[i] = float(mapping::log_odds_to_probability(map.log_odds_at(int(i))));
+    g.occupancy = occupancy;
+  }
+  return g;
+}
+
+// A robot standing in inflated space (it cut a corner, or the map just grew a wall beside it) must
+// still find a way out: the free cells within the inflation distance of it become passable.
+void open_around(const mapping::OccupancyGrid& map, const Cell& c, const TraversabilityOptions& options,
+                 std::vector<std::uint8_t>& passable) {
+  const double reach = (options.robot_radius_m + options.safety_margin_m) / map.resolution() + 1.0;
+  const int r = int(std::ceil(reach));
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      const Cell n{c.x + dx, c.y + dy};
+      if (double(dx * dx + dy * dy) > reach * reach || !map.contains(n)) continue;
+      if (map.state(n) == mapping::CellState::Free) passable[std::size_t(map.geometry().index(n))] = 1;
+    }
+  }
+}
+
+// Other robots are obstacles: the cells within two radii plus the margin of each robot that `self`
+// can talk to become impassable.
+void mark_robots(const mapping::OccupancyGrid& map, const std::vector<ExplorerRobot>& robots, int self,
+                 const std::vector<std::vector<char>>& links, const TraversabilityOptions& options,
+                 std::vector<std::uint8_t>& passable) {
+  const double reach = (2.0 * options.robot_radius_m + options.safety_margin_m) / map.resolution();
+  const int r = int(std::ceil(reach));
+  for (std::size_t j = 0; j < robots.size(); ++j) {
+    if (int(j) == self || (self >= 0 && !links[std::size_t(self)][j])) continue;
+    const Cell c = robot_cell(robots[j]);
+    for (int dy = -r; dy <= r; ++dy) {
+      for (int dx = -r; dx <= r; ++dx) {
+        const Cell n{c.x + dx, c.y + dy};
+        if (double(dx * dx + dy * dy) <= reach * reach && map.contains(n)) passable[std::size_t(map.geometry().index(n))] = 0;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+TeamExplorer::TeamExplorer(int robots, const ExplorationOptions& options)
+    : options_(options),
+      strategy_(make_strategy(options.strategy, options.strategy_options)),
+      robots_(std::size_t(std::max(0, robots))) {}
+
+bool TeamExplorer::all_finished() const {
+  return std::all_of(robots_.begin(), robots_.end(), [](const RobotState& r) { return r.finished; });
+}
+
+std::vector<Eigen::Vector2d> TeamExplorer::path(int i) const {
+  const RobotState& r = robots_[std::size_t(i)];
+  std::vector<Eigen::Vector2d> out;
+  if (!r.has_task) return out;
+  out.reserve(r.path.size() - std::min(r.next, r.path.size()));
+  for (std::size_t k = r.next; k < r.path.size(); ++k) out.push_back(r.geometry.cell_center(r.path[k]));
+  return out;
+}
+
+std::optional<Eigen::Vector2d> TeamExplorer::goal(int i) const {
+  const RobotState& r = robots_[std::size_t(i)];
+  if (!r.has_task) return std::nullopt;
+  return r.geometry.cell_center(r.goal);
+}
+
+void TeamExplorer::give_up(int i, std::int64_t known_cells) {
+  RobotState& r = robots_[std::size_t(i)];
+  r.has_task = false;
+  ++stats_.targets_given_up;
+  // A place given up before counts another attempt.
+  int attempts = 1;
+  for (const auto& list : {r.given_up, r.abandoned}) {
+    for (const auto& g : list) {
+      if (g.frontier == r.frontier) attempts = std::max(attempts, g.attempts + 1);
+    }
+  }
+  std::erase_if(r.given_up, [&](const GivenUp& g) { return g.frontier == r.frontier; });
+  if (attempts >= options_.max_attempts) r.abandoned.push_back({r.frontier, known_cells, attempts});
+  else r.given_up.push_back({r.frontier, known_cells, attempts});
+}
+
+bool TeamExplorer::blacklisted(const RobotState& r, const Target& t, double resolution) const {
+  const double radius_cells = options_.targets.piece_radius_m / resolution;
+  for (const auto& list : {std::cref(r.given_up), std::cref(r.abandoned)}) {
+    for (const auto& g : list.get()) {
+      const double dx = g.frontier.x - t.frontier.x, dy = g.frontier.y - t.frontier.y;
+      if (dx * dx + dy * dy <= radius_cells * radius_cells) return true;
+    }
+  }
+  return false;
+}
+
+void TeamExplorer::set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const {
+  r.path = std::move(path);
+  r.was_clear.resize(r.path.size());
+  for (std::size_t k = 0; k < r.path.size(); ++k) r.was_clear[k] = cell_clear(map, r.path[k], options_.traversability);
+  r.next = 0;
+}
+
+bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
+                              const std::vector<std::vector<char>>& links) {
+  const ExplorerRobot& robot = robots[std::size_t(i)];
+  RobotState& r = robots_[std::size_t(i)];
+  const auto& map = *robot.map;
+  const double res = map.resolution();
+  const Eigen::Vector2d p = robot.pose.position();
+
+  // Progress: the furthest path cell near the robot, looking a little ahead.
+  const std::size_t look = std::min(r.path.size(), r.next + 12);
+  std::size_t passed = r.next;
+  for (std::size_t k = r.next; k < look; ++k) {
+    if ((map.geometry().cell_center(r.path[k]) - p).norm() <= 1.5 * res) passed = k + 1;
+  }
+  r.next = std::max(r.next, passed);
+  // Progress means fewer path cells left than ever before on this task; a replanned path that
+  // starts where the robot stands does not count.
+  const std::size_t remaining = r.path.size() - std::min(r.next, r.path.size());
+  if (remaining < r.best_remaining) {
+    r.best_remaining = remaining;
+    r.steps_since_progress = 0;
+  } else {
+    ++r.steps_since_progress;
+  }
+
+  if (r.yielding) {
+    if ((map.geometry().cell_center(r.goal) - p).norm() <= options_.reach_tolerance_m || r.next >= r.path.size() ||
+        r.steps_since_progress > options_.stall_steps) {
+      r.has_task = r.yielding = false;
+    }
+    return r.has_task;
+  }
+  if ((map.geometry().cell_center(r.goal) - p).norm() <= options_.reach_tolerance_m || r.next >= r.path.size()) {
+    ++stats_.targets_reached;
+    r.has_task = false;
+    // Standing at the goal with the frontier still there: its unknown side cannot be seen from the
+    // free space (e.g. the inside of a wall whose corner a beam clipped). Nobody should come again;
+    // the robots this one talks to learn it too.
+    if (frontier_cells_near(map, r.frontier, 2.0 * res) > 0) {
+      ++stats_.unobservable;
+      for (std::size_t j = 0; j < robots_.size(); ++j) {
+        if (int(j) == i || links[std::size_t(i)][j]) robots_[j].abandoned.push_back({r.frontier, map.observed_count(), options_.max_attempts});
+      }
+    }
+    return false;
+  }
+  if (frontier_cells_near(map, r.frontier, options_.targets.piece_radius_m) == 0) {
+    r.has_task = false;  // explored meanwhile, by this robot or by what it was told
+    return false;
+  }
+  // Stuck, most likely behind or facing another robot: plan a way around the robots it knows of.
+  if (r.steps_since_progress > 0 && r.steps_since_progress % options_.detour_after_steps == 0) {
+    auto passable = traversable_cells(map, options_.traversability);
+    mark_robots(map, robots, i, links, options_.traversability, passable);
+    const Cell from = robot_cell(robot);
+    open_around(map, from, options_.traversability, passable);
+    std::vector<float> occupancy;
+    compute_wave(wave_grid(map, passable, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave, wave_);
+    ++stats_.waves;
+    if (wave_.reached(r.goal)) {
+      ++stats_.detours;
+      set_path(r, wave_.path_to(r.goal), map);
+    }
+  }
+  if (r.steps_since_progress > options_.stall_steps) {
+    ++stats_.given_up_stalled;
+    give_up(i, map.observed_count());
+    return false;
+  }
+  // New obstacles on the path ahead (cells clear when planned, blocked now): plan again to the same
+  // goal, or give it up.
+  const std::size_t end = std::min(r.path.size(), r.next + std::size_t(options_.path_check_cells));
+  for (std::size_t k = r.next; k < end; ++k) {
+    if (!r.was_clear[k] || cell_clear(map, r.path[k], options_.traversability)) continue;
+    if (!cell_clear(map, r.goal, options_.traversability)) {
+      r.has_task = false;  // the goal itself turned out too close to a wall: a new target, not a failure
+      return false;
+    }
+    auto passable = traversable_cells(map, options_.traversability);
+    std::vector<float> occupancy;
+    const Cell from = robot_cell(robot);
+    open_around(map, from, options_.traversability, passable);
+    compute_wave(wave_grid(map, passable, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave, wave_);
+    ++stats_.waves;
+    ++stats_.paths_replanned;
+    if (!wave_.reached(r.goal)) {
+      ++stats_.given_up_unreachable;
+      give_up(i, map.observed_count());
+      return false;
+    }
+    set_path(r, wave_.path_to(r.goal), map);
+    break;
+  }
+  return true;
+}
+
+void TeamExplorer::make_way(int stuck, const std::vector<ExplorerRobot>& robots,
+                            const std::vector<std::vector<char>>& links) {
+  const RobotState& s = robots_[std::size_t(stuck)];
+  const auto& geometry = robots[std::size_t(stuck)].map->geometry();
+  const double res = geometry.resolution();
+  const double keep_cells = (2.0 * options_.traversability.robot_radius_m + options_.traversability.safety_margin_m) / res + 1.0;
+  const std::size_t ahead = std::min(s.path.size(), s.next + std::size_t(options_.path_check_cells));
+  const auto near_path = [&](const Cell& c) {
+    for (std::size_t k = s.next; k < ahead; ++k) {
+      const double dx = c.x - s.path[k].x, dy = c.y - s.path[k].y;
+      if (dx * dx + dy * dy <= keep_cells * keep_cells) return true;
+    }
+    const Cell me = robot_cell(robots[std::size_t(stuck)]);
+    const double dx = c.x - me.x, dy = c.y - me.y;
+    return dx * dx + dy * dy <= keep_cells * keep_cells;
+  };
+  for (std::size_t j = 0; j < robots_.size(); ++j) {
+    RobotState& other = robots_[j];
+    if (int(j) == stuck || !other.finished || other.has_task || !links[std::size_t(stuck)][j]) continue;
+    const Cell at = robot_cell(robots[j]);
+    if (!near_path(at)) continue;
+    // The nearest place (by wave cost on its own map) that is clear of the stuck robot's way.
+    const auto& map = *robots[j].map;
+    auto passable = traversable_cells(map, options_.traversability);
+    open_around(map, at, options_.traversability, passable);
+    std::vector<float> occupancy;
+    compute_wave(wave_grid(map, passable, occupancy, options_.wave), std::span<const Cell>(&at, 1), options_.wave, wave_);
+    ++stats_.waves;
+    const int window = int(std::ceil(4.0 / res));
+    float best = WaveField::kUnreached;
+    Cell goal = at;
+    for (int dy = -window; dy <= window; ++dy) {
+      for (int dx = -window; dx <= window; ++dx) {
+        const Cell c{at.x + dx, at.y + dy};
+        const float cost = wave_.cost(c);
+        if (cost >= best || !map.contains(c) || !passable[std::size_t(map.geometry().index(c))] || near_path(c)) continue;
+        best = cost;
+        goal = c;
+      }
+    }
+    if (best == WaveField::kUnreached) continue;
+    other.has_task = other.yielding = true;
+    other.goal = other.frontier = goal;
+    set_path(other, wave_.path_to(goal), map);
+    other.best_remaining = other.path.size();
+    other.steps_since_progress = 0;
+    ++stats_.yields;
+  }
+}
+
+void TeamExplorer::update(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links) {
+  const int n = int(robots_.size());
+  std::vector<char> needy(std::size_t(n), false);
+  for (int i = 0; i < n; ++i) {
+    RobotState& r = robots_[std::size_t(i)];
+    r.geometry = robots[std::size_t(i)].map->geometry();
+    const auto known = robots[std::size_t(i)].map->observed_count();
+    // Targets given up are retried once the map has grown enough.
+    std::erase_if(r.given_up, [&](const GivenUp& g) { return known - g.known_cells >= options_.retry_after_new_cells; });
+    if (r.finished) {
+      if (r.has_task) check_task(i, robots, links);  // a yield task
+      if (known - r.known_when_finished >= options_.retry_after_new_cells / 4 + 1 && !r.has_task) r.finished = false;
+      else continue;
+    }
+    if (r.has_task && check_task(i, robots, links)) continue;
+    needy[std::size_t(i)] = true;
+  }
+
+  for (int i = 0; i < n; ++i) {
+    const RobotState& r = robots_[std::size_t(i)];
+    if (r.has_task && !r.yielding && r.steps_since_progress >= options_.detour_after_steps) make_way(i, robots, links);
+  }
+
+  // Groups of robots that can talk now (connected components of the link graph).
+  std::vector<int> group(std::size_t(n), -1);
+  int groups = 0;
+  for (int i = 0; i < n; ++i) {
+    if (group[std::size_t(i)] >= 0) continue;
+    std::vector<int> stack = {i};
+    group[std::size_t(i)] = groups;
+    while (!stack.empty()) {
+      const int a = stack.back();
+      stack.pop_back();
+      for (int b = 0; b < n; ++b) {
+        if (group[std::size_t(b)] < 0 && links[std::size_t(a)][std::size_t(b)]) {
+          group[std::size_t(b)] = groups;
+          stack.push_back(b);
+        }
+      }
+    }
+    ++groups;
+  }
+
+  for (int g = 0; g < groups; ++g) {
+    int leader = -1;
+    for (int i = 0; i < n && leader < 0; ++i)
+      if (group[std::size_t(i)] == g && needy[std::size_t(i)]) leader = i;
+    if (leader < 0) continue;
+    std::vector<int> members, claim_holders;
+    for (int i = 0; i < n; ++i) {
+      if (group[std::size_t(i)] != g) continue;
+      const RobotState& r = robots_[std::size_t(i)];
+      if (needy[std::size_t(i)] || (strategy_->joint() && r.has_task)) members.push_back(i);
+      else if (r.has_task) claim_holders.push_back(i);
+    }
+    assign_group(members, leader, robots, claim_holders, links);
+  }
+}
+
+void TeamExplorer::assign_group(const std::vector<int>& members, int leader, const std::vector<ExplorerRobot>& robots,
+                                const std::vector<int>& claim_holders, const std::vector<std::vector<char>>& links) {
+  ++stats_.assignment_rounds;
+  const auto& map = *robots[std::size_t(leader)].map;
+  auto passable = traversable_cells(map, options_.traversability);
+  const std::vector<Target> targets = make_targets(map, passable, options_.targets);
+  for (int i : members) open_around(map, robot_cell(robots[std::size_t(i)]), options_.traversability, passable);
+  std::vector<float> occupancy;
+  const WaveGrid grid = wave_grid(map, passable, occupancy, options_.wave);
+
+  AssignmentInput input;
+  input.targets = targets;
+  input.sensor_range_m = options_.sensor_range_m;
+  for (int c : claim_holders) input.claimed.push_back(map.geometry().cell_center(robots_[std::size_t(c)].goal));
+  std::vector<std::vector<Cell>> paths_by_member;
+  std::vector<WaveField> waves(members.size());
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const int i = members[k];
+    const RobotState& r = robots_[std::size_t(i)];
+    const Cell from = robot_cell(robots[std::size_t(i)]);
+    compute_wave(grid, std::span<const Cell>(&from, 1), options_.wave, waves[k]);
+    ++stats_.waves;
+    AssignmentRobot ar;
+    ar.team_index = i;
+    ar.team_size = int(robots_.size());
+    ar.position_m = robots[std::size_t(i)].pose.position();
+    ar.cost_m.resize(targets.size());
+    const auto& own_map = *robots[std::size_t(i)].map;
+    for (std::size_t t = 0; t < targets.size(); ++t) {
+      const float c = waves[k].cost(targets[t].goal);
+      // The goal must be clear on the member's own map as well: that is what it checks while driving.
+      ar.cost_m[t] = (c < WaveField::kUnreached && !blacklisted(r, targets[t], map.resolution()) &&
+                      (&own_map == &map || cell_clear(own_map, targets[t].goal, options_.traversability)))
+                         ? double(c) * map.resolution()
+                         : std::numeric_limits<double>::infinity();
+    }
+    input.robots.push_back(std::move(ar));
+  }
+  const std::vector<int> choice = strategy_->assign(input);
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    RobotState& r = robots_[std::size_t(members[k])];
+    const int t = choice[k];
+    if (t < 0) {
+      if (r.has_task) continue;
+      if (!r.given_up.empty()) {
+        r.given_up.clear();  // nothing else to do: try the given-up targets again next round
+        continue;
+      }
+      r.finished = true;
+      r.known_when_finished = robots[std::size_t(members[k])].map->observed_count();
+      continue;
+    }
+    const Target& target = targets[std::size_t(t)];
+    if (r.has_task && !r.yielding && r.goal == target.goal) continue;  // same target: keep the progress made
+    r.has_task = true;
+    r.yielding = false;
+    r.finished = false;
+    r.frontier = target.frontier;
+    r.goal = target.goal;
+    set_path(r, waves[k].path_to(target.goal), *robots[std::size_t(members[k])].map);
+    r.best_remaining = r.path.size();
+    r.steps_since_progress = 0;
+  }
+}
+
+}  // namespace fleetmap::exploration

@@ -1,0 +1,115 @@
+#pragma once
+// Frontier exploration for a team: keeps each robot's target and path, notices when a target is
+// reached, explored, blocked or hopeless, and asks the coordination strategy for new targets.
+// Robots that can talk decide together (on the map of the robot that needs a target); a robot
+// that talks to nobody decides alone on its own map.
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "exploration/frontiers.h"
+#include "exploration/strategy.h"
+#include "exploration/traversability.h"
+#include "exploration/wave.h"
+#include "mapping/occupancy_grid.h"
+
+namespace fleetmap::exploration {
+
+struct ExplorationOptions {
+  std::string strategy = "directional";
+  StrategyOptions strategy_options;
+  WaveOptions wave;
+  TargetOptions targets;
+  TraversabilityOptions traversability;
+  double sensor_range_m = 4.0;      // for the utility reduction around assigned targets
+  double reach_tolerance_m = 0.25;  // a goal closer than this is reached
+  int stall_steps = 20;             // steps without progress along the path before giving a target up
+  int path_check_cells = 30;        // path cells ahead checked each step against new obstacles
+  // A given-up target is tried again once the robot's map holds this many more observed cells, or
+  // when the robot has nothing else to do, up to `max_attempts` times in all.
+  int retry_after_new_cells = 400;
+  int max_attempts = 3;
+  // A robot that made no progress for this many steps plans a detour around the robots it knows of.
+  int detour_after_steps = 4;
+};
+
+// What the explorer sees of one robot in a round.
+struct ExplorerRobot {
+  const mapping::OccupancyGrid* map = nullptr;  // the robot's own map
+  core::Pose2 pose;                             // its estimated pose in that map's frame
+};
+
+class TeamExplorer {
+ public:
+  // Throws InputError for an unknown strategy name.
+  TeamExplorer(int robots, const ExplorationOptions& options);
+
+  // One decision round. `links[i][j]` is true when robots i and j can talk now.
+  void update(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
+
+  // The rest of robot i's path in metres (cell centres from the next one to the goal); empty when
+  // it has no target.
+  std::vector<Eigen::Vector2d> path(int i) const;
+  std::optional<Eigen::Vector2d> goal(int i) const;
+  // No reachable frontier is left for the robot (on its map); it may resume when its map grows.
+  bool finished(int i) const { return robots_[std::size_t(i)].finished; }
+  bool all_finished() const;
+
+  struct Stats {
+    int assignment_rounds = 0;
+    int waves = 0;
+    int targets_reached = 0;
+    int targets_given_up = 0;     // stalled or cut off; the counts below split them
+    int given_up_stalled = 0;
+    int given_up_unreachable = 0;
+    int unobservable = 0;  // reached, yet the frontier stayed: abandoned and told to the others
+    int paths_replanned = 0;
+    int detours = 0;
+    int yields = 0;  // finished robots that moved out of another's way
+  };
+  const Stats& stats() const { return stats_; }
+  const CoordinationStrategy& strategy() const { return *strategy_; }
+
+ private:
+  struct GivenUp {
+    Cell frontier;
+    std::int64_t known_cells = 0;  // the robot's observed-cell count when it gave up
+    int attempts = 1;
+  };
+  struct RobotState {
+    bool has_task = false;
+    bool yielding = false;  // the task is only to get out of another robot's way
+    Cell frontier, goal;
+    std::vector<Cell> path;
+    std::vector<char> was_clear;  // per path cell: clear of obstacles when the path was planned
+    std::size_t next = 0;  // first path cell not yet passed
+    std::size_t best_remaining = 0;  // fewest path cells left to the goal so far (replans included)
+    int steps_since_progress = 0;
+    bool finished = false;
+    std::int64_t known_when_finished = 0;
+    std::vector<GivenUp> given_up;
+    std::vector<GivenUp> abandoned;  // given up max_attempts times: never tried again
+    core::GridGeometry geometry;  // of the robot's map, to turn cells into metres
+  };
+
+  // false: the task was dropped.
+  bool check_task(int i, const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
+  void give_up(int i, std::int64_t known_cells);
+  void assign_group(const std::vector<int>& members, int leader, const std::vector<ExplorerRobot>& robots,
+                    const std::vector<int>& claim_holders, const std::vector<std::vector<char>>& links);
+  bool blacklisted(const RobotState& r, const Target& t, double resolution) const;
+  void set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const;
+  // Finished robots standing on the path of robot `stuck` move to the nearest place clear of it.
+  void make_way(int stuck, const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
+
+  ExplorationOptions options_;
+  std::unique_ptr<CoordinationStrategy> strategy_;
+  std::vector<RobotState> robots_;
+  WaveField wave_;  // reused storage
+  Stats stats_;
+};
+
+}  // namespace fleetmap::exploration

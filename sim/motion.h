@@ -1,0 +1,60 @@
+#pragma once
+// Differential-drive robots: a path-following controller and the motion itself, with process
+// noise, stopped by walls and by other robots.
+#include <Eigen/Core>
+#include <vector>
+
+#include "core/random.h"
+#include "core/transform2.h"
+#include "localization/localizer.h"
+#include "mapping/occupancy_grid.h"
+#include "sim/world.h"
+
+namespace fleetmap::sim {
+
+struct RobotOptions {
+  double radius_m = 0.2;
+  double max_speed_mps = 0.5;
+  double max_turn_rate_rps = 1.5707963267948966;  // 90 deg/s
+};
+
+// Additive Gaussian process noise per step, world frame (seed 000 eq. (1): 0.001 m, 0.01 deg).
+struct MotionNoise {
+  double position_m = 0.001;
+  double heading_rad = 0.00017453292519943296;
+};
+
+struct Command {
+  double v = 0.0;
+  double omega = 0.0;
+};
+
+// Pure pursuit: head for the farthest path point within `lookahead_m` that the robot's disc can
+// reach in a straight line on its own map (so it never cuts a corner into a door jamb); turn in
+// place when it is more than 60 degrees off, and slow down near the end of the path.
+Command follow_path(const core::Pose2& estimate, const std::vector<Eigen::Vector2d>& path,
+                    const mapping::OccupancyGrid& own_map, const RobotOptions& robot, double period_s, double lookahead_m);
+
+// Recovery after blocked moves: drive 0.15 m straight (forwards or backwards, whichever heads more
+// away) toward the direction of most clearance from the occupied cells of the robot's own map.
+Command escape_command(const core::Pose2& estimate, const mapping::OccupancyGrid& own_map, double period_s);
+
+struct MoveResult {
+  core::Pose2 pose;              // the new true pose
+  localization::Odometry odometry;  // the motion actually executed (what wheel encoders report)
+  bool blocked = false;          // the move was cut short by a wall or a robot
+  double distance_m = 0.0;       // path length travelled
+};
+
+// Executes `command` for one period along the exact arc, checked in small sub-steps against walls
+// and other robots' discs. A blocked arc is retried at lower forward speeds with the same turn rate,
+// down to turning in place; the odometry reports the arc actually driven. Process noise is added to
+// the end pose only where it keeps the robot clear. A robot never ends a step inside a wall or
+// overlapping another robot.
+MoveResult move_robot(const World& world, int self, const std::vector<core::Pose2>& truths, const RobotOptions& robot,
+                      const Command& command, double period_s, const MotionNoise& noise, core::Random& rng);
+
+// True when robot `self`'s disc at `p` overlaps no other robot's disc.
+bool clear_of_robots(int self, const Eigen::Vector2d& p, const std::vector<core::Pose2>& truths, double radius_m);
+
+}  // namespace fleetmap::sim

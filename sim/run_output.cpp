@@ -1,0 +1,236 @@
+#include "sim/run_output.h"
+
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "core/angle.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "mapping/map_io.h"
+#include "mapping/octomap_io.h"
+#include "mapping/render.h"
+
+namespace fleetmap::sim {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+json optional_int(const std::optional<int>& v) { return v ? json(*v) : json(nullptr); }
+// JSON has no infinity: an unlimited range is written as the string "inf".
+json range_value(double v) { return std::isinf(v) ? json("inf") : json(v); }
+
+std::string title(const RunResult& r, const std::string& map_label) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%s: %d robots, %s", map_label.c_str(), r.scenario.robot_count,
+                r.scenario.exploration.strategy.c_str());
+  return buf;
+}
+
+std::vector<Eigen::Vector2d> positions(const std::vector<core::Pose2>& poses) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(poses.size());
+  for (const auto& p : poses) out.push_back(p.position());
+  return out;
+}
+
+mapping::RenderOptions render_options(const std::string& t) {
+  mapping::RenderOptions o;
+  o.title = t;
+  return o;
+}
+
+}  // namespace
+
+json metrics_json(const RunResult& r, const std::string& map_label) {
+  const Scenario& s = r.scenario;
+  json j;
+  j["map"] = map_label;
+  j["robots"] = s.robot_count;
+  j["strategy"] = s.exploration.strategy;
+  j["localization"] = s.localization;
+  j["merging"] = s.merging;
+  j["communication_range_m"] = range_value(s.communication.range_m);
+  j["seed"] = s.seed;
+  j["step_limit"] = s.steps;
+  j["period_s"] = s.period_s;
+  j["steps"] = r.steps;
+  j["finished"] = r.finished;
+  j["coverage"] = r.coverage.empty() ? 0.0 : r.coverage.back();
+  j["steps_to_95"] = optional_int(r.steps_to_95);
+  j["steps_to_99"] = optional_int(r.steps_to_99);
+  double distance = 0.0;
+  int blocked = 0;
+  json per_robot = json::array();
+  for (std::size_t i = 0; i < r.robots.size(); ++i) {
+    const auto& t = r.robots[i];
+    distance += t.distance_m;
+    blocked += t.blocked_moves;
+    double se_pos = 0.0, se_head = 0.0;
+    for (std::size_t k = 0; k < t.truth.size(); ++k) {
+      se_pos += (t.truth[k].position() - t.estimate[k].position()).squaredNorm();
+      const double dh = core::normalize_angle(t.truth[k].theta - t.estimate[k].theta);
+      se_head += dh * dh;
+    }
+    const double n = double(std::max<std::size_t>(1, t.truth.size()));
+    json robot = {{"robot", i + 1},
+                  {"start", {t.truth.front().x, t.truth.front().y, core::rad2deg(t.truth.front().theta)}},
+                  {"distance_m", t.distance_m},
+                  {"blocked_moves", t.blocked_moves},
+                  {"position_rmse_m", std::sqrt(se_pos / n)},
+                  {"heading_rmse_deg", core::rad2deg(std::sqrt(se_head / n))}};
+    for (const auto& [name, value] : t.localizer_counters) robot["localizer"][name] = value;
+    per_robot.push_back(robot);
+  }
+  j["distance_m"] = distance;
+  j["blocked_moves"] = blocked;
+  j["redundancy"] = r.redundancy;
+  j["bytes_sent"] = r.bytes_sent;
+  j["meetings"] = r.meetings;
+  j["reachable_free_cells"] = r.reachable_free_cells;
+  j["landmarks"] = r.landmarks.size();
+  j["per_robot"] = per_robot;
+  std::map<std::string, int> event_counts;
+  for (const auto& e : r.events) ++event_counts[e.kind];
+  j["events"] = event_counts;
+  j["exploration"] = {{"assignment_rounds", r.exploration.assignment_rounds},
+                      {"waves", r.exploration.waves},
+                      {"targets_reached", r.exploration.targets_reached},
+                      {"targets_given_up", r.exploration.targets_given_up},
+                      {"given_up_stalled", r.exploration.given_up_stalled},
+                      {"given_up_unreachable", r.exploration.given_up_unreachable},
+                      {"unobservable_frontiers", r.exploration.unobservable},
+                      {"paths_replanned", r.exploration.paths_replanned},
+                      {"detours", r.exploration.detours},
+                      {"yields", r.exploration.yields}};
+  j["coverage_curve"] = r.coverage;
+  const auto& tm = r.timing;
+  j["timing"] = {{"total_s", tm.total},           {"motion_s", tm.motion},
+                 {"sensing_s", tm.sensing},       {"localization_s", tm.localization},
+                 {"mapping_s", tm.mapping},       {"communication_s", tm.communication},
+                 {"exploration_s", tm.exploration}, {"metrics_s", tm.metrics},
+                 {"per_step_ms", r.steps > 0 ? 1000.0 * tm.total / r.steps : 0.0}};
+  return j;
+}
+
+cv::Mat render_merged(const RunResult& r, const std::string& map_label) {
+  mapping::Overlays o;
+  const bool show_estimates = r.scenario.localization != "ideal";
+  for (std::size_t i = 0; i < r.robots.size(); ++i) {
+    const auto colour = mapping::palette_color(int(i));
+    const auto& t = r.robots[i];
+    const std::string name = "robot " + std::to_string(i + 1);
+    o.paths.push_back({positions(t.truth), colour, name + (show_estimates ? " (true)" : ""), 2, false});
+    if (show_estimates) o.paths.push_back({positions(t.estimate), colour, name + " (estimate)", 1, true});
+    o.poses.push_back({t.truth.back(), r.scenario.robot.radius_m, colour, ""});
+  }
+  if (!r.landmarks.empty()) o.points.push_back({r.landmarks, {200, 0, 200}, "landmarks", 3});
+  char buf[128];
+  std::snprintf(buf, sizeof buf, ", %d steps, %.1f%%", r.steps, 100.0 * (r.coverage.empty() ? 0.0 : r.coverage.back()));
+  return mapping::render_map(r.merged, o, render_options(title(r, map_label) + buf));
+}
+
+cv::Mat render_robot(const RunResult& r, int robot, const std::string& map_label) {
+  const auto& t = r.robots[std::size_t(robot)];
+  const auto colour = mapping::palette_color(robot);
+  mapping::Overlays o;
+  o.paths.push_back({positions(t.estimate), colour, "trajectory (estimate)", 2, false});
+  o.poses.push_back({t.estimate.back(), r.scenario.robot.radius_m, colour, "robot " + std::to_string(robot + 1)});
+  return mapping::render_map(r.robot_maps[std::size_t(robot)], o,
+                             render_options(map_label + ": robot " + std::to_string(robot + 1) + "'s map"));
+}
+
+std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& map_label, const fs::path& dir) {
+  core::ensure_directory(dir);
+  std::vector<fs::path> written;
+  const auto add = [&](const fs::path& p) { written.push_back(p); };
+  mapping::write_image(dir / "merged.png", render_merged(r, map_label));
+  add(dir / "merged.png");
+  for (std::size_t i = 0; i < r.robot_maps.size(); ++i) {
+    const fs::path p = dir / ("robot_" + std::to_string(i + 1) + ".png");
+    mapping::write_image(p, render_robot(r, int(i), map_label));
+    add(p);
+  }
+  core::write_file_atomic(dir / "metrics.json", metrics_json(r, map_label).dump(2) + "\n");
+  add(dir / "metrics.json");
+  mapping::save_map_yaml(r.merged, dir / "map.yaml");
+  add(dir / "map.pgm");
+  add(dir / "map.yaml");
+  mapping::save_octomap(r.merged, dir / "map.bt");
+  add(dir / "map.bt");
+  core::write_file_atomic(dir / "scenario.yaml", scenario_to_yaml(r.scenario));
+  add(dir / "scenario.yaml");
+  return written;
+}
+
+struct RunVideo::Impl {
+  fs::path path, tmp;
+  double fps = 12.0;
+  cv::VideoWriter writer;
+  cv::Size size;
+  int frames = 0;
+};
+
+RunVideo::RunVideo(fs::path path, double fps) : impl_(std::make_unique<Impl>()) {
+  impl_->path = std::move(path);
+  impl_->tmp = impl_->path;
+  impl_->tmp.replace_extension(".partial" + impl_->path.extension().string());
+  impl_->fps = fps;
+}
+
+RunVideo::~RunVideo() {
+  if (impl_ && impl_->writer.isOpened()) {
+    impl_->writer.release();
+    std::error_code ec;
+    fs::remove(impl_->tmp, ec);
+  }
+}
+
+void RunVideo::add_frame(const Simulation& sim, const std::string& map_label) {
+  mapping::Overlays o;
+  const auto estimates = sim.estimated_poses();
+  for (int i = 0; i < sim.scenario().robot_count; ++i) {
+    const auto colour = mapping::palette_color(i);
+    o.paths.push_back({positions(sim.track(i).truth), colour, "robot " + std::to_string(i + 1), 2, false});
+    auto plan = sim.path(i);
+    if (!plan.empty()) {
+      plan.insert(plan.begin(), estimates[std::size_t(i)].position());
+      o.paths.push_back({plan, colour, "", 1, true});
+    }
+    o.poses.push_back({sim.true_poses()[std::size_t(i)], sim.scenario().robot.radius_m, colour, ""});
+  }
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s: step %d, %.1f%%", map_label.c_str(), sim.step_count(), 100.0 * sim.coverage());
+  mapping::RenderOptions ro;
+  ro.title = buf;
+  ro.max_size_px = 1600;
+  cv::Mat frame = mapping::render_map(sim.merged_map(), o, ro);
+  if (!impl_->writer.isOpened()) {
+    // Even dimensions keep every codec happy.
+    impl_->size = cv::Size(frame.cols + (frame.cols % 2), frame.rows + (frame.rows % 2));
+    core::ensure_directory(impl_->path.parent_path());
+    if (!impl_->writer.open(impl_->tmp.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), impl_->fps, impl_->size)) {
+      throw Error(impl_->path.string() + ": cannot open a video writer (OpenCV without an MP4 encoder?)");
+    }
+  }
+  cv::Mat padded(impl_->size, CV_8UC3, cv::Scalar(255, 255, 255));
+  frame(cv::Rect(0, 0, std::min(frame.cols, impl_->size.width), std::min(frame.rows, impl_->size.height)))
+      .copyTo(padded(cv::Rect(0, 0, std::min(frame.cols, impl_->size.width), std::min(frame.rows, impl_->size.height))));
+  impl_->writer.write(padded);
+  ++impl_->frames;
+}
+
+void RunVideo::finish() {
+  if (!impl_->writer.isOpened() || impl_->frames == 0) throw Error(impl_->path.string() + ": no frames to write");
+  impl_->writer.release();
+  std::error_code ec;
+  fs::rename(impl_->tmp, impl_->path, ec);
+  if (ec) throw Error(impl_->path.string() + ": cannot move the video into place (" + ec.message() + ")");
+}
+
+}  // namespace fleetmap::sim

@@ -1,0 +1,44 @@
+#pragma once
+// What a run leaves behind: pictures, metrics.json, the merged map as map_server and OctoMap
+// files, and optionally a video. Every file is written to a temporary name and renamed.
+#include <nlohmann/json.hpp>
+#include <opencv2/core/mat.hpp>
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/simulation.h"
+
+namespace fleetmap::sim {
+
+// Every number of a run; all but "timing" are identical for two runs with the same inputs.
+nlohmann::json metrics_json(const RunResult& result, const std::string& map_label);
+
+// The merged map with every robot's true trajectory (solid), estimated trajectory (dashed, when
+// the localization is not ideal), final pose and landmarks; legend and scale bar.
+cv::Mat render_merged(const RunResult& result, const std::string& map_label);
+// Robot i's own map with its trajectory.
+cv::Mat render_robot(const RunResult& result, int robot, const std::string& map_label);
+
+// Writes merged.png, robot_<k>.png (k from 1), metrics.json, map.pgm + map.yaml, map.bt and
+// scenario.yaml into `dir`. Returns the files written.
+std::vector<std::filesystem::path> write_run_outputs(const RunResult& result, const std::string& map_label,
+                                                     const std::filesystem::path& dir);
+
+// An MP4 of a run, a frame per step (the merged map, robots, their paths and goals).
+class RunVideo {
+ public:
+  RunVideo(std::filesystem::path path, double fps = 12.0);
+  ~RunVideo();
+  void add_frame(const Simulation& sim, const std::string& map_label);
+  // Closes the video and moves it into place. Throws fleetmap::Error when nothing could be written.
+  void finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace fleetmap::sim

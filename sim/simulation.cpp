@@ -1,0 +1,382 @@
+#include "sim/simulation.h"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "core/error.h"
+#include "sim/motion.h"
+#include "sim/sensors.h"
+
+namespace fleetmap::sim {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+std::string point_text(const Eigen::Vector2d& p) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "(%.2f, %.2f)", p.x(), p.y());
+  return buf;
+}
+
+std::string extent_text(const core::GridGeometry& g) {
+  const Eigen::Vector2d lo = g.grid_to_world({0, 0}), hi = g.grid_to_world({double(g.width()), double(g.height())});
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "the map spans x %.2f..%.2f m, y %.2f..%.2f m", std::min(lo.x(), hi.x()),
+                std::max(lo.x(), hi.x()), std::min(lo.y(), hi.y()), std::max(lo.y(), hi.y()));
+  return buf;
+}
+
+// Free cells in order of 4-connected BFS distance from the free cell nearest to `centre`.
+std::vector<Cell> free_cells_from(const World& world, const Eigen::Vector2d& centre, std::size_t enough) {
+  const auto& g = world.geometry();
+  const int w = g.width(), h = g.height();
+  Cell start = g.world_to_cell_unbounded(centre);
+  start.x = std::clamp(start.x, 0, w - 1);
+  start.y = std::clamp(start.y, 0, h - 1);
+  std::vector<std::uint8_t> seen(std::size_t(w) * std::size_t(h), 0);
+  std::vector<Cell> queue = {start}, out;
+  seen[std::size_t(g.index(start))] = 1;
+  // Through any cell until the first free one, then through free cells only.
+  bool in_free = false;
+  for (std::size_t head = 0; head < queue.size() && out.size() < enough; ++head) {
+    const Cell c = queue[head];
+    const bool free = !world.blocked(c);
+    if (free && !in_free) {
+      in_free = true;
+      queue.erase(queue.begin() + std::ptrdiff_t(head) + 1, queue.end());
+      std::fill(seen.begin(), seen.end(), 0);
+      seen[std::size_t(g.index(c))] = 1;
+    }
+    if (in_free && !free) continue;
+    if (free) out.push_back(c);
+    const Cell n[4] = {{c.x + 1, c.y}, {c.x - 1, c.y}, {c.x, c.y + 1}, {c.x, c.y - 1}};
+    for (const Cell& m : n) {
+      if (!g.contains(m) || seen[std::size_t(g.index(m))]) continue;
+      seen[std::size_t(g.index(m))] = 1;
+      queue.push_back(m);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<core::Pose2> place_robots(const Scenario& s, const World& world, core::Random& rng) {
+  const double r = s.robot.radius_m;
+  const auto& g = world.geometry();
+  if (s.placement == Placement::List) {
+    for (std::size_t i = 0; i < s.starts.size(); ++i) {
+      const Eigen::Vector2d p = s.starts[i].position();
+      const std::string who = "robot " + std::to_string(i + 1) + " starts at " + point_text(p);
+      const auto cell = g.world_to_cell(p);
+      if (!cell) throw InputError(who + ", outside the map (" + extent_text(g) + ")");
+      if (world.blocked(*cell)) throw InputError(who + ", inside a wall");
+      const double clearance = world.clearance(p, r);
+      if (clearance <= r) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, ", too close to a wall (clearance %.2f m, radius %.2f m)", clearance, r);
+        throw InputError(who + buf);
+      }
+      for (std::size_t j = 0; j < i; ++j) {
+        if ((s.starts[j].position() - p).norm() < 2.0 * r) {
+          throw InputError(who + ", on robot " + std::to_string(j + 1) + " (centres closer than two radii, " +
+                           std::to_string(2.0 * r).substr(0, 4) + " m)");
+        }
+      }
+    }
+    return s.starts;
+  }
+
+  Eigen::Vector2d centre = g.grid_to_world({0.5 * g.width(), 0.5 * g.height()});
+  if (s.cluster_at) {
+    centre = *s.cluster_at;
+    const auto cell = g.world_to_cell(centre);
+    if (!cell) throw InputError("robots.cluster_at " + point_text(centre) + " is outside the map (" + extent_text(g) + ")");
+    if (world.blocked(*cell)) throw InputError("robots.cluster_at " + point_text(centre) + " is inside a wall");
+  }
+  const double separation = std::max(s.min_separation_m, 2.0 * r + 0.05);
+  const double need = r + 0.05;
+  std::vector<Cell> candidates;
+  if (s.placement == Placement::Cluster) {
+    candidates = free_cells_from(world, centre, std::size_t(-1) / 2);
+  } else {
+    candidates = free_cells_from(world, centre, std::size_t(-1) / 2);
+    std::shuffle(candidates.begin(), candidates.end(), rng.engine());
+  }
+  std::vector<core::Pose2> starts;
+  for (const Cell& c : candidates) {
+    if (int(starts.size()) == s.robot_count) break;
+    const Eigen::Vector2d p = g.cell_center(c);
+    if (world.clearance(p, need) < need) continue;
+    const bool apart = std::all_of(starts.begin(), starts.end(), [&](const core::Pose2& q) {
+      return (q.position() - p).norm() >= separation;
+    });
+    if (!apart) continue;
+    const double heading = s.placement == Placement::Random ? rng.uniform(-M_PI, M_PI) : 0.0;
+    starts.emplace_back(p.x(), p.y(), heading);
+  }
+  if (int(starts.size()) < s.robot_count) {
+    throw InputError("robots: only " + std::to_string(starts.size()) + " of " + std::to_string(s.robot_count) +
+                     " robots fit in the free space around " + point_text(centre) + " (radius " + std::to_string(r).substr(0, 4) +
+                     " m, separation " + std::to_string(separation).substr(0, 4) + " m)");
+  }
+  return starts;
+}
+
+namespace {
+
+World make_world(const Scenario& s, mapping::OccupancyGrid truth) {
+  core::Random rng = core::Random(s.seed).fork(2);
+  std::vector<Eigen::Vector2d> landmarks;
+  for (std::size_t i = 0; i < s.landmarks.size(); ++i) {
+    const auto cell = truth.geometry().world_to_cell(s.landmarks[i]);
+    const std::string who = "landmarks.points[" + std::to_string(i) + "] " + point_text(s.landmarks[i]);
+    if (!cell) throw InputError(who + " is outside the map (" + extent_text(truth.geometry()) + ")");
+    if (truth.state(*cell) != mapping::CellState::Free) throw InputError(who + " is inside a wall, where no sensor could see it");
+    landmarks.push_back(s.landmarks[i]);
+  }
+  for (const auto& p : landmarks_along_walls(truth, s.landmarks_along_walls, rng)) landmarks.push_back(p);
+  return World(std::move(truth), std::move(landmarks));
+}
+
+}  // namespace
+
+Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
+    : scenario_(scenario),
+      world_(make_world(scenario, std::move(truth))),
+      rng_(scenario.seed),
+      merged_(world_.geometry()),
+      exchange_(scenario.robot_count, world_.geometry()),
+      explorer_(scenario.robot_count, scenario.exploration) {
+  validate_scenario(scenario_);
+  core::Random placement_rng = rng_.fork(1);
+  truths_ = place_robots(scenario_, world_, placement_rng);
+  scenario_.starts = truths_;
+  scenario_.robot_count = int(truths_.size());
+  const int n = scenario_.robot_count;
+  if (n > 64) throw InputError("robots: at most 64 robots");
+
+  localization::LocalizerContext context;
+  context.options = scenario_.localization_options;
+  context.options.process_noise_xy = scenario_.noise.position_m;
+  context.options.process_noise_theta = scenario_.noise.heading_rad;
+  context.options.range_noise = scenario_.landmark_sensor.range_noise_m;
+  context.options.bearing_noise = scenario_.landmark_sensor.bearing_noise_rad;
+  context.options.known_associations = scenario_.landmark_sensor.report_ids && scenario_.localization_options.known_associations;
+  for (std::size_t k = 0; k < world_.landmarks().size(); ++k) context.known_landmarks.push_back({int(k), world_.landmarks()[k]});
+  for (int i = 0; i < n; ++i) {
+    motion_rng_.push_back(rng_.fork(100 + std::uint64_t(i)));
+    sensor_rng_.push_back(rng_.fork(200 + std::uint64_t(i)));
+    context.initial_pose = truths_[std::size_t(i)];
+    context.seed = rng_.fork(300 + std::uint64_t(i)).seed();
+    localizers_.push_back(localization::make_localizer(scenario_.localization, context));
+    maps_.emplace_back(world_.geometry());
+  }
+  tracks_.resize(std::size_t(n));
+  was_finished_.assign(std::size_t(n), 0);
+  blocked_streak_.assign(std::size_t(n), 0);
+  std::vector<Eigen::Vector2d> start_points;
+  for (const auto& p : truths_) start_points.push_back(p.position());
+  reachable_ = world_.reachable_free_cells(start_points);
+  sensed_by_.assign(std::size_t(world_.geometry().cell_count()), 0);
+  previous_links_.assign(std::size_t(n), std::vector<char>(std::size_t(n), 0));
+
+  const auto t0 = Clock::now();
+  for (int i = 0; i < n; ++i) localizers_[std::size_t(i)]->observe_truth(truths_[std::size_t(i)]);
+  sense_and_map();
+  communicate();
+  decide();
+  measure();
+  timing_.total += seconds_since(t0);
+}
+
+Simulation::~Simulation() = default;
+
+std::vector<core::Pose2> Simulation::estimated_poses() const {
+  std::vector<core::Pose2> out;
+  for (const auto& l : localizers_) out.push_back(l->pose());
+  return out;
+}
+
+bool Simulation::done() const { return step_ >= scenario_.steps || explorer_.all_finished(); }
+
+void Simulation::sense_and_map() {
+  const int n = scenario_.robot_count;
+  auto t0 = Clock::now();
+  std::vector<localization::RangeScan> scans(static_cast<std::size_t>(n));
+  std::vector<std::vector<localization::LandmarkObservation>> landmark_obs(static_cast<std::size_t>(n));
+  detections_.assign(std::size_t(n), {});
+  for (int i = 0; i < n; ++i) {
+    auto& rng = sensor_rng_[std::size_t(i)];
+    scans[std::size_t(i)] = read_ranges(world_, truths_[std::size_t(i)], scenario_.range, rng);
+    if (!world_.landmarks().empty()) {
+      landmark_obs[std::size_t(i)] = read_landmarks(world_, truths_[std::size_t(i)], scenario_.landmark_sensor, rng);
+    }
+    detections_[std::size_t(i)] = detect_robots(world_, i, truths_, scenario_.detector, rng);
+  }
+  timing_.sensing += seconds_since(t0);
+
+  t0 = Clock::now();
+  for (int i = 0; i < n; ++i) {
+    auto& loc = *localizers_[std::size_t(i)];
+    loc.observe_truth(truths_[std::size_t(i)]);
+    if (!landmark_obs[std::size_t(i)].empty()) loc.update_landmarks(landmark_obs[std::size_t(i)]);
+    loc.update_scan(scans[std::size_t(i)], maps_[std::size_t(i)]);
+    if (scenario_.localization_options.use_robot_detections) {
+      for (const auto& d : detections_[std::size_t(i)]) {
+        const auto& other = *localizers_[std::size_t(d.other)];
+        loc.update_robot({d.other, d.range, d.bearing, other.pose(), other.covariance()});
+      }
+    }
+  }
+  timing_.localization += seconds_since(t0);
+
+  t0 = Clock::now();
+  for (int i = 0; i < n; ++i) {
+    const core::Pose2 est = localizers_[std::size_t(i)]->pose();
+    const auto& scan = scans[std::size_t(i)];
+    const std::uint64_t bit = std::uint64_t{1} << i;
+    auto& own = maps_[std::size_t(i)];
+    for (std::size_t b = 0; b < scan.angles.size(); ++b) {
+      const double a = est.theta + scan.angles[b];
+      const double range = scan.ranges[b].value_or(scan.max_range);
+      const Eigen::Vector2d end = est.position() + range * Eigen::Vector2d(std::cos(a), std::sin(a));
+      const bool hit = scan.ranges[b].has_value();
+      own.integrate_ray(est.position(), end, hit, [&](int cell, bool changed) {
+        if (changed) exchange_.touched(i, cell);
+        sensed_by_[std::size_t(cell)] |= bit;
+      });
+      merged_.integrate_ray(est.position(), end, hit);
+    }
+  }
+  timing_.mapping += seconds_since(t0);
+}
+
+void Simulation::communicate() {
+  const auto t0 = Clock::now();
+  const int n = scenario_.robot_count;
+  links_ = communication_links(world_, truths_, detections_, scenario_.communication);
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      if (!links_[std::size_t(i)][std::size_t(j)]) continue;
+      const std::int64_t bytes = exchange_.exchange(i, j, maps_);
+      bytes_sent_ += bytes;
+      if (!previous_links_[std::size_t(i)][std::size_t(j)]) {
+        ++meetings_;
+        events_.push_back({step_, "meeting", i, j, std::to_string(bytes) + " bytes exchanged"});
+      }
+    }
+  }
+  previous_links_ = links_;
+  timing_.communication += seconds_since(t0);
+}
+
+void Simulation::decide() {
+  const auto t0 = Clock::now();
+  std::vector<exploration::ExplorerRobot> views;
+  for (int i = 0; i < scenario_.robot_count; ++i) views.push_back({&maps_[std::size_t(i)], localizers_[std::size_t(i)]->pose()});
+  explorer_.update(views, links_);
+  for (int i = 0; i < scenario_.robot_count; ++i) {
+    const bool f = explorer_.finished(i);
+    if (f && !was_finished_[std::size_t(i)]) events_.push_back({step_, "finished", i, -1, "no reachable frontier left"});
+    was_finished_[std::size_t(i)] = f;
+  }
+  timing_.exploration += seconds_since(t0);
+}
+
+void Simulation::measure() {
+  const auto t0 = Clock::now();
+  std::int64_t known = 0;
+  for (int idx : reachable_) known += merged_.log_odds_at(idx) != 0.0f;
+  coverage_.push_back(reachable_.empty() ? 1.0 : double(known) / double(reachable_.size()));
+  for (int i = 0; i < scenario_.robot_count; ++i) {
+    auto& t = tracks_[std::size_t(i)];
+    t.truth.push_back(truths_[std::size_t(i)]);
+    t.estimate.push_back(localizers_[std::size_t(i)]->pose());
+    t.covariance.push_back(localizers_[std::size_t(i)]->covariance());
+  }
+  timing_.metrics += seconds_since(t0);
+}
+
+void Simulation::step() {
+  if (done()) return;
+  const auto t_step = Clock::now();
+  ++step_;
+  const auto t0 = Clock::now();
+  for (int i = 0; i < scenario_.robot_count; ++i) {
+    const auto path = explorer_.path(i);
+    auto& loc = *localizers_[std::size_t(i)];
+    // Two blocked moves in a row: back away from the obstacle before following the path again.
+    int& streak = blocked_streak_[std::size_t(i)];
+    const Command cmd = streak >= 2 ? escape_command(loc.pose(), maps_[std::size_t(i)], scenario_.period_s)
+                                    : follow_path(loc.pose(), path, maps_[std::size_t(i)], scenario_.robot,
+                                                  scenario_.period_s, scenario_.lookahead_m);
+    const MoveResult mv = move_robot(world_, i, truths_, scenario_.robot, cmd, scenario_.period_s, scenario_.noise,
+                                     motion_rng_[std::size_t(i)]);
+    truths_[std::size_t(i)] = mv.pose;
+    auto& t = tracks_[std::size_t(i)];
+    t.distance_m += mv.distance_m;
+    streak = mv.blocked ? streak + 1 : (streak >= 2 ? 0 : streak);
+    if (streak > 3) streak = 0;  // the escape did not help either: follow the path again
+    if (mv.blocked) {
+      ++t.blocked_moves;
+      events_.push_back({step_, "blocked", i, -1, "move stopped by a wall or a robot"});
+    }
+    loc.predict(mv.odometry);
+  }
+  timing_.motion += seconds_since(t0);
+  sense_and_map();
+  communicate();
+  decide();
+  measure();
+  timing_.total += seconds_since(t_step);
+}
+
+RunResult Simulation::run(const ProgressCallback& progress, const std::function<void(const Simulation&)>& on_step) {
+  if (on_step) on_step(*this);
+  while (!done()) {
+    step();
+    if (progress) progress(step_, scenario_.steps, coverage());
+    if (on_step) on_step(*this);
+  }
+  return result();
+}
+
+RunResult Simulation::result() const {
+  RunResult r;
+  r.scenario = scenario_;
+  r.steps = step_;
+  r.finished = explorer_.all_finished();
+  r.coverage = coverage_;
+  for (std::size_t k = 0; k < coverage_.size(); ++k) {
+    if (!r.steps_to_95 && coverage_[k] >= 0.95) r.steps_to_95 = int(k);
+    if (!r.steps_to_99 && coverage_[k] >= 0.99) r.steps_to_99 = int(k);
+  }
+  std::int64_t sensed = 0, shared = 0;
+  for (int idx : reachable_) {
+    const int robots = std::popcount(sensed_by_[std::size_t(idx)]);
+    sensed += robots > 0;
+    shared += robots > 1;
+  }
+  r.redundancy = sensed ? double(shared) / double(sensed) : 0.0;
+  r.bytes_sent = bytes_sent_;
+  r.meetings = meetings_;
+  r.reachable_free_cells = std::int64_t(reachable_.size());
+  r.robots = tracks_;
+  for (std::size_t i = 0; i < r.robots.size(); ++i) r.robots[i].localizer_counters = localizers_[i]->counters();
+  r.events = events_;
+  r.landmarks = world_.landmarks();
+  r.merged = merged_;
+  r.robot_maps = maps_;
+  r.exploration = explorer_.stats();
+  r.timing = timing_;
+  return r;
+}
+
+}  // namespace fleetmap::sim

@@ -1,0 +1,126 @@
+#pragma once
+// The step loop (DESIGN.md §3): move, sense, localise, map, talk, decide, measure.
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/random.h"
+#include "exploration/team_explorer.h"
+#include "localization/localizer.h"
+#include "mapping/occupancy_grid.h"
+#include "sim/communication.h"
+#include "sim/scenario.h"
+#include "sim/world.h"
+
+namespace fleetmap::sim {
+
+struct Event {
+  int step = 0;
+  std::string kind;  // "meeting", "blocked", "finished"
+  int robot = -1;
+  int other = -1;
+  std::string detail;
+};
+
+struct RobotTrack {
+  std::vector<core::Pose2> truth;     // one pose per step, from step 0
+  std::vector<core::Pose2> estimate;
+  std::vector<Eigen::Matrix3d> covariance;
+  double distance_m = 0.0;
+  int blocked_moves = 0;
+  std::vector<std::pair<std::string, double>> localizer_counters;
+};
+
+struct Timings {  // seconds
+  double total = 0, motion = 0, sensing = 0, localization = 0, mapping = 0, communication = 0, exploration = 0,
+         metrics = 0;
+};
+
+struct RunResult {
+  Scenario scenario;                 // as run: starts resolved, landmarks placed
+  int steps = 0;                     // steps taken
+  bool finished = false;             // every robot ran out of reachable frontiers before the limit
+  // coverage[k] after step k (k = 0: the first scan, before moving): the share of the reachable free
+  // cells of the ground truth that the merged map has observed.
+  std::vector<double> coverage;
+  std::optional<int> steps_to_95, steps_to_99;
+  double redundancy = 0.0;           // of the reachable free cells sensed, the share sensed by 2+ robots
+  std::int64_t bytes_sent = 0;
+  int meetings = 0;
+  std::int64_t reachable_free_cells = 0;
+  std::vector<RobotTrack> robots;
+  std::vector<Event> events;
+  std::vector<Eigen::Vector2d> landmarks;
+  mapping::OccupancyGrid merged;     // every robot's readings at its estimated pose
+  std::vector<mapping::OccupancyGrid> robot_maps;
+  exploration::TeamExplorer::Stats exploration;
+  Timings timing;
+};
+
+// Called after every step with (step, step limit, coverage).
+using ProgressCallback = std::function<void(int, int, double)>;
+
+class Simulation {
+ public:
+  // Places the robots and takes the first readings. Throws InputError for starts in a wall,
+  // outside the map, on another robot, or when the robots cannot all be placed.
+  Simulation(const Scenario& scenario, mapping::OccupancyGrid truth);
+  ~Simulation();
+
+  bool done() const;
+  void step();
+  // Runs to the end; `progress` and `on_step` (for pictures) may be empty.
+  RunResult run(const ProgressCallback& progress = {}, const std::function<void(const Simulation&)>& on_step = {});
+
+  int step_count() const { return step_; }
+  const World& world() const { return world_; }
+  const Scenario& scenario() const { return scenario_; }
+  const mapping::OccupancyGrid& merged_map() const { return merged_; }
+  const mapping::OccupancyGrid& robot_map(int i) const { return maps_[std::size_t(i)]; }
+  const std::vector<core::Pose2>& true_poses() const { return truths_; }
+  std::vector<core::Pose2> estimated_poses() const;
+  const RobotTrack& track(int i) const { return tracks_[std::size_t(i)]; }
+  std::vector<Eigen::Vector2d> path(int i) const { return explorer_.path(i); }
+  double coverage() const { return coverage_.empty() ? 0.0 : coverage_.back(); }
+
+  RunResult result() const;
+
+ private:
+  void sense_and_map();
+  void communicate();
+  void decide();
+  void measure();
+
+  Scenario scenario_;
+  World world_;
+  core::Random rng_;
+  std::vector<core::Random> motion_rng_, sensor_rng_;
+  std::vector<core::Pose2> truths_;
+  std::vector<std::unique_ptr<localization::Localizer>> localizers_;
+  std::vector<mapping::OccupancyGrid> maps_;
+  mapping::OccupancyGrid merged_;
+  MapExchange exchange_;
+  exploration::TeamExplorer explorer_;
+  std::vector<std::vector<Detection>> detections_;
+  std::vector<std::vector<char>> links_, previous_links_;
+  std::vector<int> reachable_;        // indices of the reachable free cells of the truth
+  std::vector<std::uint64_t> sensed_by_;  // per cell, a bit per robot
+  std::vector<double> coverage_;
+  std::vector<RobotTrack> tracks_;
+  std::vector<Event> events_;
+  std::vector<char> was_finished_;
+  std::vector<int> blocked_streak_;  // consecutive blocked moves per robot
+  std::int64_t bytes_sent_ = 0;
+  int meetings_ = 0;
+  int step_ = 0;
+  Timings timing_;
+};
+
+// Robot start poses for a scenario on a map (also used to check a scenario before a run).
+std::vector<core::Pose2> place_robots(const Scenario& scenario, const World& world, core::Random& rng);
+
+}  // namespace fleetmap::sim
