@@ -69,6 +69,8 @@ struct PlannerOptions {
   // Wall-clock budget of the whole call. Optimising planners (RRT*, PRM*, BIT*) use all of it;
   // the others stop at their first path. 10% is kept for OMPL's path simplification.
   double time_budget_s = 1.0;
+  // OMPL planners reseed OMPL's process-wide generator with it at each call: reproducible for one
+  // caller at a time (RRT-Connect exactly; the anytime planners up to how far their budget gets).
   std::uint64_t seed = 1;
   // OMPL: shortcutting and smoothing of the solution; astar: any-angle smoothing of the grid path;
   // reactive: merging collinear steps.
