@@ -56,7 +56,8 @@ std::string resolve_map(const sim::Scenario& s) {
 }
 
 int run_explore(const ExploreFlags& f) {
-  sim::Scenario s = f.scenario.empty() ? sim::Scenario{} : sim::load_scenario(f.scenario);
+  sim::Scenario s;
+  if (!f.scenario.empty()) s = sim::load_scenario(f.scenario);
   if (f.map) s.map = *f.map, s.base_dir.clear();
   if (f.robots) {
     s.robot_count = *f.robots;
@@ -102,9 +103,12 @@ int run_explore(const ExploreFlags& f) {
   double distance = 0.0;
   for (const auto& t : result.robots) distance += t.distance_m;
   const auto step_text = [](const std::optional<int>& v) { return v ? std::to_string(*v) : std::string("not reached"); };
-  std::printf("%s: %d robots, strategy %s, localization %s, communication range %s m, seed %llu\n", label.c_str(),
-              sc.robot_count, sc.exploration.strategy.c_str(), sc.localization.c_str(),
-              std::isinf(sc.communication.range_m) ? "inf" : std::to_string(sc.communication.range_m).c_str(),
+  char range[64];
+  if (std::isinf(sc.communication.range_m)) std::snprintf(range, sizeof range, "unlimited");
+  else if (sc.communication.range_m == 0.0) std::snprintf(range, sizeof range, "only at rendezvous");
+  else std::snprintf(range, sizeof range, "%g m", sc.communication.range_m);
+  std::printf("%s: %d robots, strategy %s, localization %s, communication %s, seed %llu\n", label.c_str(),
+              sc.robot_count, sc.exploration.strategy.c_str(), sc.localization.c_str(), range,
               static_cast<unsigned long long>(sc.seed));
   std::printf("explored %s of the reachable free space in %d steps (%s); 95%% at step %s, 99%% at step %s\n",
               format_percent(result.coverage.back()).c_str(), result.steps,

@@ -1,6 +1,7 @@
 #include "core/yaml_reader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include "core/error.h"
@@ -62,6 +63,11 @@ double YamlMap::number(const std::string& key, double fallback, double lo, doubl
                             (std::isfinite(lo) && std::isfinite(hi) ? " and" : "") +
                             (std::isfinite(hi) ? " <= " + YAML::Node(hi).Scalar() : std::string());
   const std::string expected = "expected a number" + range + (allow_inf ? " (or inf)" : "");
+  if (allow_inf && n->IsScalar()) {
+    std::string t = n->Scalar();
+    for (char& ch : t) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (t == "inf" || t == "infinity" || t == "+inf") return std::numeric_limits<double>::infinity();
+  }
   if (!n->IsScalar() || !YAML::convert<double>::decode(*n, v) || std::isnan(v) || (std::isinf(v) && !allow_inf)) {
     throw InputError(where(key) + ": " + expected + ", got " + describe_node(*n));
   }

@@ -4,25 +4,69 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <opencv2/imgproc.hpp>
 
 namespace fleetmap::exploration {
 
 using mapping::CellState;
 
-bool is_frontier(const mapping::OccupancyGrid& map, const Cell& c) {
-  if (!map.contains(c) || map.state(c) != CellState::Free) return false;
-  const Cell n[4] = {{c.x + 1, c.y}, {c.x - 1, c.y}, {c.x, c.y + 1}, {c.x, c.y - 1}};
-  for (const Cell& m : n) {
-    if (map.contains(m) && !map.observed(m)) return true;
+FrontierMask::FrontierMask(const mapping::OccupancyGrid& map, const FrontierOptions& options)
+    : FrontierMask(map, options, {0, 0}, {map.width(), map.height()}) {}
+
+FrontierMask::FrontierMask(const mapping::OccupancyGrid& map, const FrontierOptions& options, const Cell& lo,
+                           const Cell& hi)
+    : lo_{std::max(0, lo.x), std::max(0, lo.y)}, hi_{std::min(map.width(), hi.x), std::min(map.height(), hi.y)} {
+  if (hi_.x <= lo_.x || hi_.y <= lo_.y) {
+    hi_ = lo_;
+    return;
   }
-  return false;
+  // The widest odd square not wider than min_unknown_width_m: 2k + 1 cells.
+  const int k = std::max(0, (int(std::floor(options.min_unknown_width_m / map.resolution() + 1e-9)) - 1) / 2);
+  // The opening's result k cells from the padded window's edge can differ from the whole map's;
+  // padding by 2k + 1 (the +1 for the neighbour test) keeps the window exact.
+  const int pad = 2 * k + 1;
+  const Cell plo{std::max(0, lo_.x - pad), std::max(0, lo_.y - pad)};
+  const Cell phi{std::min(map.width(), hi_.x + pad), std::min(map.height(), hi_.y + pad)};
+  cv::Mat unknown(phi.y - plo.y, phi.x - plo.x, CV_8UC1);
+  for (int y = plo.y; y < phi.y; ++y) {
+    auto* row = unknown.ptr<std::uint8_t>(y - plo.y);
+    for (int x = plo.x; x < phi.x; ++x) row[x - plo.x] = map.observed({x, y}) ? 0 : 255;
+  }
+  if (k > 0) {
+    // A border of 0: beyond the map there is nothing to explore; inside it, the padding makes the
+    // window's border harmless.
+    const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * k + 1, 2 * k + 1));
+    cv::morphologyEx(unknown, unknown, cv::MORPH_OPEN, kernel, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  }
+  const int w = hi_.x - lo_.x;
+  frontier_.assign(std::size_t(w) * std::size_t(hi_.y - lo_.y), 0);
+  const auto wide_unknown = [&](int x, int y) {
+    return x >= plo.x && y >= plo.y && x < phi.x && y < phi.y && unknown.at<std::uint8_t>(y - plo.y, x - plo.x) != 0;
+  };
+  for (int y = lo_.y; y < hi_.y; ++y) {
+    for (int x = lo_.x; x < hi_.x; ++x) {
+      if (map.state({x, y}) != CellState::Free) continue;
+      frontier_[std::size_t((y - lo_.y) * w + (x - lo_.x))] =
+          wide_unknown(x + 1, y) || wide_unknown(x - 1, y) || wide_unknown(x, y + 1) || wide_unknown(x, y - 1);
+    }
+  }
+}
+
+bool FrontierMask::operator()(const Cell& c) const {
+  if (c.x < lo_.x || c.y < lo_.y || c.x >= hi_.x || c.y >= hi_.y) return false;
+  return frontier_[std::size_t((c.y - lo_.y) * (hi_.x - lo_.x) + (c.x - lo_.x))] != 0;
+}
+
+bool is_frontier(const mapping::OccupancyGrid& map, const Cell& c, const FrontierOptions& options) {
+  return FrontierMask(map, options, c, {c.x + 1, c.y + 1})(c);
 }
 
 std::vector<FrontierRegion> find_frontier_regions(const mapping::OccupancyGrid& map, const FrontierOptions& options) {
   const int w = map.width(), h = map.height();
+  const FrontierMask mask(map, options);
   std::vector<std::uint8_t> frontier(std::size_t(w) * std::size_t(h), 0);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) frontier[std::size_t(y * w + x)] = is_frontier(map, {x, y});
+    for (int x = 0; x < w; ++x) frontier[std::size_t(y * w + x)] = mask({x, y});
 
   std::vector<FrontierRegion> regions;
   std::vector<int> stack;
@@ -139,13 +183,15 @@ std::vector<Target> make_targets(const mapping::OccupancyGrid& map, const std::v
   return targets;
 }
 
-int frontier_cells_near(const mapping::OccupancyGrid& map, const Cell& c, double radius_m) {
+int frontier_cells_near(const mapping::OccupancyGrid& map, const Cell& c, double radius_m,
+                        const FrontierOptions& options) {
   const int r = int(std::ceil(radius_m / map.resolution()));
   const double r2 = double(r) * r;
+  const FrontierMask mask(map, options, {c.x - r, c.y - r}, {c.x + r + 1, c.y + r + 1});
   int n = 0;
   for (int dy = -r; dy <= r; ++dy)
     for (int dx = -r; dx <= r; ++dx)
-      if (double(dx * dx + dy * dy) <= r2 && is_frontier(map, {c.x + dx, c.y + dy})) ++n;
+      if (double(dx * dx + dy * dy) <= r2 && mask({c.x + dx, c.y + dy})) ++n;
   return n;
 }
 

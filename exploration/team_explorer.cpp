@@ -153,7 +153,7 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
     // Standing at the goal with the frontier still there: its unknown side cannot be seen from the
     // free space (e.g. the inside of a wall whose corner a beam clipped). Nobody should come again;
     // the robots this one talks to learn it too.
-    if (frontier_cells_near(map, r.frontier, 2.0 * res) > 0) {
+    if (frontier_cells_near(map, r.frontier, 2.0 * res, options_.targets.frontiers) > 0) {
       ++stats_.unobservable;
       for (std::size_t j = 0; j < robots_.size(); ++j) {
         if (int(j) == i || links[std::size_t(i)][j]) robots_[j].abandoned.push_back({r.frontier, map.observed_count(), options_.max_attempts});
@@ -161,7 +161,7 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
     }
     return false;
   }
-  if (frontier_cells_near(map, r.frontier, options_.targets.piece_radius_m) == 0) {
+  if (frontier_cells_near(map, r.frontier, options_.targets.piece_radius_m, options_.targets.frontiers) == 0) {
     r.has_task = false;  // explored meanwhile, by this robot or by what it was told
     return false;
   }
@@ -316,12 +316,12 @@ void TeamExplorer::update(const std::vector<ExplorerRobot>& robots, const std::v
       if (needy[std::size_t(i)] || (strategy_->joint() && r.has_task)) members.push_back(i);
       else if (r.has_task) claim_holders.push_back(i);
     }
-    assign_group(members, leader, robots, claim_holders, links);
+    assign_group(members, leader, robots, claim_holders);
   }
 }
 
 void TeamExplorer::assign_group(const std::vector<int>& members, int leader, const std::vector<ExplorerRobot>& robots,
-                                const std::vector<int>& claim_holders, const std::vector<std::vector<char>>& links) {
+                                const std::vector<int>& claim_holders) {
   ++stats_.assignment_rounds;
   const auto& map = *robots[std::size_t(leader)].map;
   auto passable = traversable_cells(map, options_.traversability);

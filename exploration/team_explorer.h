@@ -99,7 +99,7 @@ class TeamExplorer {
   bool check_task(int i, const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
   void give_up(int i, std::int64_t known_cells);
   void assign_group(const std::vector<int>& members, int leader, const std::vector<ExplorerRobot>& robots,
-                    const std::vector<int>& claim_holders, const std::vector<std::vector<char>>& links);
+                    const std::vector<int>& claim_holders);
   bool blacklisted(const RobotState& r, const Target& t, double resolution) const;
   void set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const;
   // Finished robots standing on the path of robot `stuck` move to the nearest place clear of it.

@@ -20,9 +20,8 @@ std::int64_t WaveField::reached_count() const {
 }
 
 std::uint32_t WaveField::step_units(int dir, int entered_index) const {
-  const std::uint32_t base = dir < 4 ? kUnitsPerCell : kDiagonalUnits;
-  if (step_weight_.empty()) return base;
-  return std::uint32_t(std::lround(double(base) * double(step_weight_[std::size_t(entered_index)])));
+  if (step_units_.empty()) return dir < 4 ? kUnitsPerCell : kDiagonalUnits;
+  return step_units_[2 * std::size_t(entered_index) + (dir < 4 ? 0 : 1)];
 }
 
 void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options, WaveField& out) {
@@ -36,15 +35,17 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
   out.units_.assign(n, WaveField::kUnreachedUnits);
   out.passable_.assign(grid.passable.begin(), grid.passable.end());
   const bool weighted = options.occupancy_weight > 0.0 && !grid.occupancy.empty();
-  float max_weight = 1.0f;
+  std::uint32_t max_step = WaveField::kDiagonalUnits;
   if (weighted) {
-    out.step_weight_.resize(n);
+    out.step_units_.resize(2 * n);
     for (std::size_t i = 0; i < n; ++i) {
-      out.step_weight_[i] = float(1.0 + options.occupancy_weight * std::clamp(double(grid.occupancy[i]), 0.0, 1.0));
-      max_weight = std::max(max_weight, out.step_weight_[i]);
+      const double factor = 1.0 + options.occupancy_weight * std::clamp(double(grid.occupancy[i]), 0.0, 1.0);
+      out.step_units_[2 * i] = std::uint32_t(std::lround(double(WaveField::kUnitsPerCell) * factor));
+      out.step_units_[2 * i + 1] = std::uint32_t(std::lround(double(WaveField::kDiagonalUnits) * factor));
+      max_step = std::max(max_step, out.step_units_[2 * i + 1]);
     }
   } else {
-    out.step_weight_.clear();
+    out.step_units_.clear();
   }
   const int w = grid.width, h = grid.height;
   std::uint32_t* units = out.units_.data();
@@ -76,7 +77,6 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
   } else {
     // Dial's algorithm: a circular array of buckets, one per cost value, wide enough for the
     // largest single step; every cell is settled in cost order without a heap.
-    const std::uint32_t max_step = std::uint32_t(std::ceil(double(WaveField::kDiagonalUnits) * max_weight)) + 1;
     const std::size_t bucket_count = max_step + 1;
     thread_local std::vector<std::vector<int>> buckets;
     if (buckets.size() < bucket_count) buckets.resize(bucket_count);
@@ -91,7 +91,7 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
       ++pending;
     }
     const int neighbours = options.eight_connected ? 8 : 4;
-    const float* weight = weighted ? out.step_weight_.data() : nullptr;
+    const std::uint32_t* weighted_steps = weighted ? out.step_units_.data() : nullptr;
     for (std::uint32_t d = 0; pending > 0; ++d) {
       auto& bucket = buckets[d % bucket_count];
       while (!bucket.empty()) {
@@ -106,8 +106,8 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
           const int j = ny * w + nx;
           if (!passable[j]) continue;
           if (k >= 4 && (!passable[y * w + nx] || !passable[ny * w + x])) continue;  // no corner cutting
-          const std::uint32_t base = k < 4 ? WaveField::kUnitsPerCell : WaveField::kDiagonalUnits;
-          const std::uint32_t step = weight ? std::uint32_t(std::lround(double(base) * double(weight[j]))) : base;
+          const std::uint32_t step = weighted_steps ? weighted_steps[2 * std::size_t(j) + (k < 4 ? 0 : 1)]
+                                                    : (k < 4 ? WaveField::kUnitsPerCell : WaveField::kDiagonalUnits);
           const std::uint32_t c = d + step;
           if (c < units[j]) {
             units[j] = c;

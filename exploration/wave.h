@@ -19,8 +19,8 @@ struct WaveOptions {
   // seed 003's pseudo code is 4-connected; 8-connected adds diagonal steps of cost sqrt(2).
   // A diagonal step needs both cells beside it passable, so waves never cut a corner.
   bool eight_connected = true;
-  // Burgard's cost model: entering a cell costs its step length times (1 + occupancy_weight * P(occ)).
-  // 0 gives plain geometric distances.
+  // Burgard's cost model: entering a cell costs its step length times (1 + occupancy_weight * P(occ)),
+  // rounded to whole units (at most 0.5/70 of the step). 0 gives plain geometric distances.
   double occupancy_weight = 0.0;
 };
 
@@ -64,7 +64,7 @@ class WaveField {
   std::vector<float> cost_;
   std::vector<std::uint32_t> units_;
   std::vector<std::uint8_t> passable_;  // copy kept for path extraction
-  std::vector<float> step_weight_;      // per-cell entry multiplier (empty: all 1)
+  std::vector<std::uint32_t> step_units_;  // weighted: units to enter cell i straight [2i] and diagonally [2i+1]
 };
 
 // Fills `out` (its storage is reused between calls). Sources outside the grid are ignored; a source

@@ -21,9 +21,15 @@ void save_octomap(const OccupancyGrid& grid, const std::filesystem::path& path) 
     }
   }
   tree.updateInnerOccupancy();
+  tree.toMaxLikelihood();
   tree.prune();
+  // The header of OctoMap's writeBinary, then its node encoding. (Debian's liboctomap is built with
+  // debug output, and its writeBinaryData prints " done." to stderr; writeBinaryNode does not.)
   std::ostringstream out;
-  if (!tree.writeBinary(out)) throw Error(path.string() + ": cannot serialise the OcTree");
+  out << "# Octomap OcTree binary file\n# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
+      << "id " << tree.getTreeType() << "\nsize " << tree.size() << "\nres " << tree.getResolution() << "\ndata\n";
+  if (tree.getRoot() != nullptr) tree.writeBinaryNode(out, tree.getRoot());
+  if (!out) throw Error(path.string() + ": cannot serialise the OcTree");
   core::write_file_atomic(path, out.str());
 }
 

@@ -36,13 +36,21 @@ MapExchange::MapExchange(int robots, const core::GridGeometry& g)
       tile_version_(std::size_t(robots), std::vector<std::uint64_t>(std::size_t(tiles_x_) * std::size_t(tiles_y_), 0)),
       last_exchange_(std::size_t(robots), std::vector<std::uint64_t>(std::size_t(robots), 0)) {}
 
-std::int64_t MapExchange::send(int from, int to, std::uint64_t since, std::vector<mapping::OccupancyGrid>& maps) {
+std::vector<int> MapExchange::changed_tiles(int robot, std::uint64_t since) const {
+  std::vector<int> tiles;
+  const auto& versions = tile_version_[std::size_t(robot)];
+  for (int t = 0; t < int(versions.size()); ++t) {
+    if (versions[std::size_t(t)] > since) tiles.push_back(t);
+  }
+  return tiles;
+}
+
+std::int64_t MapExchange::send(int from, int to, const std::vector<int>& tiles,
+                               std::vector<mapping::OccupancyGrid>& maps) {
   const auto& src = maps[std::size_t(from)];
   auto& dst = maps[std::size_t(to)];
   std::int64_t bytes = 0;
-  const auto& versions = tile_version_[std::size_t(from)];
-  for (int t = 0; t < int(versions.size()); ++t) {
-    if (versions[std::size_t(t)] <= since) continue;
+  for (const int t : tiles) {
     const int tx = t % tiles_x_, ty = t / tiles_x_;
     const int x1 = std::min(width_, (tx + 1) * kTileSize), y1 = std::min(height_, (ty + 1) * kTileSize);
     bytes += kTileHeaderBytes + std::int64_t(x1 - tx * kTileSize) * (y1 - ty * kTileSize);
@@ -63,8 +71,10 @@ std::int64_t MapExchange::send(int from, int to, std::uint64_t since, std::vecto
 
 std::int64_t MapExchange::exchange(int i, int j, std::vector<mapping::OccupancyGrid>& maps) {
   const std::uint64_t since = last_exchange_[std::size_t(i)][std::size_t(j)];
-  const std::int64_t bytes = send(i, j, since, maps) + send(j, i, since, maps);
-  // What each got from the other is now known to both: do not send it back next time.
+  // Both directions are chosen before either is applied: what one just got is not echoed back, and
+  // what each changed before talking is never hidden by what it receives.
+  const std::vector<int> from_i = changed_tiles(i, since), from_j = changed_tiles(j, since);
+  const std::int64_t bytes = send(i, j, from_i, maps) + send(j, i, from_j, maps);
   last_exchange_[std::size_t(i)][std::size_t(j)] = last_exchange_[std::size_t(j)][std::size_t(i)] = clock_;
   return bytes;
 }

@@ -47,7 +47,9 @@ class MapExchange {
     const int x = cell_index % width_, y = cell_index / width_;
     return (y / kTileSize) * tiles_x_ + x / kTileSize;
   }
-  std::int64_t send(int from, int to, std::uint64_t since, std::vector<mapping::OccupancyGrid>& maps);
+  std::vector<int> changed_tiles(int robot, std::uint64_t since) const;
+  // Sends these tiles of `from`; returns the bytes.
+  std::int64_t send(int from, int to, const std::vector<int>& tiles, std::vector<mapping::OccupancyGrid>& maps);
 
   int width_ = 0, height_ = 0, tiles_x_ = 0, tiles_y_ = 0;
   std::uint64_t clock_ = 0;

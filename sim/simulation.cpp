@@ -77,8 +77,8 @@ std::vector<core::Pose2> place_robots(const Scenario& s, const World& world, cor
       const auto cell = g.world_to_cell(p);
       if (!cell) throw InputError(who + ", outside the map (" + extent_text(g) + ")");
       if (world.blocked(*cell)) throw InputError(who + ", inside a wall");
-      const double clearance = world.clearance(p, r);
-      if (clearance <= r) {
+      if (!world.disc_free(p, r)) {
+        const double clearance = world.clearance(p, 2.0 * r);
         char buf[96];
         std::snprintf(buf, sizeof buf, ", too close to a wall (clearance %.2f m, radius %.2f m)", clearance, r);
         throw InputError(who + buf);

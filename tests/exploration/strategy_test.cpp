@@ -1,0 +1,156 @@
+#include "exploration/strategy.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <random>
+#include <set>
+
+#include "tests/test_support.h"
+
+namespace fleetmap::exploration {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+Target target_at(double x, double y) {
+  Target t;
+  t.goal_m = {x, y};
+  t.cells = 5;
+  return t;
+}
+
+AssignmentRobot robot(int index, int team, Eigen::Vector2d at, std::vector<double> costs) {
+  AssignmentRobot r;
+  r.team_index = index;
+  r.team_size = team;
+  r.position_m = at;
+  r.cost_m = std::move(costs);
+  return r;
+}
+
+AssignmentInput random_input(std::mt19937& rng, int robots, int targets, double unreachable) {
+  AssignmentInput in;
+  std::uniform_real_distribution<double> pos(0.0, 20.0), cost(0.5, 30.0);
+  std::bernoulli_distribution lost(unreachable);
+  for (int t = 0; t < targets; ++t) in.targets.push_back(target_at(pos(rng), pos(rng)));
+  for (int i = 0; i < robots; ++i) {
+    std::vector<double> c;
+    for (int t = 0; t < targets; ++t) c.push_back(lost(rng) ? kInf : cost(rng));
+    in.robots.push_back(robot(i, robots, {pos(rng), pos(rng)}, c));
+  }
+  return in;
+}
+
+class EveryStrategy : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EveryStrategy, AssignsReachableTargetsOnly) {
+  const auto s = make_strategy(GetParam());
+  EXPECT_EQ(s->name(), GetParam());
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 300; ++trial) {
+    const AssignmentInput in = random_input(rng, 1 + trial % 9, trial % 13, 0.3);
+    const auto a = s->assign(in);
+    ASSERT_EQ(a.size(), in.robots.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (a[i] < 0) continue;
+      ASSERT_LT(a[i], int(in.targets.size()));
+      EXPECT_TRUE(std::isfinite(in.robots[i].cost_m[std::size_t(a[i])])) << "robot sent to an unreachable target";
+    }
+    // A robot that can reach some target gets one unless a joint strategy gave them all away.
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const bool can_reach = std::any_of(in.robots[i].cost_m.begin(), in.robots[i].cost_m.end(),
+                                         [](double c) { return std::isfinite(c); });
+      if (!s->joint() && can_reach) {
+        EXPECT_GE(a[i], 0);
+      }
+      if (!can_reach) {
+        EXPECT_EQ(a[i], -1);
+      }
+    }
+  }
+}
+
+TEST_P(EveryStrategy, JointStrategiesNeverShareATargetWhileThereAreEnough) {
+  const auto s = make_strategy(GetParam());
+  if (!s->joint()) return;  // uncoordinated and directional decide robot by robot by design
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int robots = 1 + trial % 9;
+    const AssignmentInput in = random_input(rng, robots, robots + trial % 5, 0.0);
+    const auto a = s->assign(in);
+    std::set<int> used;
+    for (int t : a) {
+      // Coordinated and optimized give every robot a target when there are enough (the auction may
+      // leave a robot out when another one is cheaper for everything).
+      if (GetParam() != "market") {
+        ASSERT_GE(t, 0) << "every robot can reach every target: all get one";
+      }
+      if (t >= 0) {
+        EXPECT_TRUE(used.insert(t).second) << GetParam() << " sent two robots to target " << t;
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(All, EveryStrategy, ::testing::ValuesIn(strategy_names()));
+
+TEST(Strategies, UnknownNameListsTheValidOnes) {
+  fleetmap::testing::expect_input_error([] { make_strategy("greedy"); },
+                                        {"unknown strategy 'greedy'", "uncoordinated", "coordinated", "optimized",
+                                         "directional", "market"});
+}
+
+TEST(Strategies, UncoordinatedTakesTheNearest) {
+  AssignmentInput in;
+  in.targets = {target_at(0, 0), target_at(5, 5), target_at(9, 9)};
+  in.robots = {robot(0, 2, {0, 0}, {4, 2, 3}), robot(1, 2, {0, 0}, {4, 2, 3})};
+  EXPECT_EQ(make_strategy("uncoordinated")->assign(in), (std::vector<int>{1, 1}));
+}
+
+TEST(Strategies, OptimizedFinishesTogetherWhereGreedyDoesNot) {
+  // seed 003 Fig. 4: the greedy assignment takes the cheapest pair first (robot 2 -> a) and leaves
+  // robot 1 the long way; squared costs prefer the assignment whose slowest robot is faster.
+  AssignmentInput in;
+  in.sensor_range_m = 1.0;  // targets far apart: no utility interplay
+  in.targets = {target_at(0, 0), target_at(20, 0)};  // a, b
+  in.robots = {robot(0, 2, {5, 0}, {2, 6}), robot(1, 2, {6, 0}, {1, 5})};
+  EXPECT_EQ(make_strategy("coordinated")->assign(in), (std::vector<int>{1, 0}));
+  EXPECT_EQ(make_strategy("optimized")->assign(in), (std::vector<int>{0, 1}));
+}
+
+TEST(Strategies, CoordinatedSpreadsRobotsOverTheSensorRange) {
+  // Two targets 0.5 m apart near both robots, one far away. Once one near target is taken the
+  // other one's utility drops (it will be seen anyway), so with a small beta the second robot goes far.
+  AssignmentInput in;
+  in.sensor_range_m = 4.0;
+  in.targets = {target_at(0, 0), target_at(0.5, 0), target_at(10, 0)};
+  in.robots = {robot(0, 2, {0, 1}, {1, 1, 3}), robot(1, 2, {0, 1}, {1, 1, 3})};
+  StrategyOptions o;
+  o.beta = 0.1;
+  const auto a = make_strategy("coordinated", o)->assign(in);
+  EXPECT_EQ(std::set<int>(a.begin(), a.end()).count(2), 1u) << "one robot should take the far target";
+  // Uncoordinated robots both stay near.
+  const auto u = make_strategy("uncoordinated")->assign(in);
+  EXPECT_NE(u[0], 2);
+  EXPECT_NE(u[1], 2);
+}
+
+TEST(Strategies, DirectionalRobotsPreferTheirOwnDirection) {
+  // Robot 0 of 2 prefers east (0 rad), robot 1 west (pi); targets east and west cost the same.
+  AssignmentInput in;
+  in.targets = {target_at(-5, 0), target_at(5, 0)};
+  in.robots = {robot(0, 2, {0, 0}, {5, 5}), robot(1, 2, {0, 0}, {5, 5})};
+  EXPECT_EQ(make_strategy("directional")->assign(in), (std::vector<int>{1, 0}));
+}
+
+TEST(Strategies, MarketBalancesBundles) {
+  // Four targets in a row; a min-max auction gives each of two robots its own side.
+  AssignmentInput in;
+  in.targets = {target_at(-6, 0), target_at(-3, 0), target_at(3, 0), target_at(6, 0)};
+  in.robots = {robot(0, 2, {-1, 0}, {5, 2, 4, 7}), robot(1, 2, {1, 0}, {7, 4, 2, 5})};
+  EXPECT_EQ(make_strategy("market")->assign(in), (std::vector<int>{1, 2}));
+}
+
+}  // namespace
+}  // namespace fleetmap::exploration

@@ -1,0 +1,126 @@
+#include "sim/simulation.h"
+
+#include <gtest/gtest.h>
+
+#include "maps/builtin_maps.h"
+#include "sim/run_output.h"
+#include "tests/sim/sim_test_maps.h"
+#include "tests/test_support.h"
+
+namespace fleetmap::sim {
+namespace {
+
+using fleetmap::testing::expect_input_error;
+
+Scenario small(const std::string& map, int robots, int steps) {
+  Scenario s;
+  s.map = map;
+  s.robot_count = robots;
+  s.steps = steps;
+  s.noise = {0.01, 0.01};  // visible noise, so that seeds matter
+  return s;
+}
+
+nlohmann::json without_timing(nlohmann::json j) {
+  j.erase("timing");
+  return j;
+}
+
+TEST(Simulation, SameSeedSameRunDifferentSeedDifferentRun) {
+  const auto grid = maps::load_map_source("office");
+  Scenario s = small("office", 3, 60);
+  s.localization = "odometry";
+  const RunResult a = Simulation(s, grid).run();
+  const RunResult b = Simulation(s, grid).run();
+  EXPECT_EQ(without_timing(metrics_json(a, "office")).dump(), without_timing(metrics_json(b, "office")).dump());
+  ASSERT_EQ(a.robots[0].truth.size(), b.robots[0].truth.size());
+  for (std::size_t k = 0; k < a.robots[0].truth.size(); ++k) {
+    EXPECT_EQ(a.robots[1].truth[k], b.robots[1].truth[k]);
+    EXPECT_EQ(a.robots[1].estimate[k], b.robots[1].estimate[k]);
+  }
+  EXPECT_EQ(a.merged.log_odds_data(), b.merged.log_odds_data());
+  s.seed = 2;
+  const RunResult c = Simulation(s, grid).run();
+  EXPECT_NE(a.robots[1].truth.back(), c.robots[1].truth.back());
+}
+
+TEST(Simulation, ExploresASmallMapAndStopsWhenDone) {
+  const RunResult r = Simulation(small("empty", 2, 2000), maps::load_map_source("empty")).run();
+  EXPECT_TRUE(r.finished);
+  EXPECT_LT(r.steps, 2000);
+  EXPECT_GE(r.coverage.back(), 0.99);
+  ASSERT_TRUE(r.steps_to_95.has_value());
+  ASSERT_TRUE(r.steps_to_99.has_value());
+  EXPECT_LE(*r.steps_to_95, *r.steps_to_99);
+  for (std::size_t k = 1; k < r.coverage.size(); ++k) ASSERT_GE(r.coverage[k], r.coverage[k - 1]);
+  EXPECT_EQ(int(r.coverage.size()), r.steps + 1);
+  EXPECT_GT(r.bytes_sent, 0);
+  EXPECT_GT(r.redundancy, 0.0);
+  EXPECT_LT(r.redundancy, 1.0);
+}
+
+TEST(Simulation, RendezvousOnlyCommunicationSendsLessThanAlways) {
+  Scenario s = small("office", 3, 150);
+  const auto grid = maps::load_map_source("office");
+  const RunResult always = Simulation(s, grid).run();
+  s.communication.range_m = 0.0;
+  const RunResult rendezvous = Simulation(s, grid).run();
+  EXPECT_LT(rendezvous.bytes_sent, always.bytes_sent);
+  EXPECT_GT(always.meetings, 0);
+}
+
+TEST(Simulation, PlacesRobotsApartInFreeSpace) {
+  const auto grid = maps::load_map_source("cave");
+  for (const Placement p : {Placement::Cluster, Placement::Random}) {
+    Scenario s = small("cave", 9, 1);
+    s.placement = p;
+    s.min_separation_m = 1.0;
+    const Simulation sim(s, grid);
+    const auto& poses = sim.true_poses();
+    ASSERT_EQ(poses.size(), 9u);
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+      EXPECT_TRUE(sim.world().disc_free(poses[i].position(), s.robot.radius_m));
+      for (std::size_t j = 0; j < i; ++j) EXPECT_GE((poses[i].position() - poses[j].position()).norm(), 1.0 - 1e-9);
+    }
+  }
+}
+
+TEST(SimulationBadInput, StartsAndCountsAreChecked) {
+  const auto room = testing::walled_room(50, 40);
+  Scenario s = small("room", 1, 10);
+  s.placement = Placement::List;
+  const auto with_starts = [&](std::vector<core::Pose2> starts) {
+    Scenario t = s;
+    t.starts = std::move(starts);
+    t.robot_count = int(t.starts.size());
+    return t;
+  };
+  expect_input_error([&] { Simulation(with_starts({{0.05, 2.0, 0}}), room); }, {"robot 1 starts at (0.05, 2.00)", "inside a wall"});
+  expect_input_error([&] { Simulation(with_starts({{1.0, 1.0, 0}, {9.0, 1.0, 0}}), room); },
+                     {"robot 2 starts at (9.00, 1.00)", "outside the map", "x 0.00..5.00"});
+  expect_input_error([&] { Simulation(with_starts({{1.0, 1.0, 0}, {1.2, 1.1, 0}}), room); }, {"robot 2", "on robot 1"});
+  expect_input_error([&] { Simulation(with_starts({{0.2, 2.0, 0}}), room); }, {"robot 1", "too close to a wall"});
+  Scenario none = small("room", 0, 10);
+  expect_input_error([&] { Simulation(none, room); }, {"robots", "at least one"});
+  Scenario crowd = small("room", 60, 10);
+  crowd.min_separation_m = 2.0;
+  expect_input_error([&] { Simulation(crowd, room); }, {"robots: only", "of 60 robots fit"});
+  Scenario noisy = small("room", 1, 10);
+  noisy.noise.position_m = -1.0;
+  expect_input_error([&] { Simulation(noisy, room); }, {"noise.position", "negative"});
+  Scenario range = small("room", 1, 10);
+  range.communication.range_m = -5.0;
+  expect_input_error([&] { Simulation(range, room); }, {"communication.range", "negative"});
+  Scenario strategy = small("room", 1, 10);
+  strategy.exploration.strategy = "greedy";
+  expect_input_error([&] { Simulation(strategy, room); }, {"unknown", "greedy", "coordinated"});
+  Scenario landmark = small("room", 1, 10);
+  landmark.landmarks = {{0.05, 0.05}};
+  expect_input_error([&] { Simulation(landmark, room); }, {"landmarks.points[0]", "inside a wall"});
+  Scenario cluster = small("room", 1, 10);
+  cluster.cluster_at = Eigen::Vector2d(0.05, 1.0);
+  expect_input_error([&] { Simulation(cluster, room); }, {"robots.cluster_at", "inside a wall"});
+}
+
+}  // namespace
+}  // namespace fleetmap::sim
