@@ -68,7 +68,7 @@ struct LocalizerOptions {
   double bearing_noise = 0.0175;  // rad
   // Initial pose uncertainty (standard deviations); seed 000: P0 = diag(0.05^2, 0.05^2, 0.0175^2).
   double initial_xy = 0.05;
-  double initial_theta = 0.0175;
+  double initial_theta = 0.017453292519943295;  // 1 deg (seed 000 uses 0.0175 rad)
   // Data association: by the sensor's landmark identities, or by nearest neighbour with a
   // Mahalanobis gate (chi-square, 2 dof) when identities are unknown.
   bool known_associations = true;

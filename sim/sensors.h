@@ -24,7 +24,7 @@ struct RangeSensorOptions {
 struct LandmarkSensorOptions {
   double max_range_m = 5.0;
   double range_noise_m = 0.02;
-  double bearing_noise_rad = 0.0175;  // 1 degree
+  double bearing_noise_rad = 0.017453292519943295;  // 1 degree
   bool report_ids = true;             // the sensor tells which landmark it sees
 };
 
@@ -32,7 +32,7 @@ struct RobotDetectorOptions {  // seed 000's camera, seed 002's detection
   double max_range_m = 5.0;
   double fov_rad = 6.283185307179586;  // centred on the heading
   double range_noise_m = 0.02;
-  double bearing_noise_rad = 0.0175;
+  double bearing_noise_rad = 0.017453292519943295;  // 1 degree
 };
 
 std::vector<double> beam_angles(const RangeSensorOptions& options);

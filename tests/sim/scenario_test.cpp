@@ -112,3 +112,22 @@ TEST(ScenarioBadInput, ErrorsNameTheKeyAndTheLine) {
 
 }  // namespace
 }  // namespace fleetmap::sim
+
+namespace fleetmap::sim {
+namespace {
+
+// The README documents every scenario key with its default: that block must parse, and give the
+// defaults.
+TEST(Scenario, TheReadmeExampleParsesToTheDefaults) {
+  const std::string readme = core::read_file(std::filesystem::path(FLEETMAP_SOURCE_DIR) / "README.md");
+  const auto section = readme.find("### Scenario files");
+  ASSERT_NE(section, std::string::npos);
+  const auto begin = readme.find("```yaml\n", section);
+  ASSERT_NE(begin, std::string::npos);
+  const auto end = readme.find("```", begin + 8);
+  const Scenario s = parse_scenario(readme.substr(begin + 8, end - begin - 8), "README.md", "");
+  EXPECT_EQ(scenario_to_yaml(s), scenario_to_yaml(parse_scenario("map: office\n", "defaults", "")));
+}
+
+}  // namespace
+}  // namespace fleetmap::sim

@@ -1,0 +1,141 @@
+// End-to-end: `fleetmap explore` as a user runs it.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "tests/cli_run.h"
+
+namespace fleetmap::cli {
+namespace {
+
+using fleetmap::testing::run_fleetmap;
+using fleetmap::testing::slurp;
+using fleetmap::testing::TempDir;
+
+nlohmann::json metrics(const std::filesystem::path& dir) { return nlohmann::json::parse(slurp(dir / "metrics.json")); }
+
+TEST(ExploreCommand, WritesEveryOutputAndSaysWhere) {
+  TempDir dir;
+  const auto r = run_fleetmap("explore --map empty --robots 2 --steps 40 --out run", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* f : {"merged.png", "robot_1.png", "robot_2.png", "metrics.json", "map.pgm", "map.yaml", "map.bt",
+                        "scenario.yaml"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / "run" / f)) << f;
+  }
+  EXPECT_NE(r.out.find("merged map: run/merged.png"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err, "");  // no progress bar when stderr is not a terminal, and no library chatter
+  const cv::Mat merged = cv::imread((dir / "run" / "merged.png").string());
+  EXPECT_GE(merged.cols, 800);
+  const auto m = metrics(dir / "run");
+  for (const char* key : {"map", "robots", "strategy", "seed", "steps", "coverage", "steps_to_95", "steps_to_99",
+                          "distance_m", "redundancy", "bytes_sent", "timing"}) {
+    EXPECT_TRUE(m.contains(key)) << key;
+  }
+  EXPECT_EQ(m["map"], "empty");
+  EXPECT_EQ(m["robots"], 2);
+  EXPECT_EQ(m["strategy"], "directional");
+  EXPECT_EQ(m["steps"], 40);
+  EXPECT_TRUE(m["steps_to_99"].is_null());  // 40 steps are not enough for 99%
+  EXPECT_GT(m["coverage"].get<double>(), 0.1);
+  // The map files are real maps: they load back.
+  const auto back = run_fleetmap("maps show run/map.yaml --out back.png", dir);
+  EXPECT_EQ(back.exit_code, 0) << back.err;
+}
+
+TEST(ExploreCommand, SameCommandSameNumbers) {
+  TempDir dir;
+  const std::string args = " --map cave --robots 3 --strategy coordinated --steps 60";
+  ASSERT_EQ(run_fleetmap("explore" + args + " --seed 5 --out a", dir).exit_code, 0);
+  ASSERT_EQ(run_fleetmap("explore" + args + " --seed 5 --out b", dir).exit_code, 0);
+  auto a = metrics(dir / "a"), b = metrics(dir / "b");
+  a.erase("timing");
+  b.erase("timing");
+  EXPECT_EQ(a.dump(), b.dump());
+  EXPECT_EQ(slurp(dir / "a" / "map.pgm"), slurp(dir / "b" / "map.pgm"));
+  ASSERT_EQ(run_fleetmap("explore" + args + " --seed 6 --out c", dir).exit_code, 0);
+  auto c = metrics(dir / "c");
+  c.erase("timing");
+  EXPECT_NE(a.dump(), c.dump());
+}
+
+TEST(ExploreCommand, ScenarioFileAndFlagsThatOverrideIt) {
+  TempDir dir;
+  dir.write("s.yaml", "map: maze\nrobots: {count: 3}\nsteps: 25\nexploration: {strategy: market}\n");
+  auto r = run_fleetmap("explore --scenario s.yaml --out s1", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto m = metrics(dir / "s1");
+  EXPECT_EQ(m["map"], "maze");
+  EXPECT_EQ(m["robots"], 3);
+  EXPECT_EQ(m["strategy"], "market");
+  r = run_fleetmap("explore --scenario s.yaml --strategy optimized --robots 2 --out s2", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  m = metrics(dir / "s2");
+  EXPECT_EQ(m["strategy"], "optimized");
+  EXPECT_EQ(m["robots"], 2);
+  // The scenario written beside the outputs runs again to the same numbers.
+  r = run_fleetmap("explore --scenario s2/scenario.yaml --out s3", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto a = metrics(dir / "s2"), b = metrics(dir / "s3");
+  a.erase("timing");
+  b.erase("timing");
+  EXPECT_EQ(a.dump(), b.dump());
+}
+
+TEST(ExploreCommand, AnimateWritesAVideo) {
+  TempDir dir;
+  const auto r = run_fleetmap("explore --map empty --robots 2 --steps 12 --animate --out v", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  cv::VideoCapture video((dir / "v" / "run.mp4").string());
+  ASSERT_TRUE(video.isOpened());
+  int frames = 0;
+  cv::Mat frame;
+  while (video.read(frame)) ++frames;
+  EXPECT_EQ(frames, 13);  // the start and each of the 12 steps
+  EXPECT_FALSE(std::filesystem::exists(dir / "v" / "run.partial.mp4"));
+}
+
+TEST(ExploreCommand, BadInputGetsOneLineAndNonZeroExit) {
+  TempDir dir;
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map ofice", dir), "unknown map 'ofice'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map ofice", dir), "maze");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --strategy greedy --steps 1", dir), "greedy");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --strategy greedy --steps 1", dir), "coordinated");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --localization gps --steps 1", dir), "gps");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --robots 0", dir), "--robots");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --comm-range far", dir), "--comm-range");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --comm-range -3", dir), "--comm-range");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario missing.yaml", dir), "missing.yaml");
+  dir.write("wall.yaml", "map: empty\nrobots: {starts: [[0.05, 5.0, 0]]}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario wall.yaml", dir), "inside a wall");
+  dir.write("outside.yaml", "map: empty\nrobots: {starts: [[50, 5.0, 0]]}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario outside.yaml", dir), "outside the map");
+  dir.write("onrobot.yaml", "map: empty\nrobots: {starts: [[5, 5, 0], [5.1, 5.0, 0]]}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario onrobot.yaml", dir), "on robot 1");
+  dir.write("zero.yaml", "map: empty\nrobots: {count: 0}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario zero.yaml", dir), "zero.yaml:2");
+  dir.write("noise.yaml", "map: empty\nnoise: {position: -1}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario noise.yaml", dir), "noise.position");
+  dir.write("range.yaml", "map: empty\nsensors: {range: {max_range: -4}}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario range.yaml", dir), "sensors.range.max_range");
+  dir.write("key.yaml", "map: empty\nrobot: 3\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario key.yaml", dir), "key.yaml:2: unknown key 'robot'");
+  dir.write("badmap.yaml", "map: nowhere.png\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario badmap.yaml", dir), "nowhere.png");
+  // Nothing half-written by a failed run.
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+}
+
+TEST(ExploreCommand, HelpListsStrategiesAndLocalizers) {
+  TempDir dir;
+  const auto r = run_fleetmap("explore --help", dir);
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* s : {"uncoordinated", "coordinated", "optimized", "directional", "market", "Burgard", "seed 003",
+                        "ideal", "odometry", "ekf", "--comm-range", "--animate", "--scenario"}) {
+    EXPECT_NE(r.out.find(s), std::string::npos) << s;
+  }
+}
+
+}  // namespace
+}  // namespace fleetmap::cli
