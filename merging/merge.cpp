@@ -94,6 +94,19 @@ const std::vector<MergeMethod>& merge_methods() {
   return kMethods;
 }
 
+namespace {
+
+// auto's order: (method, pass) lists, each ending with a decision.
+const std::vector<std::vector<std::pair<std::string, std::size_t>>>& auto_steps() {
+  static const std::vector<std::vector<std::pair<std::string, std::size_t>>> kSteps = {
+      {{"overlap", 0}},
+      {{"features", 0}, {"overlap", 1}},
+  };
+  return kSteps;
+}
+
+}  // namespace
+
 std::vector<std::string> merge_method_names() {
   std::vector<std::string> names = {"auto"};
   for (const auto& m : merge_methods()) names.push_back(m.name);
@@ -139,9 +152,11 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   const auto& co = options.confidence;
   const double agree_factor = clamp01((best_q.agreement - co.zero_agreement) / (co.full_agreement - co.zero_agreement));
   const double support_factor = clamp01(best_q.constraint / co.full_constraint);
+  const double acceptance_factor =
+      clamp01((result.acceptance - co.zero_acceptance) / (co.full_acceptance - co.zero_acceptance));
   std::vector<std::pair<AlignmentQuality, core::Transform2>> others;
   for (std::size_t i = 1; i < scored.size(); ++i) others.emplace_back(scored[i].first, scored[i].second->fit.b_to_a);
-  if (options.probe_symmetries && agree_factor * support_factor >= options.min_confidence) {
+  if (options.probe_symmetries && agree_factor * acceptance_factor * support_factor >= options.min_confidence) {
     std::vector<double> turns;
     for (int k = 0; k < 4; ++k) turns.push_back(result.transform.rotation() + k * std::numbers::pi / 2.0);
     OverlapSearchOptions probe = options.overlap;
@@ -165,15 +180,15 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
     }
   }
   result.distinctiveness = best_q.score > 0.0 ? clamp01(1.0 - second / best_q.score) : 0.0;
-  result.confidence = agree_factor * support_factor * result.distinctiveness;
+  result.confidence = agree_factor * acceptance_factor * support_factor * result.distinctiveness;
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {
-    char buf[200];
+    char buf[256];
     std::snprintf(buf, sizeof buf,
-                  "no reliable overlap: confidence %.2f < %.2f (wall agreement %.2f, constraint %.1f, "
-                  "distinctiveness %.2f)",
-                  result.confidence, options.min_confidence, best_q.agreement, best_q.constraint,
-                  result.distinctiveness);
+                  "no reliable overlap: confidence %.2f < %.2f (wall agreement %.2f, acceptance %.2f, "
+                  "constraint %.1f, distinctiveness %.2f)",
+                  result.confidence, options.min_confidence, best_q.agreement, result.acceptance,
+                  best_q.constraint, result.distinctiveness);
     result.reason = buf;
   }
   return result;
@@ -189,20 +204,22 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
   }
   core::Random random(options.seed);
   // Steps: lists of (method, pass). Candidates accumulate; each step ends with a decision.
-  std::vector<std::vector<std::pair<const MergeMethod*, std::size_t>>> steps;
-  for (const auto& m : merge_methods()) {
-    if (m.name != options.method) continue;
-    for (std::size_t p = 0; p < m.passes.size(); ++p) steps.push_back({{&m, p}});
-  }
-  if (options.method == "auto") {
-    // overlap's first pass is fast and usually enough; then every other pass at once.
-    steps.push_back({{&merge_methods().front(), 0}});
-    steps.emplace_back();
+  const auto method_named = [](const std::string& name) -> const MergeMethod* {
     for (const auto& m : merge_methods()) {
-      for (std::size_t p = (&m == &merge_methods().front() ? 1 : 0); p < m.passes.size(); ++p) {
-        steps.back().push_back({&m, p});
-      }
+      if (m.name == name) return &m;
     }
+    return nullptr;
+  };
+  std::vector<std::vector<std::pair<const MergeMethod*, std::size_t>>> steps;
+  if (options.method == "auto") {
+    // overlap's spectral pass is fast and usually enough; then the other passes at once.
+    for (const auto& step : auto_steps()) {
+      steps.emplace_back();
+      for (const auto& [name, pass] : step) steps.back().push_back({method_named(name), pass});
+    }
+  } else {
+    const MergeMethod* m = method_named(options.method);
+    for (std::size_t p = 0; p < m->passes.size(); ++p) steps.push_back({{m, p}});
   }
   std::vector<Hypothesis> candidates;
   MergeResult best;

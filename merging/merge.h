@@ -25,9 +25,12 @@
 
 namespace fleetmap::merging {
 
-// confidence = agreement factor * support factor * distinctiveness, each in [0, 1]:
+// confidence = agreement factor * acceptance factor * support factor * distinctiveness, each in [0, 1]:
 // - agreement factor: the share of matched walls among matched + contradicting walls, mapped
 //   linearly from zero_agreement (0) to full_agreement (1);
+// - acceptance factor: seed 003's omega over all cells known in both maps, mapped linearly from
+//   zero_acceptance (0) to full_acceptance (1). Right answers agree on nearly every common cell;
+//   two unrelated maps laid edge to edge along a wall fit their walls but not the cells beside them;
 // - support factor: AlignmentQuality::constraint / full_constraint, at most 1 (a straight wall or a
 //   single round obstacle leaves a direction free and gives 0);
 // - distinctiveness: 1 - S2 / S1, with S1 the best candidate's score and S2 the best score of a
@@ -39,6 +42,8 @@ namespace fleetmap::merging {
 struct ConfidenceOptions {
   double zero_agreement = 0.8;
   double full_agreement = 0.95;
+  double zero_acceptance = 0.8;
+  double full_acceptance = 0.92;
   double full_constraint = 40.0;
   double distinct_distance = 4.0;
   double distinct_rotation_deg = 2.0;

@@ -61,6 +61,7 @@ struct PrepareOptions {
   int max_refine_points = 6000;    // wall points kept per level for refinement (evenly subsampled)
 };
 
+// Keeps a reference to `grid`, which must outlive it.
 class PreparedGrid {
  public:
   explicit PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOptions& options = {});

@@ -100,6 +100,27 @@ TEST_P(MethodOnDisjointMaps, NoOverlapIsNeverMerged) {
 
 INSTANTIATE_TEST_SUITE_P(AllMethods, MethodOnDisjointMaps, ::testing::ValuesIn(registry_and_auto()));
 
+// Found by the benchmark: two views of the synthetic world that do not overlap fit edge to edge,
+// one's top wall on the other's bottom wall with several cross walls in line (walls agree 97%).
+// The cells beside those walls disagree (omega 0.83), and that refuses it.
+TEST(AlignMaps, UnrelatedMapsLaidEdgeToEdgeAlongAWallAreRefused) {
+  core::Random world_random(2000);
+  SyntheticWorldOptions wo;
+  wo.width = wo.height = 2200;
+  const SyntheticWorld world(wo, world_random);
+  CropPairOptions o;
+  o.width = o.height = 1000;
+  o.overlap = 0.0;
+  o.min_inside = 0.8;
+  core::Random random(1000u * 7919u + 13u);
+  const CropPair pair = make_world_pair(world, o, random);
+  MergeOptions options;
+  options.method = "overlap";
+  const MergeResult r = align_maps(pair.a, pair.b, options);
+  EXPECT_FALSE(r.merged) << "confidence " << r.confidence << ", acceptance " << r.acceptance;
+  EXPECT_NE(r.reason.find("acceptance"), std::string::npos) << r.reason;
+}
+
 TEST(MergeRegistry, NamesAutoFirstThenTheTable) {
   const auto names = merge_method_names();
   ASSERT_GE(names.size(), 3u);
