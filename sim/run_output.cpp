@@ -10,6 +10,7 @@
 #include "core/angle.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "localization/metrics.h"
 #include "mapping/map_io.h"
 #include "mapping/octomap_io.h"
 #include "mapping/render.h"
@@ -64,30 +65,35 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   j["coverage"] = r.coverage.empty() ? 0.0 : r.coverage.back();
   j["steps_to_95"] = optional_int(r.steps_to_95);
   j["steps_to_99"] = optional_int(r.steps_to_99);
-  double distance = 0.0;
+  double distance = 0.0, position_rmse_sum = 0.0;
   int blocked = 0;
   json per_robot = json::array();
   for (std::size_t i = 0; i < r.robots.size(); ++i) {
     const auto& t = r.robots[i];
     distance += t.distance_m;
     blocked += t.blocked_moves;
-    double se_pos = 0.0, se_head = 0.0;
-    for (std::size_t k = 0; k < t.truth.size(); ++k) {
-      se_pos += (t.truth[k].position() - t.estimate[k].position()).squaredNorm();
-      const double dh = core::normalize_angle(t.truth[k].theta - t.estimate[k].theta);
-      se_head += dh * dh;
-    }
-    const double n = double(std::max<std::size_t>(1, t.truth.size()));
+    localization::LocalizationMetrics lm;
+    for (std::size_t k = 0; k < t.truth.size(); ++k) lm.add(t.truth[k], t.estimate[k], t.covariance[k]);
+    const auto loc = lm.summary();
+    position_rmse_sum += loc.position_rmse;
     json robot = {{"robot", i + 1},
                   {"start", {t.truth.front().x, t.truth.front().y, core::rad2deg(t.truth.front().theta)}},
                   {"distance_m", t.distance_m},
                   {"blocked_moves", t.blocked_moves},
-                  {"position_rmse_m", std::sqrt(se_pos / n)},
-                  {"heading_rmse_deg", core::rad2deg(std::sqrt(se_head / n))}};
+                  {"position_rmse_m", loc.position_rmse},
+                  {"heading_rmse_deg", core::rad2deg(loc.heading_rmse)},
+                  // Standard NEES (e^T P^-1 e) averaged over the steps with a positive-definite P,
+                  // with its two-sided 95% chi-square band; seed 000's mu (e^T P e) beside it.
+                  {"nees", loc.average_nees ? json(*loc.average_nees) : json(nullptr)},
+                  {"nees_steps", loc.nees_steps},
+                  {"nees_band_95", {loc.nees_band.lower, loc.nees_band.upper}},
+                  {"nees_inside_band", loc.nees_inside_band},
+                  {"seed000_mu", loc.seed000_mu}};
     for (const auto& [name, value] : t.localizer_counters) robot["localizer"][name] = value;
     per_robot.push_back(robot);
   }
   j["distance_m"] = distance;
+  j["position_rmse_m"] = r.robots.empty() ? 0.0 : position_rmse_sum / double(r.robots.size());  // mean over robots
   j["blocked_moves"] = blocked;
   j["redundancy"] = r.redundancy;
   j["bytes_sent"] = r.bytes_sent;

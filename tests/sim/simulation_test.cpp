@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/angle.h"
 #include "maps/builtin_maps.h"
 #include "sim/run_output.h"
 #include "tests/sim/sim_test_maps.h"
@@ -120,6 +121,38 @@ TEST(SimulationBadInput, StartsAndCountsAreChecked) {
   Scenario cluster = small("room", 1, 10);
   cluster.cluster_at = Eigen::Vector2d(0.05, 1.0);
   expect_input_error([&] { Simulation(cluster, room); }, {"robots.cluster_at", "inside a wall"});
+}
+
+}  // namespace
+}  // namespace fleetmap::sim
+
+namespace fleetmap::sim {
+namespace {
+
+TEST(Simulation, EkfAgainstLandmarksBeatsOdometryAndIsConsistent) {
+  const auto grid = maps::load_map_source("warehouse");
+  Scenario s;
+  s.map = "warehouse";
+  s.robot_count = 2;
+  s.steps = 250;
+  s.noise = {0.01, core::deg2rad(0.5)};
+  s.landmarks_along_walls = 0.3;
+  s.landmark_sensor.range_noise_m = 0.05;
+  s.landmark_sensor.bearing_noise_rad = core::deg2rad(2.0);
+  s.localization = "odometry";
+  const auto odometry = metrics_json(Simulation(s, grid).run(), "warehouse");
+  s.localization = "ekf";
+  const auto ekf = metrics_json(Simulation(s, grid).run(), "warehouse");
+  EXPECT_LT(ekf["position_rmse_m"].get<double>(), 0.5 * odometry["position_rmse_m"].get<double>());
+  for (const auto& robot : ekf["per_robot"]) {
+    EXPECT_GT(robot["localizer"]["landmark_updates"].get<double>(), 100.0);
+    // The simulator's noise is the filter's model: the run-average NEES lies in its 95% band
+    // (each robot's band is for ~250 steps of a 3-dof chi-square). With two robots, the chance that
+    // a consistent filter misses is about 10%, so allow a 20% margin beyond the band.
+    const double nees = robot["nees"].get<double>(), lo = robot["nees_band_95"][0], hi = robot["nees_band_95"][1];
+    EXPECT_GT(nees, 0.8 * lo);
+    EXPECT_LT(nees, 1.2 * hi);
+  }
 }
 
 }  // namespace
