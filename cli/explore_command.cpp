@@ -9,11 +9,14 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/plan_output.h"
 #include "cli/progress.h"
 #include "core/error.h"
 #include "exploration/strategy.h"
 #include "localization/localizer.h"
+#include "core/file_io.h"
 #include "maps/builtin_maps.h"
+#include "planning/planner.h"
 #include "sim/run_output.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"
@@ -26,7 +29,9 @@ namespace {
 
 struct ExploreFlags {
   std::string scenario;
-  std::optional<std::string> map, strategy, localization, comm_range;
+  std::optional<std::string> map, strategy, localization, comm_range, path_planner;
+  std::string plan_from, plan_to, planner = "astar";
+  double plan_time = 1.0;
   std::optional<int> robots, steps, beams;
   std::optional<std::uint64_t> seed;
   std::optional<double> sensor_range;
@@ -70,7 +75,21 @@ int run_explore(const ExploreFlags& f) {
   if (f.seed) s.seed = *f.seed;
   if (f.sensor_range) s.range.max_range_m = *f.sensor_range;
   if (f.beams) s.range.beams = *f.beams, s.range.angles_rad.clear();
+  if (f.path_planner) s.path_planner = *f.path_planner;
   sim::validate_scenario(s);
+  // A plan after the run: its endpoints are checked before the run starts.
+  std::optional<Eigen::Vector2d> plan_from, plan_to;
+  if (f.plan_from.empty() != f.plan_to.empty()) throw InputError("--plan-from and --plan-to go together: give both");
+  if (!f.plan_from.empty()) {
+    planning::make_planner(f.planner);  // an unknown planner is refused before the run
+    const auto point = [](const std::string& flag, const std::string& text) {
+      const auto p = parse_pair(text);
+      if (!p) throw InputError(flag + " '" + text + "': expected x,y in metres, e.g. 2.5,4");
+      return Eigen::Vector2d(p->first, p->second);
+    };
+    plan_from = point("--plan-from", f.plan_from);
+    plan_to = point("--plan-to", f.plan_to);
+  }
 
   mapping::MapLoadOptions load;
   load.max_cells = f.max_cells;
@@ -90,14 +109,52 @@ int run_explore(const ExploreFlags& f) {
       });
   bar.finish();
 
-  auto written = sim::write_run_outputs(result, label, out);
+  // The plan on the merged map, drawn on merged.png and written to path.json.
+  std::optional<planning::PlanResult> plan;
+  mapping::Overlays extra;
+  if (plan_from) {
+    planning::PlanPathOptions o;
+    o.planner = f.planner;
+    o.space.robot_radius_m = s.robot.radius_m;
+    o.search.time_budget_s = f.plan_time;
+    o.search.seed = s.seed;
+    plan = planning::plan_path(result.merged, *plan_from, *plan_to, o);
+    if (plan->success()) {
+      char text[96];
+      std::snprintf(text, sizeof text, "%s path on the merged map, %.2f m", plan->planner.c_str(), plan->length_m);
+      extra.paths.push_back({plan->path, {20, 20, 20}, text, 3, false});
+    }
+    extra.poses.push_back({{plan_from->x(), plan_from->y(), 0.0}, s.robot.radius_m, {44, 160, 44}, "plan start"});
+    extra.poses.push_back({{plan_to->x(), plan_to->y(), 0.0}, s.robot.radius_m, {214, 39, 40}, "plan goal"});
+  }
+  auto written = sim::write_run_outputs(result, label, out, extra);
+  if (plan) {
+    core::write_file_atomic(out / "path.json",
+                            plan_json(*plan, {label, *plan_from, *plan_to, s.robot.radius_m, "obstacle", f.plan_time, s.seed})
+                                    .dump(2) +
+                                "\n");
+    written.push_back(out / "path.json");
+  }
   if (video) {
     video->finish();
     written.push_back(out / "run.mp4");
   }
+  // A plan that failed: the run's outputs are written; the plan's problem gets one line.
+  const auto plan_exit = [&]() {
+    if (!plan || plan->success()) return 0;
+    using planning::PlanStatus;
+    const bool bad_point = plan->status == PlanStatus::StartOutsideMap || plan->status == PlanStatus::StartInObstacle ||
+                           plan->status == PlanStatus::GoalOutsideMap || plan->status == PlanStatus::GoalInObstacle;
+    const bool at_start = plan->status == PlanStatus::StartOutsideMap || plan->status == PlanStatus::StartInObstacle;
+    std::fprintf(stderr, "fleetmap: %s: no path on the merged map: %s\n",
+                 bad_point ? (at_start ? ("--plan-from " + f.plan_from).c_str() : ("--plan-to " + f.plan_to).c_str())
+                           : "--plan-from/--plan-to",
+                 plan->detail.c_str());
+    return bad_point ? 2 : 1;
+  };
   if (f.quiet) {
     std::printf("%s\n", (out / "merged.png").c_str());
-    return 0;
+    return plan_exit();
   }
   const auto& sc = result.scenario;
   double distance = 0.0;
@@ -116,11 +173,15 @@ int run_explore(const ExploreFlags& f) {
               step_text(result.steps_to_99).c_str());
   std::printf("travelled %.1f m in all, redundancy %.2f, %lld bytes sent in %d meetings, %.2f s\n", distance,
               result.redundancy, static_cast<long long>(result.bytes_sent), result.meetings, result.timing.total);
+  if (plan && plan->success()) {
+    std::printf("planned on the merged map (%s): %.2f m in %zu waypoints, %.3f s\n", plan->planner.c_str(),
+                plan->length_m, plan->path.size(), plan->time_s);
+  }
   std::printf("merged map: %s\n", (out / "merged.png").c_str());
   std::printf("all outputs in %s/:", out.c_str());
   for (const auto& p : written) std::printf(" %s", p.filename().c_str());
   std::printf("\n");
-  return 0;
+  return plan_exit();
 }
 
 }  // namespace
@@ -146,6 +207,14 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--seed", f->seed, "Random seed: the same seed gives the same run [default: 1]");
   app->add_option("--sensor-range", f->sensor_range, "Laser range in metres [default: 4]")->check(CLI::PositiveNumber);
   app->add_option("--beams", f->beams, "Laser beams over 360 degrees [default: 360]")->check(CLI::PositiveNumber);
+  app->add_option("--path-planner", f->path_planner,
+                  "How robots get paths to targets: wave, or a planner of `fleetmap plan` (astar, rrtconnect, ...) "
+                  "[default: wave]");
+  app->add_option("--plan-from", f->plan_from, "After the run, plan from x,y (metres) on the merged map ...");
+  app->add_option("--plan-to", f->plan_to, "... to x,y; the path goes on merged.png and into path.json");
+  app->add_option("--planner", f->planner, "Planner for --plan-from/--plan-to (see `fleetmap plan --help`)")
+      ->capture_default_str();
+  app->add_option("--plan-time", f->plan_time, "Time budget of that plan, seconds")->capture_default_str()->check(CLI::PositiveNumber);
   app->add_option("--out", f->out, "Output folder, created if missing [default: out/<map>]");
   app->add_flag("--animate", f->animate, "Also write run.mp4, a frame per step");
   app->add_flag("--quiet,-q", f->quiet, "Print only the merged map's path; no progress bar");

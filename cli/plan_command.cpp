@@ -9,6 +9,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/plan_output.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "maps/builtin_maps.h"
@@ -40,22 +41,6 @@ struct Endpoint {
   Eigen::Vector2d point;
 };
 
-// Splits "a,b" into two numbers; nullopt unless both parse completely.
-std::optional<std::pair<double, double>> parse_pair(const std::string& text) {
-  const auto comma = text.find(',');
-  if (comma == std::string::npos) return std::nullopt;
-  const std::string a = text.substr(0, comma), b = text.substr(comma + 1);
-  if (a.empty() || b.empty()) return std::nullopt;
-  try {
-    std::size_t na = 0, nb = 0;
-    const double x = std::stod(a, &na), y = std::stod(b, &nb);
-    if (na != a.size() || nb != b.size() || !std::isfinite(x) || !std::isfinite(y)) return std::nullopt;
-    return std::pair{x, y};
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-}
-
 Endpoint endpoint(const std::string& name, const std::string& metres, const std::string& cell,
                   const mapping::OccupancyGrid& grid) {
   const std::string flag_m = "--" + name, flag_c = "--" + name + "-cell";
@@ -82,28 +67,9 @@ Endpoint endpoint(const std::string& name, const std::string& metres, const std:
   return {flag_c, cell, grid.geometry().cell_center(at)};
 }
 
-nlohmann::json point_json(const Eigen::Vector2d& p) { return nlohmann::json::array({p.x(), p.y()}); }
-
 nlohmann::json result_json(const PlanCommandOptions& o, const planning::PlanResult& r, const Endpoint& start,
                            const Endpoint& goal) {
-  nlohmann::json j;
-  j["map"] = o.map;
-  j["planner"] = r.planner;
-  j["success"] = r.success();
-  j["status"] = std::string(planning::to_string(r.status));
-  j["detail"] = r.detail;
-  j["time_s"] = r.time_s;
-  j["first_solution_s"] = r.first_solution_s ? nlohmann::json(*r.first_solution_s) : nlohmann::json(nullptr);
-  j["length_m"] = r.success() ? nlohmann::json(r.length_m) : nlohmann::json(nullptr);
-  j["start"] = point_json(start.point);
-  j["goal"] = point_json(goal.point);
-  j["robot_radius_m"] = o.radius_m;
-  j["unknown"] = o.unknown;
-  j["time_budget_s"] = o.time_s;
-  j["seed"] = o.seed;
-  j["waypoints"] = nlohmann::json::array();
-  for (const auto& p : r.path) j["waypoints"].push_back(point_json(p));
-  return j;
+  return plan_json(r, {o.map, start.point, goal.point, o.radius_m, o.unknown, o.time_s, o.seed});
 }
 
 cv::Mat picture(const PlanCommandOptions& o, const mapping::OccupancyGrid& grid, const planning::FreeSpace& space,

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <functional>
 
+#include "mapping/grid_traversal.h"
+
 namespace fleetmap::exploration {
 
 namespace {
@@ -115,6 +117,30 @@ void TeamExplorer::set_path(RobotState& r, std::vector<Cell> path, const mapping
   r.next = 0;
 }
 
+std::vector<Cell> TeamExplorer::plan(const mapping::OccupancyGrid& map, const ExplorerRobot& robot, const Cell& goal,
+                                     const WaveField& wave) {
+  if (provider_) {
+    const auto points = provider_(map, robot.pose.position(), map.geometry().cell_center(goal));
+    if (points.size() >= 2) {
+      // The cells the segments cross, in order, each once.
+      std::vector<Cell> cells;
+      for (std::size_t k = 1; k < points.size(); ++k) {
+        mapping::traverse_segment(map.geometry(), points[k - 1], points[k], [&](const Cell& c, double) {
+          if (cells.empty() || !(cells.back() == c)) cells.push_back(c);
+          return true;
+        });
+      }
+      const bool ends_at_goal = !cells.empty() && cells.back() == goal;
+      if (ends_at_goal) {
+        ++stats_.provider_paths;
+        return cells;
+      }
+    }
+    ++stats_.provider_fallbacks;
+  }
+  return wave.path_to(goal);
+}
+
 bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
                               const std::vector<std::vector<char>>& links) {
   const ExplorerRobot& robot = robots[std::size_t(i)];
@@ -205,7 +231,7 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
       give_up(i, map.observed_count());
       return false;
     }
-    set_path(r, wave_.path_to(r.goal), map);
+    set_path(r, plan(map, robot, r.goal, wave_), map);
     break;
   }
   return true;
@@ -379,7 +405,8 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
     r.finished = false;
     r.frontier = target.frontier;
     r.goal = target.goal;
-    set_path(r, waves[k].path_to(target.goal), *robots[std::size_t(members[k])].map);
+    set_path(r, plan(*robots[std::size_t(members[k])].map, robots[std::size_t(members[k])], target.goal, waves[k]),
+             *robots[std::size_t(members[k])].map);
     r.best_remaining = r.path.size();
     r.steps_since_progress = 0;
   }

@@ -4,6 +4,7 @@
 // Robots that can talk decide together (on the map of the robot that needs a target); a robot
 // that talks to nobody decides alone on its own map.
 #include <Eigen/Core>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -42,10 +43,19 @@ struct ExplorerRobot {
   core::Pose2 pose;                             // its estimated pose in that map's frame
 };
 
+// Plans a path on a robot's map from `from` to `to` (metres), or returns nothing. The simulator
+// supplies one backed by a sampling or grid planner; without one, robots follow the wave.
+using PathProvider = std::function<std::vector<Eigen::Vector2d>(const mapping::OccupancyGrid& map,
+                                                                const Eigen::Vector2d& from, const Eigen::Vector2d& to)>;
+
 class TeamExplorer {
  public:
   // Throws InputError for an unknown strategy name.
   TeamExplorer(int robots, const ExplorationOptions& options);
+
+  // New targets and replanned paths come from `provider` when it finds a path the robot can
+  // follow (every cell on it clear); otherwise from the wave. Detours around robots use the wave.
+  void set_path_provider(PathProvider provider) { provider_ = std::move(provider); }
 
   // One decision round. `links[i][j]` is true when robots i and j can talk now.
   void update(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
@@ -69,6 +79,8 @@ class TeamExplorer {
     int paths_replanned = 0;
     int detours = 0;
     int yields = 0;  // finished robots that moved out of another's way
+    int provider_paths = 0;     // paths from the path provider
+    int provider_fallbacks = 0;  // the provider found none: the wave's path was used
   };
   const Stats& stats() const { return stats_; }
   const CoordinationStrategy& strategy() const { return *strategy_; }
@@ -102,11 +114,15 @@ class TeamExplorer {
                     const std::vector<int>& claim_holders);
   bool blacklisted(const RobotState& r, const Target& t, double resolution) const;
   void set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const;
+  // The provider's path to the goal as cells, or the wave's when the provider has none.
+  std::vector<Cell> plan(const mapping::OccupancyGrid& map, const ExplorerRobot& robot, const Cell& goal,
+                         const WaveField& wave);
   // Finished robots standing on the path of robot `stuck` move to the nearest place clear of it.
   void make_way(int stuck, const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
 
   ExplorationOptions options_;
   std::unique_ptr<CoordinationStrategy> strategy_;
+  PathProvider provider_;
   std::vector<RobotState> robots_;
   WaveField wave_;  // reused storage
   Stats stats_;

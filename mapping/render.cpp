@@ -165,6 +165,7 @@ cv::Mat decorate(const cv::Mat& base, const core::GridGeometry& geometry, const 
 
   constexpr int kRow = 22, kPad = 10, kSwatch = 14;
   int panel_w = std::max(160, bar_px + 2 * kPad);
+  if (!options.title.empty()) panel_w = std::max(panel_w, cv::getTextSize(options.title, kFont, 0.6, 1, nullptr).width + 2 * kPad);
   for (const auto& e : legend) panel_w = std::max(panel_w, cv::getTextSize(e.label, kFont, kFontScale, 1, nullptr).width + 3 * kPad + kSwatch + 10);
   const int title_h = options.title.empty() ? 0 : 30;
   const int rows = options.legend ? int(legend.size()) : 0;

@@ -113,7 +113,10 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
                       {"unobservable_frontiers", r.exploration.unobservable},
                       {"paths_replanned", r.exploration.paths_replanned},
                       {"detours", r.exploration.detours},
-                      {"yields", r.exploration.yields}};
+                      {"yields", r.exploration.yields},
+                      {"path_planner", r.scenario.path_planner},
+                      {"planner_paths", r.exploration.provider_paths},
+                      {"planner_fallbacks", r.exploration.provider_fallbacks}};
   j["coverage_curve"] = r.coverage;
   const auto& tm = r.timing;
   j["timing"] = {{"total_s", tm.total},           {"motion_s", tm.motion},
@@ -124,7 +127,7 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   return j;
 }
 
-cv::Mat render_merged(const RunResult& r, const std::string& map_label) {
+cv::Mat render_merged(const RunResult& r, const std::string& map_label, const mapping::Overlays& extra) {
   mapping::Overlays o;
   const bool show_estimates = r.scenario.localization != "ideal";
   for (std::size_t i = 0; i < r.robots.size(); ++i) {
@@ -136,6 +139,10 @@ cv::Mat render_merged(const RunResult& r, const std::string& map_label) {
     o.poses.push_back({t.truth.back(), r.scenario.robot.radius_m, colour, ""});
   }
   if (!r.landmarks.empty()) o.points.push_back({r.landmarks, {200, 0, 200}, "landmarks", 3});
+  o.cells.insert(o.cells.end(), extra.cells.begin(), extra.cells.end());
+  o.paths.insert(o.paths.end(), extra.paths.begin(), extra.paths.end());
+  o.points.insert(o.points.end(), extra.points.begin(), extra.points.end());
+  o.poses.insert(o.poses.end(), extra.poses.begin(), extra.poses.end());
   char buf[128];
   std::snprintf(buf, sizeof buf, ", %d steps, %.1f%%", r.steps, 100.0 * (r.coverage.empty() ? 0.0 : r.coverage.back()));
   return mapping::render_map(r.merged, o, render_options(title(r, map_label) + buf));
@@ -151,11 +158,12 @@ cv::Mat render_robot(const RunResult& r, int robot, const std::string& map_label
                              render_options(map_label + ": robot " + std::to_string(robot + 1) + "'s map"));
 }
 
-std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& map_label, const fs::path& dir) {
+std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& map_label, const fs::path& dir,
+                                        const mapping::Overlays& extra) {
   core::ensure_directory(dir);
   std::vector<fs::path> written;
   const auto add = [&](const fs::path& p) { written.push_back(p); };
-  mapping::write_image(dir / "merged.png", render_merged(r, map_label));
+  mapping::write_image(dir / "merged.png", render_merged(r, map_label, extra));
   add(dir / "merged.png");
   for (std::size_t i = 0; i < r.robot_maps.size(); ++i) {
     const fs::path p = dir / ("robot_" + std::to_string(i + 1) + ".png");

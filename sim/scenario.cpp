@@ -11,6 +11,7 @@
 #include "core/file_io.h"
 #include "core/yaml_reader.h"
 #include "exploration/strategy.h"
+#include "planning/planner.h"
 
 namespace fleetmap::sim {
 
@@ -67,6 +68,12 @@ std::string quoted(const std::string& text) {
 }  // namespace
 
 std::vector<std::string> merging_names() { return {"known"}; }
+
+std::vector<std::string> path_planner_names() {
+  std::vector<std::string> names = {"wave"};
+  for (const auto& n : planning::planner_names()) names.push_back(n);
+  return names;
+}
 
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
   const YAML::Node root = core::parse_yaml(text, source);
@@ -179,6 +186,8 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     e.targets.piece_radius_m = ex.number("piece_radius", e.targets.piece_radius_m, 1e-3, 1e6);
     e.targets.frontiers.min_region_cells = int(ex.integer("min_frontier_cells", e.targets.frontiers.min_region_cells, 1, 1'000'000));
     e.traversability.safety_margin_m = ex.number("safety_margin", e.traversability.safety_margin_m, 0.0, 100.0);
+    s.path_planner = ex.choice("path_planner", s.path_planner, path_planner_names());
+    s.planner_time_s = ex.number("planner_time", s.planner_time_s, 1e-3, 3600.0);
     ex.finish();
   }
   s.merging = top.choice("merging", s.merging, merging_names());
@@ -219,6 +228,8 @@ void validate_scenario(const Scenario& s) {
   check_name("exploration.strategy", s.exploration.strategy, exploration::strategy_names());
   check_name("localization", s.localization, localization::localizer_names());
   check_name("merging", s.merging, merging_names());
+  check_name("exploration.path_planner", s.path_planner, path_planner_names());
+  if (!(s.planner_time_s > 0.0)) throw InputError("exploration.planner_time: must be positive, got " + fmt(s.planner_time_s));
 }
 
 std::string scenario_to_yaml(const Scenario& s) {
@@ -267,7 +278,8 @@ std::string scenario_to_yaml(const Scenario& s) {
     << "\n  directional_weight: " << fmt(e.strategy_options.directional_weight)
     << "\n  eight_connected: " << (e.wave.eight_connected ? "true" : "false") << "\n  occupancy_weight: " << fmt(e.wave.occupancy_weight)
     << "\n  stall_steps: " << e.stall_steps << "\n  piece_radius: " << fmt(e.targets.piece_radius_m)
-    << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m) << "\n";
+    << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m)
+    << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s) << "\n";
   y << "merging: " << s.merging << "\nlookahead: " << fmt(s.lookahead_m) << "\n";
   return y.str();
 }

@@ -46,9 +46,15 @@ struct Scenario {
   exploration::ExplorationOptions exploration;
   std::string merging = "known";             // how robots bring others' maps into their frame
   double lookahead_m = 0.5;                  // path following
+  // How robots get a path to their target: "wave" (the wave's steepest descent) or a planner of
+  // planning/ by name (astar, rrtconnect, rrtstar, ...), given `planner_time_s` per path.
+  std::string path_planner = "wave";
+  double planner_time_s = 0.1;
 };
 
 std::vector<std::string> merging_names();
+// "wave" and every planner of planning/.
+std::vector<std::string> path_planner_names();
 
 // Parses scenario YAML; `source` names it in errors and `base_dir` anchors relative map paths.
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "core/error.h"
+#include "planning/planner.h"
 #include "sim/motion.h"
 #include "sim/sensors.h"
 
@@ -177,6 +178,20 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
     context.seed = rng_.fork(300 + std::uint64_t(i)).seed();
     localizers_.push_back(localization::make_localizer(scenario_.localization, context));
     maps_.emplace_back(world_.geometry());
+  }
+  if (scenario_.path_planner != "wave") {
+    planning::PlanPathOptions plan;
+    plan.planner = scenario_.path_planner;
+    // The same clearance the explorer keeps, so the paths it gets are ones it accepts.
+    plan.space.robot_radius_m = scenario_.exploration.traversability.robot_radius_m +
+                                scenario_.exploration.traversability.safety_margin_m;
+    plan.search.time_budget_s = scenario_.planner_time_s;
+    plan.search.seed = scenario_.seed;
+    explorer_.set_path_provider([plan](const mapping::OccupancyGrid& map, const Eigen::Vector2d& from,
+                                       const Eigen::Vector2d& to) {
+      const planning::PlanResult r = planning::plan_path(map, from, to, plan);
+      return r.success() ? r.path : std::vector<Eigen::Vector2d>{};
+    });
   }
   tracks_.resize(std::size_t(n));
   was_finished_.assign(std::size_t(n), 0);

@@ -139,3 +139,39 @@ TEST(ExploreCommand, HelpListsStrategiesAndLocalizers) {
 
 }  // namespace
 }  // namespace fleetmap::cli
+
+namespace fleetmap::cli {
+namespace {
+
+TEST(ExploreCommand, PlansOnTheMergedMapAfterTheRun) {
+  TempDir dir;
+  auto r = run_fleetmap("explore --map empty --robots 2 --out p --plan-from 2,2 --plan-to 17,17 --planner astar", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto path = nlohmann::json::parse(slurp(dir / "p" / "path.json"));
+  EXPECT_TRUE(path["success"].get<bool>());
+  EXPECT_EQ(path["planner"], "astar");
+  // Straight across the empty square: about sqrt(2) * 15 m.
+  EXPECT_NEAR(path["length_m"].get<double>(), 15.0 * std::sqrt(2.0), 0.5);
+  EXPECT_NE(r.out.find("planned on the merged map"), std::string::npos);
+  // Endpoints are checked before the run; a failed plan still leaves the run's outputs.
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --plan-from 2,x --plan-to 3,3", dir), "--plan-from '2,x'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --plan-from 2,2", dir), "go together");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --plan-from 2,2 --plan-to 3,3 --planner magic", dir), "magic");
+  r = run_fleetmap("explore --map empty --robots 2 --steps 3 --out q --plan-from 10,10 --plan-to 0.05,0.05", dir);
+  EXPECT_ONE_LINE_ERROR(r, "--plan-to 0.05,0.05");
+  EXPECT_TRUE(std::filesystem::exists(dir / "q" / "merged.png"));
+  EXPECT_FALSE(nlohmann::json::parse(slurp(dir / "q" / "path.json"))["success"].get<bool>());
+}
+
+TEST(ExploreCommand, RobotsCanFollowPlannerPaths) {
+  TempDir dir;
+  const auto r = run_fleetmap("explore --map office --robots 3 --steps 80 --path-planner astar --out a", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto m = metrics(dir / "a");
+  EXPECT_EQ(m["exploration"]["path_planner"], "astar");
+  EXPECT_GT(m["exploration"]["planner_paths"].get<int>(), 0);
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --path-planner teleport --steps 1", dir), "teleport");
+}
+
+}  // namespace
+}  // namespace fleetmap::cli

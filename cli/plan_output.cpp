@@ -1,0 +1,48 @@
+#include "cli/plan_output.h"
+
+#include <cmath>
+#include <exception>
+
+namespace fleetmap::cli {
+
+std::optional<std::pair<double, double>> parse_pair(const std::string& text) {
+  const auto comma = text.find(',');
+  if (comma == std::string::npos) return std::nullopt;
+  const std::string a = text.substr(0, comma), b = text.substr(comma + 1);
+  if (a.empty() || b.empty()) return std::nullopt;
+  try {
+    std::size_t na = 0, nb = 0;
+    const double x = std::stod(a, &na), y = std::stod(b, &nb);
+    if (na != a.size() || nb != b.size() || !std::isfinite(x) || !std::isfinite(y)) return std::nullopt;
+    return std::pair{x, y};
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+namespace {
+nlohmann::json point_json(const Eigen::Vector2d& p) { return nlohmann::json::array({p.x(), p.y()}); }
+}  // namespace
+
+nlohmann::json plan_json(const planning::PlanResult& r, const PlanJsonContext& c) {
+  nlohmann::json j;
+  j["map"] = c.map;
+  j["planner"] = r.planner;
+  j["success"] = r.success();
+  j["status"] = std::string(planning::to_string(r.status));
+  j["detail"] = r.detail;
+  j["time_s"] = r.time_s;
+  j["first_solution_s"] = r.first_solution_s ? nlohmann::json(*r.first_solution_s) : nlohmann::json(nullptr);
+  j["length_m"] = r.success() ? nlohmann::json(r.length_m) : nlohmann::json(nullptr);
+  j["start"] = point_json(c.start);
+  j["goal"] = point_json(c.goal);
+  j["robot_radius_m"] = c.robot_radius_m;
+  j["unknown"] = c.unknown;
+  j["time_budget_s"] = c.time_budget_s;
+  j["seed"] = c.seed;
+  j["waypoints"] = nlohmann::json::array();
+  for (const auto& p : r.path) j["waypoints"].push_back(point_json(p));
+  return j;
+}
+
+}  // namespace fleetmap::cli
