@@ -29,7 +29,7 @@ namespace {
 
 struct ExploreFlags {
   std::string scenario;
-  std::optional<std::string> map, strategy, localization, comm_range, path_planner;
+  std::optional<std::string> map, strategy, localization, comm_range, path_planner, merging;
   std::string plan_from, plan_to, planner = "astar";
   double plan_time = 1.0;
   std::optional<int> robots, steps, beams;
@@ -71,6 +71,7 @@ int run_explore(const ExploreFlags& f) {
   if (f.strategy) s.exploration.strategy = *f.strategy;
   if (f.localization) s.localization = *f.localization;
   if (f.comm_range) s.communication.range_m = parse_range(*f.comm_range);
+  if (f.merging) s.merging = *f.merging;
   if (f.steps) s.steps = *f.steps;
   if (f.seed) s.seed = *f.seed;
   if (f.sensor_range) s.range.max_range_m = *f.sensor_range;
@@ -173,6 +174,18 @@ int run_explore(const ExploreFlags& f) {
               step_text(result.steps_to_99).c_str());
   std::printf("travelled %.1f m in all, redundancy %.2f, %lld bytes sent in %d meetings, %.2f s\n", distance,
               result.redundancy, static_cast<long long>(result.bytes_sent), result.meetings, result.timing.total);
+  if (sc.merging != "known") {
+    int made = 0;
+    double worst_deg = 0.0, worst_m = 0.0;
+    for (const auto& m : result.merges) {
+      if (!m.merged) continue;
+      ++made;
+      worst_deg = std::max(worst_deg, m.rotation_error_deg);
+      worst_m = std::max(worst_m, m.position_error_m);
+    }
+    std::printf("merging (%s): %d merges made, %zu refused; worst error against the truth %.2f deg, %.3f m\n",
+                sc.merging.c_str(), made, result.merges.size() - made, worst_deg, worst_m);
+  }
   if (plan && plan->success()) {
     std::printf("planned on the merged map (%s): %.2f m in %zu waypoints, %.3f s\n", plan->planner.c_str(),
                 plan->length_m, plan->path.size(), plan->time_s);
@@ -192,6 +205,12 @@ Command add_explore_command(CLI::App& root) {
       "Explore a map with a team of simulated robots; writes the merged map, each robot's map, metrics and map files.\n\n"
       "Strategies (--strategy):\n" +
           exploration::strategy_help() + "\nLocalization (--localization):\n" + localization::localizer_help() +
+          "\nMerging (--merging): how robots bring each other's maps into their own frame\n"
+          "  known       every robot knows its start pose in one shared frame (default)\n"
+          "  rendezvous  each robot maps in its own frame; robots that detect each other take the\n"
+          "              relative transform from the detection (seed 000 section 3.2)\n"
+          "  overlap     each robot maps in its own frame; robots that can talk search their maps for\n"
+          "              the best overlap (as `fleetmap merge`) and merge only above a confidence\n"
           "\nFlags override the scenario file; without one, the defaults below apply.");
   auto f = std::make_shared<ExploreFlags>();
   app->add_option("--scenario", f->scenario, "Scenario YAML file (see scenarios/); flags below override it")
@@ -203,6 +222,7 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]");
   app->add_option("--comm-range", f->comm_range,
                   "Communication range in metres; 0 = only when robots see each other; inf = always [default: inf]");
+  app->add_option("--merging", f->merging, "known, rendezvous or overlap (see above) [default: known]");
   app->add_option("--steps", f->steps, "Step limit [default: 2000]")->check(CLI::PositiveNumber);
   app->add_option("--seed", f->seed, "Random seed: the same seed gives the same run [default: 1]");
   app->add_option("--sensor-range", f->sensor_range, "Laser range in metres [default: 4]")->check(CLI::PositiveNumber);

@@ -67,6 +67,8 @@ class TeamExplorer {
   // No reachable frontier is left for the robot (on its map); it may resume when its map grows.
   bool finished(int i) const { return robots_[std::size_t(i)].finished; }
   bool all_finished() const;
+  // Forgets robot i's target, path and given-up places (its map moved to another frame).
+  void reset_robot(int i) { robots_[std::size_t(i)] = RobotState{}; }
 
   struct Stats {
     int assignment_rounds = 0;

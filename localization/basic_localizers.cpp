@@ -2,9 +2,20 @@
 #include <cmath>
 
 #include "localization/localizer.h"
+#include "core/error.h"
 #include "localization/localizers.h"
 
 namespace fleetmap::localization {
+
+void Localizer::change_frame(const core::Transform2&) {
+  throw Error("localization '" + name() + "' cannot move its estimate into another map frame");
+}
+
+Eigen::Matrix3d rotate_pose_covariance(const Eigen::Matrix3d& covariance, double angle) {
+  Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
+  j.topLeftCorner<2, 2>() = core::Transform2(0.0, 0.0, angle).rotation_matrix();
+  return j * covariance * j.transpose();
+}
 
 core::Pose2 integrate_motion(const core::Pose2& p, const Odometry& u) {
   const double dtheta = u.omega * u.dt;
@@ -27,6 +38,7 @@ class IdealLocalizer final : public Localizer {
   void observe_truth(const core::Pose2& truth) override { pose_ = truth; }
   core::Pose2 pose() const override { return pose_; }
   Eigen::Matrix3d covariance() const override { return Eigen::Matrix3d::Zero(); }
+  void change_frame(const core::Transform2& t) override { pose_ = core::Pose2::from_transform(t * pose_.as_transform()); }
 
  private:
   core::Pose2 pose_;
@@ -55,6 +67,10 @@ class OdometryLocalizer final : public Localizer {
   }
   core::Pose2 pose() const override { return pose_; }
   Eigen::Matrix3d covariance() const override { return covariance_; }
+  void change_frame(const core::Transform2& t) override {
+    pose_ = core::Pose2::from_transform(t * pose_.as_transform());
+    covariance_ = rotate_pose_covariance(covariance_, t.rotation());
+  }
 
  private:
   core::Pose2 pose_;

@@ -173,4 +173,20 @@ NearestNeighbourAssociation associate_nearest_neighbour(const Eigen::MatrixXd& d
   return out;
 }
 
+void EkfCore::change_frame(const core::Transform2& t) {
+  const core::Pose2 p = core::Pose2::from_transform(t * pose().as_transform());
+  mean_(0) = p.x;
+  mean_(1) = p.y;
+  mean_(2) = p.theta;
+  const Eigen::Matrix2d r = t.rotation_matrix();
+  for (int slot = 0; slot < landmark_count(); ++slot) mean_.segment<2>(offset(slot)) = t.apply(landmark(slot));
+  // J: R on every (x, y) pair, 1 on the heading.
+  const Eigen::Index n = mean_.size();
+  Eigen::MatrixXd j = Eigen::MatrixXd::Identity(n, n);
+  j.block<2, 2>(0, 0) = r;
+  for (int slot = 0; slot < landmark_count(); ++slot) j.block<2, 2>(offset(slot), offset(slot)) = r;
+  covariance_ = j * covariance_ * j.transpose();
+  covariance_ = 0.5 * (covariance_ + covariance_.transpose());
+}
+
 }  // namespace fleetmap::localization

@@ -54,6 +54,9 @@ class EkfCore {
   // Removes the slots' rows and columns (seed 000 §3.1); later slots move down to fill the gaps.
   void remove_landmarks(const std::vector<int>& slots);
 
+  // x_new = t x_old for the pose and every landmark; P_new = J P J^T with J the block rotation.
+  void change_frame(const core::Transform2& t);
+
   core::Pose2 pose() const { return {mean_(0), mean_(1), mean_(2)}; }
   Eigen::Matrix3d pose_covariance() const { return covariance_.topLeftCorner<3, 3>(); }
   int landmark_count() const { return static_cast<int>((mean_.size() - 3) / 2); }

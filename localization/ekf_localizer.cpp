@@ -76,6 +76,14 @@ class EkfLocalizer final : public Localizer {
 
   core::Pose2 pose() const override { return filter_.pose(); }
   Eigen::Matrix3d covariance() const override { return filter_.pose_covariance(); }
+  // The known landmark map moves with the frame (the robot knows it in its own frame).
+  void change_frame(const core::Transform2& t) override {
+    filter_.change_frame(t);
+    for (Landmark& l : landmarks_) {
+      l.position = t.apply(l.position);
+      l.covariance = t.rotation_matrix() * l.covariance * t.rotation_matrix().transpose();
+    }
+  }
 
   std::vector<std::pair<std::string, double>> counters() const override {
     return {{"landmark_updates", static_cast<double>(landmark_updates_)},

@@ -89,6 +89,7 @@ class EkfSlamLocalizer final : public Localizer {
 
   core::Pose2 pose() const override { return filter_.pose(); }
   Eigen::Matrix3d covariance() const override { return filter_.pose_covariance(); }
+  void change_frame(const core::Transform2& t) override { filter_.change_frame(t); }
 
   std::vector<std::pair<std::string, double>> counters() const override {
     return {{"landmark_updates", static_cast<double>(landmark_updates_)},

@@ -108,6 +108,11 @@ class Localizer {
   virtual core::Pose2 pose() const = 0;
   virtual Eigen::Matrix3d covariance() const = 0;
 
+  // Re-expresses everything the localizer holds (pose, covariance, landmarks) in another frame:
+  // x_new = new_from_old * x_old. Used when a robot adopts a teammate's map frame after a merge.
+  // The default throws fleetmap::Error: a localizer that cannot be moved cannot join another frame.
+  virtual void change_frame(const core::Transform2& new_from_old);
+
   // Counters for metrics.json. `ekf` and `ekf-slam`: "landmark_updates", "rejected_associations",
   // "robot_updates", "rejected_robot_detections"; `ekf-slam` also "landmarks_in_state",
   // "landmarks_added", "landmarks_removed".

@@ -7,6 +7,9 @@
 
 namespace fleetmap::localization {
 
+// The covariance of a pose whose frame turns by `angle`: J P J^T with J = diag(R(angle), 1).
+Eigen::Matrix3d rotate_pose_covariance(const Eigen::Matrix3d& covariance, double angle);
+
 std::unique_ptr<Localizer> make_ideal_localizer(const LocalizerContext& context);
 std::unique_ptr<Localizer> make_odometry_localizer(const LocalizerContext& context);
 std::unique_ptr<Localizer> make_ekf_localizer(const LocalizerContext& context);       // ekf_localizer.cpp

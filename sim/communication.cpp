@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.h"
 #include "mapping/ray_cast.h"
 
 namespace fleetmap::sim {
@@ -31,51 +32,89 @@ std::vector<std::vector<char>> communication_links(const World& world, const std
 }
 
 MapExchange::MapExchange(int robots, const core::GridGeometry& g)
-    : width_(g.width()), height_(g.height()),
-      tiles_x_((g.width() + kTileSize - 1) / kTileSize), tiles_y_((g.height() + kTileSize - 1) / kTileSize),
-      tile_version_(std::size_t(robots), std::vector<std::uint64_t>(std::size_t(tiles_x_) * std::size_t(tiles_y_), 0)),
-      last_exchange_(std::size_t(robots), std::vector<std::uint64_t>(std::size_t(robots), 0)) {}
+    : MapExchange(std::vector<core::GridGeometry>(std::size_t(robots), g)) {}
+
+MapExchange::MapExchange(const std::vector<core::GridGeometry>& geometries)
+    : tiles_(geometries.size()),
+      last_exchange_(geometries.size(), std::vector<std::uint64_t>(geometries.size(), 0)) {
+  for (std::size_t i = 0; i < geometries.size(); ++i) {
+    reset(int(i), geometries[i]);
+    std::fill(tiles_[i].version.begin(), tiles_[i].version.end(), 0);  // empty maps: nothing to send yet
+  }
+}
+
+void MapExchange::reset(int robot, const core::GridGeometry& g) {
+  Tiles& t = tiles_[std::size_t(robot)];
+  t.width = g.width();
+  t.height = g.height();
+  t.tiles_x = (g.width() + kTileSize - 1) / kTileSize;
+  t.tiles_y = (g.height() + kTileSize - 1) / kTileSize;
+  t.version.assign(std::size_t(t.tiles_x) * std::size_t(t.tiles_y), ++clock_);
+  // In its new frame the robot has exchanged nothing with anyone yet.
+  for (std::size_t k = 0; k < last_exchange_.size(); ++k) {
+    last_exchange_[std::size_t(robot)][k] = last_exchange_[k][std::size_t(robot)] = 0;
+  }
+}
 
 std::vector<int> MapExchange::changed_tiles(int robot, std::uint64_t since) const {
   std::vector<int> tiles;
-  const auto& versions = tile_version_[std::size_t(robot)];
+  const auto& versions = tiles_[std::size_t(robot)].version;
   for (int t = 0; t < int(versions.size()); ++t) {
     if (versions[std::size_t(t)] > since) tiles.push_back(t);
   }
   return tiles;
 }
 
+std::int64_t MapExchange::tile_bytes(const Tiles& t, int tile) const {
+  const int tx = tile % t.tiles_x, ty = tile / t.tiles_x;
+  const int x1 = std::min(t.width, (tx + 1) * kTileSize), y1 = std::min(t.height, (ty + 1) * kTileSize);
+  return kTileHeaderBytes + std::int64_t(x1 - tx * kTileSize) * (y1 - ty * kTileSize);
+}
+
 std::int64_t MapExchange::send(int from, int to, const std::vector<int>& tiles,
                                std::vector<mapping::OccupancyGrid>& maps) {
   const auto& src = maps[std::size_t(from)];
   auto& dst = maps[std::size_t(to)];
+  const Tiles& t = tiles_[std::size_t(from)];
   std::int64_t bytes = 0;
-  for (const int t : tiles) {
-    const int tx = t % tiles_x_, ty = t / tiles_x_;
-    const int x1 = std::min(width_, (tx + 1) * kTileSize), y1 = std::min(height_, (ty + 1) * kTileSize);
-    bytes += kTileHeaderBytes + std::int64_t(x1 - tx * kTileSize) * (y1 - ty * kTileSize);
+  for (const int tile : tiles) {
+    const int tx = tile % t.tiles_x, ty = tile / t.tiles_x;
+    const int x1 = std::min(t.width, (tx + 1) * kTileSize), y1 = std::min(t.height, (ty + 1) * kTileSize);
+    bytes += tile_bytes(t, tile);
     bool changed = false;
     for (int y = ty * kTileSize; y < y1; ++y) {
       for (int x = tx * kTileSize; x < x1; ++x) {
-        const float ls = src.log_odds_at(y * width_ + x), ld = dst.log_odds_at(y * width_ + x);
+        const float ls = src.log_odds_at(y * t.width + x), ld = dst.log_odds_at(y * t.width + x);
         if (ld == 0.0f && ls != 0.0f) {
           dst.set_log_odds({x, y}, ls);
           changed = true;
         }
       }
     }
-    if (changed) tile_version_[std::size_t(to)][std::size_t(t)] = ++clock_;
+    if (changed) tiles_[std::size_t(to)].version[std::size_t(tile)] = ++clock_;
   }
   return bytes;
 }
 
 std::int64_t MapExchange::exchange(int i, int j, std::vector<mapping::OccupancyGrid>& maps) {
+  if (!(maps[std::size_t(i)].geometry() == maps[std::size_t(j)].geometry())) {
+    throw Error("MapExchange::exchange: robots " + std::to_string(i) + " and " + std::to_string(j) +
+                " do not share a map frame");
+  }
   const std::uint64_t since = last_exchange_[std::size_t(i)][std::size_t(j)];
   // Both directions are chosen before either is applied: what one just got is not echoed back, and
   // what each changed before talking is never hidden by what it receives.
   const std::vector<int> from_i = changed_tiles(i, since), from_j = changed_tiles(j, since);
   const std::int64_t bytes = send(i, j, from_i, maps) + send(j, i, from_j, maps);
   last_exchange_[std::size_t(i)][std::size_t(j)] = last_exchange_[std::size_t(j)][std::size_t(i)] = clock_;
+  return bytes;
+}
+
+std::int64_t MapExchange::send_without_fusing(int from, int to) {
+  std::uint64_t& since = last_exchange_[std::size_t(from)][std::size_t(to)];
+  std::int64_t bytes = 0;
+  for (const int tile : changed_tiles(from, since)) bytes += tile_bytes(tiles_[std::size_t(from)], tile);
+  since = clock_;
   return bytes;
 }
 

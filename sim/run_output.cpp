@@ -101,6 +101,24 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   j["reachable_free_cells"] = r.reachable_free_cells;
   j["landmarks"] = r.landmarks.size();
   j["per_robot"] = per_robot;
+  json merges = json::array();
+  int merged = 0, refused = 0;
+  for (const auto& m : r.merges) {
+    json e = {{"step", m.step}, {"receiver", m.receiver + 1}, {"sender", m.sender + 1}, {"method", m.method},
+              {"merged", m.merged}, {"confidence", m.confidence}};
+    if (m.merged) {
+      e["rotation_error_deg"] = m.rotation_error_deg;
+      e["position_error_m"] = m.position_error_m;
+      ++merged;
+    } else {
+      e["reason"] = m.reason;
+      ++refused;
+    }
+    merges.push_back(e);
+  }
+  j["merges"] = merges;
+  j["merges_made"] = merged;
+  j["merges_refused"] = refused;
   std::map<std::string, int> event_counts;
   for (const auto& e : r.events) ++event_counts[e.kind];
   j["events"] = event_counts;
@@ -151,9 +169,14 @@ cv::Mat render_merged(const RunResult& r, const std::string& map_label, const ma
 cv::Mat render_robot(const RunResult& r, int robot, const std::string& map_label) {
   const auto& t = r.robots[std::size_t(robot)];
   const auto colour = mapping::palette_color(robot);
+  // The robot's map is in its own frame; its estimates were recorded in the world's.
+  const core::Transform2 to_frame = r.robot_frames[std::size_t(robot)].inverse();
+  std::vector<Eigen::Vector2d> trajectory;
+  for (const auto& p : t.estimate) trajectory.push_back(to_frame.apply(p.position()));
+  const core::Pose2 last = core::Pose2::from_transform(to_frame * t.estimate.back().as_transform());
   mapping::Overlays o;
-  o.paths.push_back({positions(t.estimate), colour, "trajectory (estimate)", 2, false});
-  o.poses.push_back({t.estimate.back(), r.scenario.robot.radius_m, colour, "robot " + std::to_string(robot + 1)});
+  o.paths.push_back({trajectory, colour, "trajectory (estimate)", 2, false});
+  o.poses.push_back({last, r.scenario.robot.radius_m, colour, "robot " + std::to_string(robot + 1)});
   return mapping::render_map(r.robot_maps[std::size_t(robot)], o,
                              render_options(map_label + ": robot " + std::to_string(robot + 1) + "'s map"));
 }

@@ -11,6 +11,7 @@
 #include "core/file_io.h"
 #include "core/yaml_reader.h"
 #include "exploration/strategy.h"
+#include "merging/merge.h"
 #include "planning/planner.h"
 
 namespace fleetmap::sim {
@@ -67,7 +68,7 @@ std::string quoted(const std::string& text) {
 
 }  // namespace
 
-std::vector<std::string> merging_names() { return {"known"}; }
+std::vector<std::string> merging_names() { return {"known", "rendezvous", "overlap"}; }
 
 std::vector<std::string> path_planner_names() {
   std::vector<std::string> names = {"wave"};
@@ -190,7 +191,16 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     s.planner_time_s = ex.number("planner_time", s.planner_time_s, 1e-3, 3600.0);
     ex.finish();
   }
-  s.merging = top.choice("merging", s.merging, merging_names());
+  if (const auto m = top.node("merging"); m && m->IsScalar()) {
+    s.merging = top.choice("merging", s.merging, merging_names());
+  } else {
+    auto merge = top.map("merging");
+    s.merging = merge.choice("mode", s.merging, merging_names());
+    s.merge_method = merge.choice("method", s.merge_method, merging::merge_method_names());
+    s.merge_min_confidence = merge.number("min_confidence", s.merge_min_confidence, 0.0, 1.0);
+    s.merge_attempt_every = int(merge.integer("attempt_every", s.merge_attempt_every, 1, 1'000'000));
+    merge.finish();
+  }
   s.lookahead_m = top.number("lookahead", s.lookahead_m, 0.0, 1e6);
   top.finish();
   validate_scenario(s);
@@ -228,6 +238,7 @@ void validate_scenario(const Scenario& s) {
   check_name("exploration.strategy", s.exploration.strategy, exploration::strategy_names());
   check_name("localization", s.localization, localization::localizer_names());
   check_name("merging", s.merging, merging_names());
+  check_name("merging.method", s.merge_method, merging::merge_method_names());
   check_name("exploration.path_planner", s.path_planner, path_planner_names());
   if (!(s.planner_time_s > 0.0)) throw InputError("exploration.planner_time: must be positive, got " + fmt(s.planner_time_s));
 }
@@ -280,7 +291,9 @@ std::string scenario_to_yaml(const Scenario& s) {
     << "\n  stall_steps: " << e.stall_steps << "\n  piece_radius: " << fmt(e.targets.piece_radius_m)
     << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m)
     << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s) << "\n";
-  y << "merging: " << s.merging << "\nlookahead: " << fmt(s.lookahead_m) << "\n";
+  y << "merging:\n  mode: " << s.merging << "\n  method: " << s.merge_method << "\n  min_confidence: "
+    << fmt(s.merge_min_confidence) << "\n  attempt_every: " << s.merge_attempt_every << "\n";
+  y << "lookahead: " << fmt(s.lookahead_m) << "\n";
   return y.str();
 }
 

@@ -44,7 +44,14 @@ struct Scenario {
   localization::LocalizerOptions localization_options;
   CommunicationOptions communication;
   exploration::ExplorationOptions exploration;
-  std::string merging = "known";             // how robots bring others' maps into their frame
+  // How robots bring others' maps into their frame: "known" (every robot knows its start pose in a
+  // common frame), "rendezvous" (each robot maps in its own frame; robots that detect each other
+  // compute the relative transform from the detection, seed 000 §3.2) or "overlap" (robots that can
+  // talk search their maps for the best overlap, merging/).
+  std::string merging = "known";
+  std::string merge_method = "auto";         // overlap: a method of `fleetmap merge`
+  double merge_min_confidence = 0.5;         // overlap: below, no merge
+  int merge_attempt_every = 20;              // overlap: steps between attempts of the same pair
   double lookahead_m = 0.5;                  // path following
   // How robots get a path to their target: "wave" (the wave's steepest descent) or a planner of
   // planning/ by name (astar, rrtconnect, rrtstar, ...), given `planner_time_s` per path.

@@ -5,8 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "core/error.h"
+#include "core/angle.h"
+#include "localization/localizers.h"
+#include "merging/merge.h"
+#include "merging/rendezvous.h"
 #include "planning/planner.h"
 #include "sim/motion.h"
 #include "sim/sensors.h"
@@ -163,6 +168,34 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   const int n = scenario_.robot_count;
   if (n > 64) throw InputError("robots: at most 64 robots");
 
+  // Map frames: one shared world frame, or one per robot, its origin at the robot's start.
+  if (scenario_.merging == "known") {
+    frame_of_.assign(std::size_t(n), 0);
+    frame_origin_ = {core::Transform2::identity()};
+    frame_geometry_ = {world_.geometry()};
+  } else {
+    const auto& g = world_.geometry();
+    for (int i = 0; i < n; ++i) {
+      frame_of_.push_back(i);
+      frame_origin_.push_back(truths_[std::size_t(i)].as_transform());
+      // Large enough to hold the whole world around the start, however the frame is turned.
+      double reach = 0.0;
+      for (const auto& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(g.width(), 0), Eigen::Vector2d(0, g.height()),
+                                 Eigen::Vector2d(g.width(), g.height())}) {
+        reach = std::max(reach, (g.grid_to_world(corner) - truths_[std::size_t(i)].position()).norm());
+      }
+      const int cells = 2 * int(std::ceil((reach + 1.0) / g.resolution()));
+      const double half = 0.5 * cells * g.resolution();
+      frame_geometry_.emplace_back(g.resolution(), cells, cells, core::Pose2(-half, -half, 0.0));
+    }
+  }
+  {
+    std::vector<core::GridGeometry> geometries;
+    for (int i = 0; i < n; ++i) geometries.push_back(frame_geometry_[std::size_t(frame_of_[std::size_t(i)])]);
+    exchange_ = MapExchange(geometries);
+  }
+  last_attempt_.assign(std::size_t(n), std::vector<int>(std::size_t(n), std::numeric_limits<int>::min() / 2));
+
   localization::LocalizerContext context;
   context.options = scenario_.localization_options;
   context.options.process_noise_xy = scenario_.noise.position_m;
@@ -170,14 +203,19 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   context.options.range_noise = scenario_.landmark_sensor.range_noise_m;
   context.options.bearing_noise = scenario_.landmark_sensor.bearing_noise_rad;
   context.options.known_associations = scenario_.landmark_sensor.report_ids && scenario_.localization_options.known_associations;
-  for (std::size_t k = 0; k < world_.landmarks().size(); ++k) context.known_landmarks.push_back({int(k), world_.landmarks()[k]});
   for (int i = 0; i < n; ++i) {
     motion_rng_.push_back(rng_.fork(100 + std::uint64_t(i)));
     sensor_rng_.push_back(rng_.fork(200 + std::uint64_t(i)));
-    context.initial_pose = truths_[std::size_t(i)];
+    // Each robot knows its start and the landmark map in its own map frame.
+    const core::Transform2 to_frame = frame_origin(i).inverse();
+    context.initial_pose = core::Pose2::from_transform(to_frame * truths_[std::size_t(i)].as_transform());
+    context.known_landmarks.clear();
+    for (std::size_t k = 0; k < world_.landmarks().size(); ++k) {
+      context.known_landmarks.push_back({int(k), to_frame.apply(world_.landmarks()[k]), Eigen::Matrix2d::Zero()});
+    }
     context.seed = rng_.fork(300 + std::uint64_t(i)).seed();
     localizers_.push_back(localization::make_localizer(scenario_.localization, context));
-    maps_.emplace_back(world_.geometry());
+    maps_.emplace_back(frame_geometry_[std::size_t(frame_of_[std::size_t(i)])]);
   }
   if (scenario_.path_planner != "wave") {
     planning::PlanPathOptions plan;
@@ -203,7 +241,6 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   previous_links_.assign(std::size_t(n), std::vector<char>(std::size_t(n), 0));
 
   const auto t0 = Clock::now();
-  for (int i = 0; i < n; ++i) localizers_[std::size_t(i)]->observe_truth(truths_[std::size_t(i)]);
   sense_and_map();
   communicate();
   decide();
@@ -240,11 +277,12 @@ void Simulation::sense_and_map() {
   t0 = Clock::now();
   for (int i = 0; i < n; ++i) {
     auto& loc = *localizers_[std::size_t(i)];
-    loc.observe_truth(truths_[std::size_t(i)]);
+    loc.observe_truth(core::Pose2::from_transform(frame_origin(i).inverse() * truths_[std::size_t(i)].as_transform()));
     if (!landmark_obs[std::size_t(i)].empty()) loc.update_landmarks(landmark_obs[std::size_t(i)]);
     loc.update_scan(scans[std::size_t(i)], maps_[std::size_t(i)]);
     if (scenario_.localization_options.use_robot_detections) {
       for (const auto& d : detections_[std::size_t(i)]) {
+        if (frame_of_[std::size_t(d.other)] != frame_of_[std::size_t(i)]) continue;  // its estimate means nothing here
         const auto& other = *localizers_[std::size_t(d.other)];
         loc.update_robot({d.other, d.range, d.bearing, other.pose(), other.covariance()});
       }
@@ -265,9 +303,12 @@ void Simulation::sense_and_map() {
       const bool hit = scan.ranges[b].has_value();
       own.integrate_ray(est.position(), end, hit, [&](int cell, bool changed) {
         if (changed) exchange_.touched(i, cell);
-        sensed_by_[std::size_t(cell)] |= bit;
       });
-      merged_.integrate_ray(est.position(), end, hit);
+      // The evaluation's merged map is in the world frame: the simulator knows where each frame lies.
+      const core::Pose2 world = in_world(i, est);
+      const Eigen::Vector2d world_end = frame_origin(i).apply(end);
+      merged_.integrate_ray(world.position(), world_end, hit,
+                            [&](int cell, bool) { sensed_by_[std::size_t(cell)] |= bit; });
     }
   }
   timing_.mapping += seconds_since(t0);
@@ -280,12 +321,16 @@ void Simulation::communicate() {
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       if (!links_[std::size_t(i)][std::size_t(j)]) continue;
+      const bool new_link = !previous_links_[std::size_t(i)][std::size_t(j)];
+      if (new_link) ++meetings_;
+      if (frame_of_[std::size_t(i)] != frame_of_[std::size_t(j)]) try_merge(i, j);
+      if (frame_of_[std::size_t(i)] != frame_of_[std::size_t(j)]) {
+        if (new_link) events_.push_back({step_, "meeting", i, j, "in different frames: no map exchanged"});
+        continue;
+      }
       const std::int64_t bytes = exchange_.exchange(i, j, maps_);
       bytes_sent_ += bytes;
-      if (!previous_links_[std::size_t(i)][std::size_t(j)]) {
-        ++meetings_;
-        events_.push_back({step_, "meeting", i, j, std::to_string(bytes) + " bytes exchanged"});
-      }
+      if (new_link) events_.push_back({step_, "meeting", i, j, std::to_string(bytes) + " bytes exchanged"});
     }
   }
   previous_links_ = links_;
@@ -296,7 +341,11 @@ void Simulation::decide() {
   const auto t0 = Clock::now();
   std::vector<exploration::ExplorerRobot> views;
   for (int i = 0; i < scenario_.robot_count; ++i) views.push_back({&maps_[std::size_t(i)], localizers_[std::size_t(i)]->pose()});
-  explorer_.update(views, links_);
+  // Robots coordinate only when they can talk and share a map frame.
+  auto links = links_;
+  for (std::size_t i = 0; i < links.size(); ++i)
+    for (std::size_t j = 0; j < links.size(); ++j) links[i][j] = links[i][j] && frame_of_[i] == frame_of_[j];
+  explorer_.update(views, links);
   for (int i = 0; i < scenario_.robot_count; ++i) {
     const bool f = explorer_.finished(i);
     if (f && !was_finished_[std::size_t(i)]) events_.push_back({step_, "finished", i, -1, "no reachable frontier left"});
@@ -313,10 +362,107 @@ void Simulation::measure() {
   for (int i = 0; i < scenario_.robot_count; ++i) {
     auto& t = tracks_[std::size_t(i)];
     t.truth.push_back(truths_[std::size_t(i)]);
-    t.estimate.push_back(localizers_[std::size_t(i)]->pose());
-    t.covariance.push_back(localizers_[std::size_t(i)]->covariance());
+    t.estimate.push_back(in_world(i, localizers_[std::size_t(i)]->pose()));
+    t.covariance.push_back(
+        localization::rotate_pose_covariance(localizers_[std::size_t(i)]->covariance(), frame_origin(i).rotation()));
   }
   timing_.metrics += seconds_since(t0);
+}
+
+core::Pose2 Simulation::in_world(int i, const core::Pose2& frame_pose) const {
+  return core::Pose2::from_transform(frame_origin(i) * frame_pose.as_transform());
+}
+
+void Simulation::try_merge(int i, int j) {
+  // The robot in the lower-numbered frame receives: the other's group adopts its frame.
+  const int receiver = frame_of_[std::size_t(i)] < frame_of_[std::size_t(j)] ? i : j;
+  const int sender = receiver == i ? j : i;
+  MergeRecord record;
+  record.step = step_;
+  record.receiver = receiver;
+  record.sender = sender;
+  std::optional<core::Transform2> t;  // sender's frame (metres) into the receiver's
+  if (scenario_.merging == "rendezvous") {
+    // seed 000 §3.2: both robots see each other and exchange their poses and what they measured.
+    const auto seen = [&](int a, int b) -> const Detection* {
+      for (const auto& d : detections_[std::size_t(a)])
+        if (d.other == b) return &d;
+      return nullptr;
+    };
+    const Detection* rs = seen(receiver, sender);
+    const Detection* sr = seen(sender, receiver);
+    if (rs == nullptr || sr == nullptr) return;  // no rendezvous yet
+    bytes_sent_ += 2 * 5 * 8;                    // each sends its pose and its reading: 5 doubles
+    t = merging::rendezvous_transform_matrices(localizers_[std::size_t(receiver)]->pose(),
+                                               localizers_[std::size_t(sender)]->pose(), 0.5 * (rs->range + sr->range),
+                                               rs->bearing, sr->bearing);
+    record.method = "rendezvous";
+    record.confidence = 1.0;
+  } else {
+    int& last = last_attempt_[std::size_t(receiver)][std::size_t(sender)];
+    if (step_ - last < scenario_.merge_attempt_every) return;
+    last = step_;
+    bytes_sent_ += exchange_.send_without_fusing(sender, receiver);
+    merging::MergeOptions o;
+    o.method = scenario_.merge_method;
+    o.min_confidence = scenario_.merge_min_confidence;
+    o.seed = scenario_.seed;
+    const merging::MergeResult m = merging::align_maps(maps_[std::size_t(receiver)], maps_[std::size_t(sender)], o);
+    record.method = m.method.empty() ? scenario_.merge_method : m.method;
+    record.confidence = m.confidence;
+    if (!m.merged) {
+      record.reason = m.reason;
+      merges_.push_back(record);
+      return;
+    }
+    t = merging::world_from_cells(maps_[std::size_t(receiver)].geometry(), maps_[std::size_t(sender)].geometry(),
+                                  m.transform);
+  }
+  // Against the truth: where the sender's frame really lies in the receiver's.
+  const core::Transform2 truth = frame_origin(receiver).inverse() * frame_origin(sender);
+  const Eigen::Vector2d at = localizers_[std::size_t(sender)]->pose().position();
+  record.merged = true;
+  record.rotation_error_deg = core::rad2deg(std::abs(core::normalize_angle(t->rotation() - truth.rotation())));
+  record.position_error_m = (t->apply(at) - truth.apply(at)).norm();
+  merges_.push_back(record);
+  char detail[160];
+  std::snprintf(detail, sizeof detail, "%s merge, confidence %.2f: rotation error %.2f deg, position error %.3f m",
+                record.method.c_str(), record.confidence, record.rotation_error_deg, record.position_error_m);
+  events_.push_back({step_, "merge", receiver, sender, detail});
+  adopt_frame(frame_of_[std::size_t(sender)], frame_of_[std::size_t(receiver)], *t);
+}
+
+void Simulation::adopt_frame(int from, int to, const core::Transform2& t) {
+  const core::GridGeometry& target = frame_geometry_[std::size_t(to)];
+  const core::Transform2 back = t.inverse();
+  for (int k = 0; k < scenario_.robot_count; ++k) {
+    if (frame_of_[std::size_t(k)] != from) continue;
+    // Resample the map into the new frame: each target cell takes the source cell under its centre.
+    const mapping::OccupancyGrid& old = maps_[std::size_t(k)];
+    mapping::OccupancyGrid moved(target, old.options());
+    Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+    for (const auto& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(old.width(), 0), Eigen::Vector2d(0, old.height()),
+                               Eigen::Vector2d(old.width(), old.height())}) {
+      const Eigen::Vector2d g = target.world_to_grid(t.apply(old.geometry().grid_to_world(corner)));
+      lo = lo.cwiseMin(g);
+      hi = hi.cwiseMax(g);
+    }
+    const int x0 = std::max(0, int(std::floor(lo.x()))), x1 = std::min(target.width(), int(std::ceil(hi.x())) + 1);
+    const int y0 = std::max(0, int(std::floor(lo.y()))), y1 = std::min(target.height(), int(std::ceil(hi.y())) + 1);
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const auto source = old.geometry().world_to_cell(back.apply(target.cell_center({x, y})));
+        if (!source) continue;
+        const float l = old.log_odds(*source);
+        if (l != 0.0f) moved.set_log_odds({x, y}, l);
+      }
+    }
+    maps_[std::size_t(k)] = std::move(moved);
+    localizers_[std::size_t(k)]->change_frame(t);
+    exchange_.reset(k, target);
+    explorer_.reset_robot(k);
+    frame_of_[std::size_t(k)] = to;
+  }
 }
 
 void Simulation::step() {
@@ -384,6 +530,8 @@ RunResult Simulation::result() const {
   r.meetings = meetings_;
   r.reachable_free_cells = std::int64_t(reachable_.size());
   r.robots = tracks_;
+  for (int i = 0; i < scenario_.robot_count; ++i) r.robot_frames.push_back(frame_origin(i));
+  r.merges = merges_;
   for (std::size_t i = 0; i < r.robots.size(); ++i) r.robots[i].localizer_counters = localizers_[i]->counters();
   r.events = events_;
   r.landmarks = world_.landmarks();

@@ -35,6 +35,21 @@ struct RobotTrack {
   std::vector<std::pair<std::string, double>> localizer_counters;
 };
 
+// One attempt to bring a teammate's map into a robot's frame (merging: rendezvous or overlap).
+struct MergeRecord {
+  int step = 0;
+  int receiver = -1;  // the robot whose frame the sender's group adopted
+  int sender = -1;
+  std::string method;  // "rendezvous", or the merge method that found the overlap
+  bool merged = false;
+  double confidence = 0.0;
+  std::string reason;  // why not merged
+  // Against the truth (merged only): the rotation error, and how far the sender's position lands
+  // from where it truly is in the receiver's frame.
+  double rotation_error_deg = 0.0;
+  double position_error_m = 0.0;
+};
+
 struct Timings {  // seconds
   double total = 0, motion = 0, sensing = 0, localization = 0, mapping = 0, communication = 0, exploration = 0,
          metrics = 0;
@@ -52,7 +67,9 @@ struct RunResult {
   std::int64_t bytes_sent = 0;
   int meetings = 0;
   std::int64_t reachable_free_cells = 0;
-  std::vector<RobotTrack> robots;
+  std::vector<RobotTrack> robots;     // truth and estimates in the world frame
+  std::vector<core::Transform2> robot_frames;  // where each robot's map frame lies in the world, at the end
+  std::vector<MergeRecord> merges;
   std::vector<Event> events;
   std::vector<Eigen::Vector2d> landmarks;
   mapping::OccupancyGrid merged;     // every robot's readings at its estimated pose
@@ -86,12 +103,18 @@ class Simulation {
   const RobotTrack& track(int i) const { return tracks_[std::size_t(i)]; }
   std::vector<Eigen::Vector2d> path(int i) const { return explorer_.path(i); }
   double coverage() const { return coverage_.empty() ? 0.0 : coverage_.back(); }
+  // Where robot i's map frame lies in the world (identity with merging: known).
+  const core::Transform2& frame_origin(int i) const { return frame_origin_[std::size_t(frame_of_[std::size_t(i)])]; }
 
   RunResult result() const;
 
  private:
   void sense_and_map();
   void communicate();
+  void try_merge(int i, int j);
+  // Every robot in `from` frame moves into `to` frame; `t` maps from-frame metres into to-frame metres.
+  void adopt_frame(int from, int to, const core::Transform2& t);
+  core::Pose2 in_world(int i, const core::Pose2& frame_pose) const;
   void decide();
   void measure();
 
@@ -114,6 +137,14 @@ class Simulation {
   std::vector<Event> events_;
   std::vector<char> was_finished_;
   std::vector<int> blocked_streak_;  // consecutive blocked moves per robot
+  // Map frames: robot i's map and pose estimate are in frame frame_of_[i]; frame f lies at
+  // frame_origin_[f] in the world (known to the simulator only, for evaluation) with a grid of
+  // frame_geometry_[f]. With merging: known there is one frame, the world's.
+  std::vector<int> frame_of_;
+  std::vector<core::Transform2> frame_origin_;
+  std::vector<core::GridGeometry> frame_geometry_;
+  std::vector<std::vector<int>> last_attempt_;  // overlap: step of the last attempt per pair
+  std::vector<MergeRecord> merges_;
   std::int64_t bytes_sent_ = 0;
   int meetings_ = 0;
   int step_ = 0;

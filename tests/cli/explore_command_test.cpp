@@ -173,5 +173,23 @@ TEST(ExploreCommand, RobotsCanFollowPlannerPaths) {
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --path-planner teleport --steps 1", dir), "teleport");
 }
 
+TEST(ExploreCommand, RobotsInTheirOwnFramesMergeAtRendezvous) {
+  TempDir dir;
+  dir.write("own.yaml",
+            "map: office\nrobots: {random: 3, min_separation: 4}\n"
+            "communication: {range: 0}\nexploration: {strategy: coordinated}\nsteps: 300\n");
+  const auto r = run_fleetmap("explore --scenario own.yaml --merging rendezvous --out m", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("merging (rendezvous): "), std::string::npos) << r.out;
+  const auto m = metrics(dir / "m");
+  EXPECT_EQ(m["merging"], "rendezvous");
+  ASSERT_TRUE(m.contains("merges"));
+  EXPECT_GT(m["merges_made"].get<int>(), 0);
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --merging magic --steps 1", dir), "magic");
+  const auto help = run_fleetmap("explore --help", dir);
+  EXPECT_NE(help.out.find("--merging"), std::string::npos);
+  EXPECT_NE(help.out.find("overlap"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace fleetmap::cli
