@@ -11,6 +11,7 @@
 #include "cli/command.h"
 #include "cli/plan_output.h"
 #include "cli/progress.h"
+#include "cli/validators.h"
 #include "core/error.h"
 #include "exploration/strategy.h"
 #include "localization/localizer.h"
@@ -96,10 +97,20 @@ int run_explore(const ExploreFlags& f) {
   load.max_cells = f.max_cells;
   const std::string map_source = resolve_map(s);
   auto truth = maps::load_map_source(map_source, load);
+  bool any_free = false;
+  for (int i = 0; i < truth.width() * truth.height() && !any_free; ++i) any_free = truth.state_at(i) == mapping::CellState::Free;
+  if (!any_free) throw InputError(map_source + ": the map has no free cell: nowhere for a robot to start");
   const std::string label = maps::is_builtin_map(s.map) ? s.map : fs::path(s.map).stem().string();
   const fs::path out = f.out.empty() ? fs::path("out") / label : fs::path(f.out);
 
-  sim::Simulation simulation(s, std::move(truth));
+  // Placing the robots is where a scenario meets its map: errors name the scenario, or the map.
+  std::optional<sim::Simulation> made;
+  try {
+    made.emplace(s, std::move(truth));
+  } catch (const InputError& e) {
+    throw InputError((f.scenario.empty() ? map_source : f.scenario) + ": " + e.what());
+  }
+  sim::Simulation& simulation = *made;
   ProgressBar bar(!f.quiet);
   std::unique_ptr<sim::RunVideo> video;
   if (f.animate) video = std::make_unique<sim::RunVideo>(out / "run.mp4");
@@ -218,27 +229,31 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--map", f->map, "Built-in map name, image or map_server YAML [default: office]");
   app->add_option("--robots", f->robots, "Number of robots, placed together near the map centre [default: 4]")
       ->check(CLI::Range(1, 64));
-  app->add_option("--strategy", f->strategy, "Coordination strategy [default: directional]");
-  app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]");
+  app->add_option("--strategy", f->strategy, "Coordination strategy [default: directional]")
+      ->check(CLI::IsMember(exploration::strategy_names()));
+  app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]")
+      ->check(CLI::IsMember(localization::localizer_names()));
   app->add_option("--comm-range", f->comm_range,
                   "Communication range in metres; 0 = only when robots see each other; inf = always [default: inf]");
-  app->add_option("--merging", f->merging, "known, rendezvous or overlap (see above) [default: known]");
-  app->add_option("--steps", f->steps, "Step limit [default: 2000]")->check(CLI::PositiveNumber);
-  app->add_option("--seed", f->seed, "Random seed: the same seed gives the same run [default: 1]");
-  app->add_option("--sensor-range", f->sensor_range, "Laser range in metres [default: 4]")->check(CLI::PositiveNumber);
-  app->add_option("--beams", f->beams, "Laser beams over 360 degrees [default: 360]")->check(CLI::PositiveNumber);
+  app->add_option("--merging", f->merging, "known, rendezvous or overlap (see above) [default: known]")
+      ->check(CLI::IsMember(sim::merging_names()));
+  app->add_option("--steps", f->steps, "Step limit [default: 2000]")->check(positive());
+  app->add_option("--seed", f->seed, "Random seed: the same seed gives the same run [default: 1]")->check(whole_number());
+  app->add_option("--sensor-range", f->sensor_range, "Laser range in metres [default: 4]")->check(positive());
+  app->add_option("--beams", f->beams, "Laser beams over 360 degrees [default: 360]")->check(positive());
   app->add_option("--path-planner", f->path_planner,
                   "How robots get paths to targets: wave, or a planner of `fleetmap plan` (astar, rrtconnect, ...) "
-                  "[default: wave]");
+                  "[default: wave]")
+      ->check(CLI::IsMember(sim::path_planner_names()));
   app->add_option("--plan-from", f->plan_from, "After the run, plan from x,y (metres) on the merged map ...");
   app->add_option("--plan-to", f->plan_to, "... to x,y; the path goes on merged.png and into path.json");
   app->add_option("--planner", f->planner, "Planner for --plan-from/--plan-to (see `fleetmap plan --help`)")
       ->capture_default_str();
-  app->add_option("--plan-time", f->plan_time, "Time budget of that plan, seconds")->capture_default_str()->check(CLI::PositiveNumber);
+  app->add_option("--plan-time", f->plan_time, "Time budget of that plan, seconds")->capture_default_str()->check(positive());
   app->add_option("--out", f->out, "Output folder, created if missing [default: out/<map>]");
   app->add_flag("--animate", f->animate, "Also write run.mp4, a frame per step");
   app->add_flag("--quiet,-q", f->quiet, "Print only the merged map's path; no progress bar");
-  app->add_option("--max-cells", f->max_cells, "Refuse maps with more cells than this")->capture_default_str()->check(CLI::PositiveNumber);
+  app->add_option("--max-cells", f->max_cells, "Refuse maps with more cells than this")->capture_default_str()->check(positive());
   return {app, [f]() { return run_explore(*f); }};
 }
 

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/validators.h"
 #include "core/error.h"
 #include "maps/builtin_maps.h"
 #include "mapping/map_io.h"
@@ -72,10 +73,10 @@ Command add_maps_command(CLI::App& root) {
   show->add_option("--title", o->title, "Title in the legend panel (default: the map name)");
   show->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   show->add_option("--max-cells", o->max_cells, "Refuse maps with more cells than this")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   return {maps, [list, show, o]() {
             if (list->parsed()) return run_list();
             if (show->parsed()) return run_show(*o);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cli/command.h"
+#include "cli/validators.h"
 #include "core/angle.h"
 #include "core/error.h"
 #include "core/file_io.h"
@@ -230,10 +231,10 @@ Command add_merge_command(CLI::App& root) {
   merge->add_option("--min-confidence", o->min_confidence, "Refuse merges below this confidence")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  merge->add_option("--seed", o->seed, "Seed of the RANSAC sampling (features)")->capture_default_str();
+  merge->add_option("--seed", o->seed, "Seed of the RANSAC sampling (features)")->capture_default_str()->check(whole_number());
   merge->add_option("--resolution", o->resolution, "Metres per cell for bare images without YAML")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   return {merge, [o]() { return run_merge(*o); }};
 }
 

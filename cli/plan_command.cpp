@@ -10,6 +10,7 @@
 
 #include "cli/command.h"
 #include "cli/plan_output.h"
+#include "cli/validators.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "maps/builtin_maps.h"
@@ -162,17 +163,17 @@ Command add_plan_command(CLI::App& root) {
   plan->add_option("--planner", o->planner, "Planner name (see the list below)")
       ->capture_default_str()
       ->check(CLI::IsMember(planning::planner_names()));
-  plan->add_option("--time", o->time_s, "Time budget in seconds")->capture_default_str()->check(CLI::PositiveNumber);
-  plan->add_option("--radius", o->radius_m, "Robot radius in metres")->capture_default_str()->check(CLI::NonNegativeNumber);
+  plan->add_option("--time", o->time_s, "Time budget in seconds")->capture_default_str()->check(positive());
+  plan->add_option("--radius", o->radius_m, "Robot radius in metres")->capture_default_str()->check(non_negative());
   plan->add_option("--unknown", o->unknown, "Unknown cells are 'obstacle' or 'free'")
       ->capture_default_str()
       ->check(CLI::IsMember({"obstacle", "free"}));
-  plan->add_option("--seed", o->seed, "Seed of the sampling planners")->capture_default_str();
+  plan->add_option("--seed", o->seed, "Seed of the sampling planners")->capture_default_str()->check(whole_number());
   plan->add_option("--out,-o", o->out, "Draw the map and the path to this PNG (default: none)");
   plan->add_option("--json", o->json, "Write planner, success, time, length and waypoints to this JSON (default: none)");
   plan->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   return {plan, [o]() { return run_plan(*o); }};
 }
 

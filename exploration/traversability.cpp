@@ -12,25 +12,21 @@ std::vector<std::uint8_t> traversable_cells(const mapping::OccupancyGrid& map, c
   std::vector<std::uint8_t> out(std::size_t(w) * std::size_t(h), 0);
   if (w == 0 || h == 0) return out;
   // Distance transform input: 0 at cells that are not known free. Rows are in grid order (row 0 at
-  // the bottom); the transform does not care.
-  cv::Mat not_occupied(h, w, CV_8UC1);
-  bool any_occupied = false;
+  // the bottom); the transform does not care. A ring of zeros around the map: beyond the map's
+  // edge is no place for a robot either.
+  cv::Mat not_occupied(h + 2, w + 2, CV_8UC1, cv::Scalar(0));
   for (int y = 0; y < h; ++y) {
-    auto* row = not_occupied.ptr<std::uint8_t>(y);
-    for (int x = 0; x < w; ++x) {
-      const bool occ = map.state_at(y * w + x) != CellState::Free;
-      row[x] = occ ? 0 : 255;
-      any_occupied |= occ;
-    }
+    auto* row = not_occupied.ptr<std::uint8_t>(y + 1);
+    for (int x = 0; x < w; ++x) row[x + 1] = map.state_at(y * w + x) != CellState::Free ? 0 : 255;
   }
   const double need_cells = (options.robot_radius_m + options.safety_margin_m) / map.resolution();
   cv::Mat dist;
-  if (any_occupied) cv::distanceTransform(not_occupied, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  cv::distanceTransform(not_occupied, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
   for (int y = 0; y < h; ++y) {
-    const float* d = any_occupied ? dist.ptr<float>(y) : nullptr;
+    const float* d = dist.ptr<float>(y + 1);
     for (int x = 0; x < w; ++x) {
       const int i = y * w + x;
-      out[std::size_t(i)] = map.state_at(i) == CellState::Free && (!d || d[x] > need_cells);
+      out[std::size_t(i)] = map.state_at(i) == CellState::Free && d[x + 1] > need_cells;
     }
   }
   return out;

@@ -1,5 +1,6 @@
 #include "mapping/map_io.h"
 
+#include <png.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -52,38 +53,78 @@ std::optional<std::pair<std::int64_t, std::int64_t>> peek_image_size(const std::
   return std::nullopt;
 }
 
-void check_size(const fs::path& path, std::int64_t w, std::int64_t h, const MapLoadOptions& options) {
+void check_size(const std::string& path, std::int64_t w, std::int64_t h, const MapLoadOptions& options) {
   if (w <= 0 || h <= 0) {
-    throw InputError(path.string() + ": image has no pixels (" + std::to_string(w) + "x" + std::to_string(h) + ")");
+    throw InputError(path + ": image has no pixels (" + std::to_string(w) + "x" + std::to_string(h) + ")");
   }
-  if (w * h > options.max_cells) {
-    throw InputError(path.string() + ": image is " + std::to_string(w) + "x" + std::to_string(h) + " = " +
-                     std::to_string(w * h) + " cells, over the size limit of " +
+  if (w > options.max_cells / h) {  // w * h > max_cells, without overflow
+    const std::string cells = w <= INT64_MAX / h ? std::to_string(w * h) : std::string("too many");
+    throw InputError(path + ": image is " + std::to_string(w) + "x" + std::to_string(h) + " = " + cells +
+                     " cells, over the size limit of " +
                      std::to_string(options.max_cells) + " cells");
   }
 }
 
-cv::Mat read_image(const fs::path& path, const MapLoadOptions& options) {
-  const std::string bytes = core::read_file(path);
-  if (bytes.empty()) throw InputError(path.string() + ": empty file, expected a PNG or PGM image");
-  if (const auto size = peek_image_size(bytes)) check_size(path, size->first, size->second, options);
-  cv::Mat image;
-  try {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
-                         cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception&) {
-    image.release();
+// Decodes a PNG with libpng's simplified API, which reports every problem in its return value and
+// never prints (OpenCV's PNG decoder lets libpng print "libpng error/warning: ..." to stderr).
+// Pixels come out as OpenCV would give them: grey, grey+alpha, BGR or BGRA; 16-bit stays 16-bit.
+cv::Mat decode_png(const std::string& bytes, const std::string& source, const MapLoadOptions& options) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  const auto fail = [&](const char* what) {
+    const std::string message = png.message[0] ? png.message : "invalid data";
+    png_image_free(&png);
+    throw InputError(source + ": " + what + " (" + message + ")");
+  };
+  if (!png_image_begin_read_from_memory(&png, bytes.data(), bytes.size())) fail("cannot decode PNG");
+  check_size(source, png.width, png.height, options);
+  // 16-bit files are linear in libpng's model: read them as linear 16-bit so that no gamma
+  // conversion happens (alpha then comes premultiplied; map images rarely carry partial alpha).
+  const bool sixteen = (png.format & PNG_FORMAT_FLAG_LINEAR) != 0;
+  const bool colour = (png.format & PNG_FORMAT_FLAG_COLOR) != 0, alpha = (png.format & PNG_FORMAT_FLAG_ALPHA) != 0;
+  png.format = (colour ? PNG_FORMAT_FLAG_COLOR | PNG_FORMAT_FLAG_BGR : 0) | (alpha ? PNG_FORMAT_FLAG_ALPHA : 0) |
+               (sixteen ? PNG_FORMAT_FLAG_LINEAR : 0);
+  const int channels = (colour ? 3 : 1) + (alpha ? 1 : 0);
+  cv::Mat image(static_cast<int>(png.height), static_cast<int>(png.width), CV_MAKETYPE(sixteen ? CV_16U : CV_8U, channels));
+  if (!png_image_finish_read(&png, nullptr, image.data, static_cast<png_int_32>(image.step[0] / (sixteen ? 2 : 1)),
+                             nullptr)) {
+    fail("cannot decode PNG, truncated or corrupt");
   }
-  if (image.empty()) throw InputError(path.string() + ": cannot decode image (not a valid PNG/PGM, or truncated)");
-  check_size(path, image.cols, image.rows, options);
-  if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
-  if (image.depth() != CV_8U || image.channels() > 4) {
-    throw InputError(path.string() + ": unsupported image format (expected 8- or 16-bit grey, RGB or RGBA)");
-  }
+  png_image_free(&png);
   return image;
 }
 
+cv::Mat read_image(const fs::path& path, const MapLoadOptions& options) {
+  return decode_map_image(core::read_file(path), path.string(), options);
+}
+
 }  // namespace
+
+cv::Mat decode_map_image(const std::string& bytes, const std::string& source, const MapLoadOptions& options) {
+  if (bytes.empty()) throw InputError(source + ": empty file, expected a PNG or PGM image");
+  if (bytes.size() > std::size_t{INT32_MAX}) throw InputError(source + ": file too large for an image");
+  if (const auto size = peek_image_size(bytes)) check_size(source, size->first, size->second, options);
+  static const unsigned char kPng[4] = {0x89, 'P', 'N', 'G'};
+  const bool is_png = bytes.size() >= 4 && std::equal(kPng, kPng + 4, reinterpret_cast<const unsigned char*>(bytes.data()));
+  cv::Mat image;
+  if (is_png) {
+    image = decode_png(bytes, source, options);
+  } else {
+    try {
+      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
+                           cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception&) {
+      image.release();
+    }
+  }
+  if (image.empty()) throw InputError(source + ": cannot decode image (not a valid PNG/PGM, or truncated)");
+  check_size(source, image.cols, image.rows, options);
+  if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
+  if (image.depth() != CV_8U || image.channels() > 4) {
+    throw InputError(source + ": unsupported image format (expected 8- or 16-bit grey, RGB or RGBA)");
+  }
+  return image;
+}
 
 MapYaml parse_map_yaml(std::string_view text, const std::string& source) {
   const YAML::Node root = core::parse_yaml(std::string(text), source);

@@ -41,6 +41,9 @@ MapYaml parse_map_yaml(std::string_view text, const std::string& source);
 // The YAML text map_saver writes (the image path as given).
 std::string format_map_yaml(const MapYaml& yaml);
 
+// Decodes the bytes of a PNG or PGM map image, refusing images over `options.max_cells` from their
+// header before decoding. Returns 8-bit 1-4 channel pixels; throws InputError naming `source`.
+cv::Mat decode_map_image(const std::string& bytes, const std::string& source, const MapLoadOptions& options = {});
 // Builds a grid from a decoded image (8-bit, 1 to 4 channels) with map_server's rules.
 OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta,
                               const OccupancyGridOptions& grid_options = {});

@@ -5,11 +5,13 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libeigen3-dev libopencv-dev libompl-dev liboctomap-dev
+  libeigen3-dev libopencv-dev libompl-dev liboctomap-dev libpng-dev
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev
 )
+# `--robustness` adds clang and its libFuzzer runtime, for the fuzzing stage of .ci/run.
+[[ "${1:-}" == "--robustness" ]] && packages+=(clang libclang-rt-14-dev)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -9,15 +9,17 @@ namespace fleetmap::sim {
 World::World(mapping::OccupancyGrid truth, std::vector<Eigen::Vector2d> landmarks)
     : truth_(std::move(truth)), landmarks_(std::move(landmarks)) {
   const int w = truth_.width(), h = truth_.height();
-  cv::Mat free(h, w, CV_8UC1);
+  // A ring of blocked cells around the map: outside the map is blocked too (distanceTransform
+  // would otherwise take the image border for open space, and a map with no wall for empty plains).
+  cv::Mat free(h + 2, w + 2, CV_8UC1, cv::Scalar(0));
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) free.at<std::uint8_t>(y, x) = blocked({x, y}) ? 0 : 255;
+    for (int x = 0; x < w; ++x) free.at<std::uint8_t>(y + 1, x + 1) = blocked({x, y}) ? 0 : 255;
   cv::Mat dist;
   cv::distanceTransform(free, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
   centre_clearance_m_.resize(std::size_t(w) * std::size_t(h));
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      centre_clearance_m_[std::size_t(y * w + x)] = dist.at<float>(y, x) * float(truth_.resolution());
+      centre_clearance_m_[std::size_t(y * w + x)] = dist.at<float>(y + 1, x + 1) * float(truth_.resolution());
 }
 
 double World::clearance(const Eigen::Vector2d& p, double horizon_m) const {

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The robustness stage of CI: the whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer,
+# then every libFuzzer target of fuzz/ for FUZZ_SECONDS seconds each (default 60) from its seed corpus.
+# Builds with clang in build-asan/ (one build serves both: the fuzzers need clang's libFuzzer).
+# Fails on a test failure, a sanitizer report, a leak, a fuzzer crash or a fuzzer timeout.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${FUZZ_SECONDS:-60}
+jobs=${JOBS:-2}
+
+./scripts/install-deps.sh --robustness
+CC=clang CXX=clang++ cmake -S . -B build-asan -G Ninja -DFLEETMAP_FUZZ=ON -DFLEETMAP_BUILD_BENCH=OFF
+cmake --build build-asan
+
+# Sanitizer reports end the process with an error; leaks are reported at exit.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:halt_on_error=1:detect_stack_use_after_return=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0}
+ctest --test-dir build-asan -j"$jobs" --output-on-failure
+
+# Fuzz from a copy of the seed corpus, so that the repository's corpus stays as committed.
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+for target in map_image map_yaml scenario; do
+  mkdir -p "$work/$target" "$work/artifacts"
+  cp fuzz/corpus/$target/* "$work/$target/"
+  echo "robustness: fuzzing $target for ${seconds} s"
+  build-asan/fuzz/fuzz_$target "$work/$target" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -max_len=65536 -print_final_stats=1 -artifact_prefix="$work/artifacts/" 2>"$work/$target.log" || {
+    tail -n 60 "$work/$target.log"
+    echo "robustness: fuzz_$target found a problem (input saved under $work/artifacts, shown above)" >&2
+    trap - EXIT
+    exit 1
+  }
+  grep -E "stat::number_of_executed_units|stat::peak_rss_mb" "$work/$target.log" | sed "s/^/  $target /"
+done
+echo "robustness: all passed"
