@@ -1,5 +1,6 @@
 // fleetmap: the command-line program. Thin: parses flags, calls the libraries, reports.
 #include <CLI/CLI.hpp>
+#include <opencv2/core/utils/logger.hpp>
 
 #include <cstdio>
 #include <exception>
@@ -54,6 +55,8 @@ void check_subcommand_words(const CLI::App& app, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // fleetmap reports problems itself, in one line; OpenCV's own log lines would only add noise.
+  cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   namespace fm = fleetmap;
   CLI::App app{
       "fleetmap: multi-robot exploration and mapping. A team of simulated robots explores a 2D map,\n"

@@ -106,6 +106,10 @@ cv::Mat decode_map_image(const std::string& bytes, const std::string& source, co
   if (const auto size = peek_image_size(bytes)) check_size(source, size->first, size->second, options);
   static const unsigned char kPng[4] = {0x89, 'P', 'N', 'G'};
   const bool is_png = bytes.size() >= 4 && std::equal(kPng, kPng + 4, reinterpret_cast<const unsigned char*>(bytes.data()));
+  // PGM/PPM/PBM ("P1".."P6"); other formats OpenCV could decode (JPEG 2000, TIFF, ...) are not map
+  // formats, and their decoders log to stderr.
+  const bool is_pnm = bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '6';
+  if (!is_png && !is_pnm) throw InputError(source + ": not a PNG or PGM image");
   cv::Mat image;
   if (is_png) {
     image = decode_png(bytes, source, options);

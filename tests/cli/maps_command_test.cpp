@@ -47,7 +47,7 @@ TEST(MapsCommand, BadInputGetsOneLineAndNonZeroExit) {
   dir.write("empty.png", "");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("maps show empty.png", dir), "empty.png: empty file");
   dir.write("junk.png", "junk junk junk");
-  EXPECT_ONE_LINE_ERROR(run_fleetmap("maps show junk.png", dir), "cannot decode");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("maps show junk.png", dir), "junk.png: not a PNG or PGM image");
   dir.write("nores.yaml", "image: x.png\n");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("maps show nores.yaml", dir), "missing key 'resolution'");
   dir.write("noimage.yaml", "resolution: 0.1\n");

@@ -149,11 +149,16 @@ TEST(MapIoBadInput, DirectoryInsteadOfFile) {
 TEST(MapIoBadInput, EmptyAndUndecodableImages) {
   TempDir dir;
   expect_input_error([&] { load_map(dir.write("empty.png", "")); }, {"empty.png", "empty file"});
-  expect_input_error([&] { load_map(dir.write("text.png", "this is not an image")); }, {"text.png", "cannot decode"});
+  expect_input_error([&] { load_map(dir.write("text.png", "this is not an image")); }, {"text.png", "not a PNG or PGM image"});
   std::vector<std::uint8_t> png;
   cv::imencode(".png", cv::Mat(50, 50, CV_8UC1, cv::Scalar(254)), png);
   const std::string truncated(png.begin(), png.begin() + 40);
   expect_input_error([&] { load_map(dir.write("cut.png", truncated)); }, {"cut.png", "cannot decode"});
+  // Formats OpenCV could decode but that are no map format are refused before decoding.
+  std::vector<std::uint8_t> jpeg;
+  cv::imencode(".jpg", cv::Mat(50, 50, CV_8UC1, cv::Scalar(254)), jpeg);
+  expect_input_error([&] { load_map(dir.write("photo.png", std::string(jpeg.begin(), jpeg.end()))); },
+                     {"photo.png", "not a PNG or PGM image"});
 }
 
 TEST(MapIoBadInput, ImageOverTheSizeLimit) {

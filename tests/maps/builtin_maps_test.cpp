@@ -15,6 +15,11 @@ const std::filesystem::path kMapsDir = std::filesystem::path(FLEETMAP_SOURCE_DIR
 class BuiltinMap : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(BuiltinMap, CommittedFilesMatchTheGenerator) {
+#ifdef __clang__
+  // The committed files come from the project's compiler, g++ 12; clang's floating point (contraction
+  // into FMA, libm calls folded at compile time) moves a few generated obstacles.
+  GTEST_SKIP() << "bit-for-bit regeneration is checked in the g++ build";
+#endif
   const auto generated = generate_builtin_map(GetParam());
   EXPECT_EQ(core::read_file(kMapsDir / (GetParam() + ".png")), encode_png(generated.image))
       << "maps/" << GetParam() << ".png differs from the generator: run build/maps/fleetmap_generate_maps";
