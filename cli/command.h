@@ -18,6 +18,7 @@ struct Command {
 Command add_maps_command(CLI::App& root);
 Command add_merge_command(CLI::App& root);
 Command add_plan_command(CLI::App& root);
+Command add_slam_command(CLI::App& root);
 Command add_explore_command(CLI::App& root);
 
 }  // namespace fleetmap::cli

@@ -66,6 +66,8 @@ struct LocalizerOptions {
   // Landmark sensor noise (standard deviations).
   double range_noise = 0.02;     // m
   double bearing_noise = 0.0175;  // rad
+  // Range-scan noise (standard deviation of a beam's distance), for `polynomial`.
+  double scan_range_noise = 0.02;  // m
   // Initial pose uncertainty (standard deviations); seed 000: P0 = diag(0.05^2, 0.05^2, 0.0175^2).
   double initial_xy = 0.05;
   double initial_theta = 0.017453292519943295;  // 1 deg (seed 000 uses 0.0175 rad)

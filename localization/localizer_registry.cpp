@@ -22,6 +22,8 @@ const std::vector<Entry>& registry() {
        make_ekf_localizer},
       {"ekf-slam", "EKF-SLAM: pose and point landmarks learnt as they are seen (seed 000 eq. (4)-(5))",
        make_ekf_slam_localizer},
+      {"polynomial", "seed 000's polynomial EKF-SLAM: walls as polynomials learnt from the range scan, c0 coefficients in the state",
+       make_polynomial_localizer},
   };
   return kEntries;
 }

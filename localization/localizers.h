@@ -14,5 +14,6 @@ std::unique_ptr<Localizer> make_ideal_localizer(const LocalizerContext& context)
 std::unique_ptr<Localizer> make_odometry_localizer(const LocalizerContext& context);
 std::unique_ptr<Localizer> make_ekf_localizer(const LocalizerContext& context);       // ekf_localizer.cpp
 std::unique_ptr<Localizer> make_ekf_slam_localizer(const LocalizerContext& context);  // ekf_slam_localizer.cpp
+std::unique_ptr<Localizer> make_polynomial_localizer(const LocalizerContext& context);  // polynomial_localizer.cpp
 
 }  // namespace fleetmap::localization

@@ -202,6 +202,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   context.options.process_noise_theta = scenario_.noise.heading_rad;
   context.options.range_noise = scenario_.landmark_sensor.range_noise_m;
   context.options.bearing_noise = scenario_.landmark_sensor.bearing_noise_rad;
+  context.options.scan_range_noise = scenario_.range.noise_m;
   context.options.known_associations = scenario_.landmark_sensor.report_ids && scenario_.localization_options.known_associations;
   for (int i = 0; i < n; ++i) {
     motion_rng_.push_back(rng_.fork(100 + std::uint64_t(i)));

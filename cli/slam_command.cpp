@@ -1,0 +1,130 @@
+// `fleetmap slam`: a SLAM experiment repeated over many runs (seed 000 §4 with
+// scenarios/dalfonso_3robots.yaml): Table 1 as Markdown and CSV, every run's numbers, and the maps
+// of the first run as pictures. The scenario's `method` picks the SLAM method.
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli/command.h"
+#include "cli/progress.h"
+#include "core/error.h"
+#include "sim/slam_experiment.h"
+#include "sim/slam_output.h"
+#include "sim/slam_scenario.h"
+
+namespace fleetmap::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct SlamFlags {
+  std::string scenario;
+  std::optional<int> runs;
+  std::optional<std::uint64_t> seed;
+  int jobs = 1;
+  std::string out;
+  bool quiet = false;
+};
+
+std::string method_names() {
+  std::string names;
+  for (const auto& n : sim::slam_method_names()) names += (names.empty() ? "" : ", ") + n;
+  return names;
+}
+
+int run_slam(const SlamFlags& f) {
+  sim::SlamScenario s = sim::load_slam_scenario(f.scenario);
+  if (f.runs) s.runs = *f.runs;
+  if (f.seed) s.seed = *f.seed;
+  const sim::SlamSetup setup = sim::prepare_slam(s);
+  const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
+
+  int single = -1;
+  for (std::size_t i = 0; i < s.robots.size(); ++i) {
+    if (s.robots[i].name == s.single_robot) single = int(i);
+  }
+  // Jobs 0 .. runs-1 are the team runs; runs .. 2 runs-1 the single-robot runs (when asked for).
+  const int total = s.runs * (single >= 0 ? 2 : 1);
+  sim::SlamCampaign campaign;
+  campaign.team.resize(std::size_t(s.runs));
+  if (single >= 0) campaign.alone.resize(std::size_t(s.runs));
+  std::atomic<int> next{0}, done{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  const auto worker = [&]() {
+    for (;;) {
+      const int job = next++;
+      if (job >= total) return;
+      try {
+        if (job < s.runs) {
+          campaign.team[std::size_t(job)] = sim::run_slam(setup, job, s.exchange);
+        } else {
+          campaign.alone[std::size_t(job - s.runs)] = sim::run_slam(setup, job - s.runs, false, single);
+        }
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+        next = total;
+      }
+      ++done;
+    }
+  };
+  ProgressBar bar(!f.quiet);
+  const int jobs = std::clamp(f.jobs, 1, total);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < jobs; ++t) threads.emplace_back(worker);
+  while (done < total && !failure) {
+    bar.update(done, total, "runs");
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  for (auto& t : threads) t.join();
+  bar.update(done, total, "runs");
+  bar.finish();
+  if (failure) std::rethrow_exception(failure);
+
+  const auto written = sim::write_slam_outputs(setup, campaign, out, s.paper_table);
+  if (f.quiet) {
+    std::printf("%s\n", (out / "table1.md").c_str());
+    return 0;
+  }
+  std::printf("%s", sim::slam_table_markdown(setup, campaign, s.paper_table).c_str());
+  std::printf("\nall outputs in %s/:", out.c_str());
+  for (const auto& p : written) std::printf(" %s", p.filename().c_str());
+  std::printf("\n");
+  return 0;
+}
+
+}  // namespace
+
+Command add_slam_command(CLI::App& root) {
+  CLI::App* app = root.add_subcommand(
+      "slam",
+      "Repeat a SLAM experiment: robots follow precomputed paths in a room, each maps it and localizes itself on\n"
+      "its own, and robots that see each other exchange maps. Writes Table 1 (means and standard deviations over\n"
+      "the runs) as table1.md and table1.csv, runs.csv, rendezvous.csv, and the first run's maps as map_<robot>.png\n"
+      "(and map_<robot>_alone.png for the scenario's single_robot).\n\n"
+      "Methods (the scenario's `method`): " + method_names() +
+          "\n  polynomial: seed 000's polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
+          "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso");
+  auto f = std::make_shared<SlamFlags>();
+  app->add_option("--scenario", f->scenario, "SLAM scenario YAML (see scenarios/dalfonso_3robots.yaml)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app->add_option("--runs", f->runs, "Number of runs [default: the scenario's runs, 100 if it has none]")
+      ->check(CLI::Range(1, 1'000'000));
+  app->add_option("--seed", f->seed, "Random seed; run k uses its own streams derived from it [default: the scenario's, 1]");
+  app->add_option("--jobs", f->jobs, "Runs computed in parallel")->capture_default_str()->check(CLI::Range(1, 256));
+  app->add_option("--out", f->out, "Output folder, created if missing [default: out/slam_<scenario name>]");
+  app->add_flag("--quiet,-q", f->quiet, "Print only the path of table1.md; no progress bar");
+  return {app, [f]() { return run_slam(*f); }};
+}
+
+}  // namespace fleetmap::cli

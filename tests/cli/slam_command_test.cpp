@@ -1,0 +1,68 @@
+// End-to-end: `fleetmap slam` as a user runs it.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/cli_run.h"
+
+namespace fleetmap::cli {
+namespace {
+
+using fleetmap::testing::run_fleetmap;
+using fleetmap::testing::slurp;
+using fleetmap::testing::TempDir;
+
+std::string scenario() { return std::string("'") + FLEETMAP_SOURCE_DIR + "/scenarios/dalfonso_3robots.yaml'"; }
+
+TEST(SlamCommand, WritesTable1AndTheFigures) {
+  TempDir dir;
+  const auto r = run_fleetmap("slam --scenario " + scenario() + " --runs 2 --jobs 2 --out out", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");  // no progress bar when stderr is not a terminal
+  for (const char* f : {"table1.md", "table1.csv", "runs.csv", "rendezvous.csv", "map_r1.png", "map_r2.png", "map_r3.png",
+                        "map_r3_alone.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / f)) << f;
+  }
+  EXPECT_NE(r.out.find("mean ± standard deviation over 2 runs"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("all outputs in out/"), std::string::npos) << r.out;
+  const std::string runs = slurp(dir / "out" / "runs.csv");
+  EXPECT_EQ(std::count(runs.begin(), runs.end(), '\n'), 1 + 2 * 3 + 2);  // header, 2 runs x 3 robots, 2 single-robot runs
+  const cv::Mat figure = cv::imread((dir / "out" / "map_r3.png").string());
+  EXPECT_GE(figure.cols, 800);
+  // The same command gives the same numbers (everything but tau).
+  const auto again = run_fleetmap("slam --scenario " + scenario() + " --runs 2 --jobs 1 --out again -q", dir);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(again.out, "again/table1.md\n");
+  const auto without_tau = [](std::string csv) {
+    std::string out;
+    std::size_t start = 0;
+    while (start < csv.size()) {
+      const std::size_t end = csv.find('\n', start);
+      const std::string line = csv.substr(start, end - start);
+      if (line.rfind("tau_ms", 0) != 0) out += line + "\n";
+      start = end == std::string::npos ? csv.size() : end + 1;
+    }
+    return out;
+  };
+  EXPECT_EQ(without_tau(slurp(dir / "out" / "table1.csv")), without_tau(slurp(dir / "again" / "table1.csv")));
+}
+
+TEST(SlamCommand, BadInputGetsOneLine) {
+  TempDir dir;
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam", dir), "--scenario");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario missing.yaml", dir), "missing.yaml");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario " + scenario() + " --runs 0", dir), "--runs");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario " + scenario() + " --jobs x", dir), "--jobs");
+  dir.write("bad_key.yaml", slurp(std::string(FLEETMAP_SOURCE_DIR) + "/scenarios/dalfonso_3robots.yaml") + "speed: 3\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario bad_key.yaml", dir), "unknown key 'speed'");
+  dir.write("bad_value.yaml", "method: polynomial\nsteps: -3\nroom: {boundary: [[0, 0], [4, 0], [4, 3]]}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario bad_value.yaml", dir), "steps");
+  dir.write("bad_method.yaml", "method: magic\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario bad_method.yaml", dir), "magic");
+  dir.write("wall.yaml", "room: {boundary: [[0, 0], [4, 0], [4, 3], [0, 3]]}\n"
+                         "robots: {team: [{name: a, start: [1, 1, 0], path: [[9, 1]]}]}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario wall.yaml", dir), "within its radius of a wall");
+}
+
+}  // namespace
+}  // namespace fleetmap::cli

@@ -1,0 +1,326 @@
+#include "localization/polynomial_slam.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include "core/angle.h"
+#include "core/random.h"
+#include "localization/localizer.h"
+#include "tests/test_support.h"
+
+namespace fleetmap::localization {
+namespace {
+
+Eigen::Matrix3d p0() { return Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.0175 * 0.0175).asDiagonal(); }
+
+// Exact readings inside an axis-aligned rectangle [0, w] x [0, h].
+std::optional<double> rectangle_range(const core::Pose2& pose, double angle, double w, double h, double max_range) {
+  const double a = pose.theta + angle;
+  const double c = std::cos(a), s = std::sin(a);
+  double t = std::numeric_limits<double>::infinity();
+  if (c > 1e-12) t = std::min(t, (w - pose.x) / c);
+  if (c < -1e-12) t = std::min(t, -pose.x / c);
+  if (s > 1e-12) t = std::min(t, (h - pose.y) / s);
+  if (s < -1e-12) t = std::min(t, -pose.y / s);
+  if (!(t <= max_range)) return std::nullopt;
+  return t;
+}
+
+// Distance from a point to the rectangle's boundary.
+double to_rectangle(const Eigen::Vector2d& p, double w, double h) {
+  const double dx = std::min(std::abs(p.x()), std::abs(p.x() - w));
+  const double dy = std::min(std::abs(p.y()), std::abs(p.y() - h));
+  const bool inside_x = p.x() >= 0 && p.x() <= w, inside_y = p.y() >= 0 && p.y() <= h;
+  if (inside_x && inside_y) return std::min(dx, dy);
+  if (inside_x) return dy;
+  if (inside_y) return dx;
+  return std::hypot(dx, dy);
+}
+
+// The largest distance to the rectangle's walls of the inner 90% of each polynomial's domain, seen
+// from the true pose as the filter sees it from its estimate (map and pose share a frame whose
+// offset from the room's is only known to P0: the map is judged relative to the pose). The ends
+// are left out: a wall's polynomial may run a few millimetres round a corner.
+// `room_from_frame` brings map and estimate back into the room's frame after a change of frame.
+double map_error_seen_from_pose(const mapping::PolynomialMap& map, const core::Pose2& estimate, const core::Pose2& truth,
+                                double w, double h, const core::Transform2& room_from_frame = {}) {
+  const core::Transform2 fix = truth.as_transform() * (room_from_frame * estimate.as_transform()).inverse() * room_from_frame;
+  double worst = 0.0;
+  for (const auto& l : map.landmarks) {
+    const auto& p = l.polynomial;
+    const double margin = 0.05 * (p.hi - p.lo);
+    for (const auto& q : mapping::sample_equally(p, p.lo + margin, p.hi - margin, 50)) worst = std::max(worst, to_rectangle(fix * q, w, h));
+  }
+  return worst;
+}
+
+const std::vector<double> kFiveSensors = {-std::numbers::pi / 2, -std::numbers::pi / 4, 0.0, std::numbers::pi / 4,
+                                          std::numbers::pi / 2};
+
+TEST(PolynomialSlam, ThresholdsFollowTheCovarianceUpToKP0) {
+  PolynomialSlamOptions o;
+  const SlamThresholds at_p0 = slam_thresholds(p0(), p0(), o);
+  EXPECT_NEAR(at_p0.factor, 1.0 / 150.0, 1e-12);
+  EXPECT_NEAR(at_p0.rho, 0.08 + 0.16 / 150.0, 1e-12);
+  EXPECT_NEAR(at_p0.sigma, 0.1 + 0.2 / 150.0, 1e-12);
+  EXPECT_FALSE(at_p0.diverging);
+  const SlamThresholds half = slam_thresholds(75.0 * p0(), p0(), o);
+  EXPECT_NEAR(half.rho, 0.16, 1e-12);
+  EXPECT_NEAR(half.sigma, 0.2, 1e-12);
+  const SlamThresholds beyond = slam_thresholds(200.0 * p0(), p0(), o);
+  EXPECT_TRUE(beyond.diverging);
+  EXPECT_DOUBLE_EQ(beyond.rho, 0.24);
+  EXPECT_DOUBLE_EQ(beyond.sigma, 0.3);
+}
+
+TEST(PolynomialSlam, NoiseFreeRobotMapsARectangleAndStaysWhereItIs) {
+  // A robot turning in place in a 4 x 3 m room with exact readings: every wall becomes polynomials
+  // lying on it, and the pose estimate does not move away from the truth.
+  PolynomialSlamOptions o;
+  o.range_noise = 0.005;
+  o.cluster_tolerance = 0.001;
+  const core::Pose2 start(1.5, 1.2, 0.3);
+  PolynomialSlam slam(start, p0(), Eigen::Matrix3d::Zero(), o);
+  core::Pose2 truth = start;
+  for (int k = 0; k < 300; ++k) {
+    if (k > 0) {
+      const Odometry u{0.0, 0.1, 1.0};
+      slam.predict(u);
+      truth = integrate_motion(truth, u);
+    }
+    std::vector<std::optional<double>> ranges;
+    for (double a : kFiveSensors) ranges.push_back(rectangle_range(truth, a, 4.0, 3.0, 3.0));
+    slam.update(kFiveSensors, ranges);
+  }
+  // The frame itself is anchored only by P0 (sigma 5 cm): a polynomial made of points round a corner
+  // can shift pose and map together by a few centimetres, never apart.
+  EXPECT_LT((slam.pose().position() - truth.position()).norm(), 3 * 0.05);
+  EXPECT_LT(std::abs(core::normalize_angle(slam.pose().theta - truth.theta)), 1e-3);
+  ASSERT_GE(slam.map().landmarks.size(), 4u);
+  // Exact readings: the map is off only where a corner point bent a polynomial (a few mm).
+  EXPECT_LT(map_error_seen_from_pose(slam.map(), slam.pose(), truth, 4.0, 3.0), 5e-3);
+  EXPECT_GT(slam.counters().updates, 500);
+  EXPECT_EQ(slam.counters().diverged_steps, 0);
+}
+
+// A filter at the origin facing +x2 that has mapped the wall x2 = 2 over x1 in [-0.5, 0.5] from
+// eleven exact readings (one cluster of epsilon_Z + 1 points).
+PolynomialSlam facing_a_wall(const PolynomialSlamOptions& o) {
+  PolynomialSlam slam(core::Pose2(0.0, 0.0, std::numbers::pi / 2), p0(), Eigen::Matrix3d::Zero(), o);
+  std::vector<double> angles;
+  std::vector<std::optional<double>> ranges;
+  for (int i = -5; i <= 5; ++i) {
+    const double x = 0.1 * i;
+    angles.push_back(std::atan2(2.0, x) - std::numbers::pi / 2);
+    ranges.push_back(std::hypot(x, 2.0));
+  }
+  slam.update(angles, ranges);
+  return slam;
+}
+
+TEST(PolynomialSlam, BadlyApproximatedPointsRefitTheirPolynomial) {
+  PolynomialSlamOptions o;
+  o.cluster_tolerance = 0.001;
+  PolynomialSlam slam = facing_a_wall(o);
+  ASSERT_EQ(slam.map().landmarks.size(), 1u);
+  const long first_id = slam.map().landmarks[0].id;
+  EXPECT_NEAR(slam.map().landmarks[0].polynomial.value(0.0), 2.0, 1e-9);
+  // Readings 9 cm beyond the polynomial: rho_k < eps <= sigma_k, so they go to Q_bad; past
+  // epsilon_M of them the polynomial is refitted on Q_bad and R, and replaced.
+  std::vector<double> angles;
+  std::vector<std::optional<double>> ranges;
+  for (int i = -3; i <= 2; ++i) {
+    const double x = 0.15 * i;
+    angles.push_back(std::atan2(2.09, x) - std::numbers::pi / 2);
+    ranges.push_back(std::hypot(x, 2.09));
+  }
+  slam.update(angles, ranges);
+  EXPECT_EQ(slam.counters().bad_points, 6);
+  EXPECT_EQ(slam.counters().refits, 1);
+  ASSERT_EQ(slam.map().landmarks.size(), 1u);
+  const auto& refitted = slam.map().landmarks[0];
+  EXPECT_NE(refitted.id, first_id);
+  EXPECT_TRUE(refitted.bad_points.empty());
+  // Weighted between the old polynomial (R) and the bad points.
+  EXPECT_GT(refitted.polynomial.value(0.0), 2.02);
+  EXPECT_LT(refitted.polynomial.value(0.0), 2.08);
+  EXPECT_EQ(slam.filter().slots(), 1);
+}
+
+TEST(PolynomialSlam, FarPointsFormClustersThatBecomePolynomials) {
+  PolynomialSlamOptions o;
+  PolynomialSlam slam(core::Pose2(), p0(), Eigen::Matrix3d::Zero(), o);
+  // Ten points of a wall: one cluster, no polynomial yet; the eleventh makes one.
+  std::vector<double> angles;
+  std::vector<std::optional<double>> ranges;
+  for (int i = 0; i < 10; ++i) {
+    const double y = -0.5 + 0.1 * i;
+    angles.push_back(std::atan2(y, 1.5));
+    ranges.push_back(std::hypot(1.5, y));
+  }
+  slam.update(angles, ranges);
+  EXPECT_EQ(slam.map().landmarks.size(), 0u);
+  ASSERT_EQ(slam.map().clusters.size(), 1u);
+  EXPECT_EQ(slam.map().clusters[0].points.size(), 10u);
+  slam.update({std::atan2(0.5, 1.5)}, {std::hypot(1.5, 0.5)});
+  ASSERT_EQ(slam.map().landmarks.size(), 1u);
+  EXPECT_EQ(slam.map().clusters.size(), 0u);
+  EXPECT_EQ(slam.map().landmarks[0].polynomial.axis, mapping::PolynomialAxis::X2);  // the wall x1 = 1.5
+  EXPECT_NEAR(slam.map().landmarks[0].polynomial.value(0.0), 1.5, 0.02);
+  // A point farther than R from the cluster's points starts a new cluster.
+  slam.update({std::numbers::pi}, {1.0});
+  EXPECT_EQ(slam.map().clusters.size(), 1u);
+}
+
+TEST(PolynomialSlam, ReceivedCurvesMergeWithOverlappingPolynomialsFig3) {
+  PolynomialSlamOptions o;
+  o.cluster_tolerance = 0.001;
+  PolynomialSlam slam = facing_a_wall(o);
+  ASSERT_EQ(slam.map().landmarks.size(), 1u);
+  // The same wall seen by another robot, 2 cm off and reaching farther: merged into one.
+  ReceivedCurve same;
+  same.polyline = {{-0.2, 2.02}, {0.4, 2.02}, {1.0, 2.02}};
+  same.variance = 1e-3;
+  same.from_robot = 1;
+  EXPECT_EQ(slam.integrate_received({same}), 1);
+  EXPECT_EQ(slam.counters().merges, 1);
+  ASSERT_EQ(slam.map().landmarks.size(), 1u);
+  const auto& merged = slam.map().landmarks[0].polynomial;
+  EXPECT_NEAR(merged.lo, -0.5, 1e-6);
+  EXPECT_NEAR(merged.hi, 1.0, 1e-6);
+  EXPECT_GT(merged.value(0.0), 2.0);
+  EXPECT_LT(merged.value(0.0), 2.02);
+  EXPECT_EQ(slam.map().landmarks[0].received_from, -1);  // made of both robots' data
+  // A wall elsewhere is added as it is.
+  ReceivedCurve other;
+  other.polyline = {{3.0, -1.0}, {3.0, 1.0}};
+  other.variance = 1e-3;
+  other.from_robot = 1;
+  slam.integrate_received({other});
+  ASSERT_EQ(slam.map().landmarks.size(), 2u);
+  EXPECT_EQ(slam.map().landmarks[1].received_from, 1);
+  EXPECT_EQ(slam.map().landmarks[1].polynomial.axis, mapping::PolynomialAxis::X2);
+  EXPECT_EQ(slam.filter().slots(), 2);
+}
+
+TEST(PolynomialSlam, GammaTestKeepsParallelWallsApart) {
+  PolynomialSlamOptions o;
+  o.cluster_tolerance = 0.001;
+  PolynomialSlam slam = facing_a_wall(o);
+  ReceivedCurve parallel;  // 0.5 m away: gamma = 0.5 > gamma_M
+  parallel.polyline = {{-0.5, 2.5}, {0.5, 2.5}};
+  parallel.variance = 1e-3;
+  slam.integrate_received({parallel});
+  EXPECT_EQ(slam.counters().merges, 0);
+  EXPECT_EQ(slam.map().landmarks.size(), 2u);
+}
+
+TEST(PolynomialSlam, TheLocalizerIsRegisteredAndUsesScans) {
+  const auto names = localizer_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "polynomial"), names.end());
+  LocalizerContext c;
+  c.initial_pose = core::Pose2(2.0, 1.5, 0.0);
+  auto loc = make_localizer("polynomial", c);
+  EXPECT_EQ(loc->name(), "polynomial");
+  core::Random rng(4);
+  core::Pose2 truth = c.initial_pose;
+  const mapping::OccupancyGrid unused;
+  for (int k = 0; k < 120; ++k) {
+    if (k > 0) {
+      const Odometry u{0.0, 0.2, 1.0};
+      loc->predict(u);
+      truth = integrate_motion(truth, u);
+    }
+    RangeScan scan;
+    scan.max_range = 4.0;
+    for (int b = 0; b < 360; ++b) {
+      scan.angles.push_back(core::normalize_angle(b * std::numbers::pi / 180.0));
+      const auto r = rectangle_range(truth, scan.angles.back(), 5.0, 3.0, 4.0);
+      scan.ranges.push_back(r ? std::optional<double>(*r + rng.normal(0.0, 0.02)) : std::nullopt);
+    }
+    loc->update_scan(scan, unused);
+  }
+  // Within 3 sigma of P0, the frame's only anchor.
+  EXPECT_LT((loc->pose().position() - truth.position()).norm(), 3 * 0.05);
+  double polynomials = 0.0;
+  for (const auto& [key, value] : loc->counters()) {
+    if (key == "polynomials") polynomials = value;
+  }
+  EXPECT_GE(polynomials, 4.0);
+}
+
+TEST(PolynomialSlam, ChangeFrameMovesPoseMapAndCovarianceTogether) {
+  // A robot that has mapped a 4 x 3 m room with noisy readings adopts a frame turned by 40 degrees
+  // and moved; its polynomials must lie on the moved walls within the noise they were made with,
+  // its pose and covariance move rigidly, and it keeps localizing in the new frame.
+  PolynomialSlamOptions o;
+  const core::Pose2 start(1.5, 1.2, 0.3);
+  PolynomialSlam slam(start, p0(), Eigen::Matrix3d::Zero(), o);
+  core::Random rng(11);
+  core::Pose2 truth = start;
+  const auto drive = [&](int steps, const core::Transform2& frame) {
+    for (int k = 0; k < steps; ++k) {
+      const Odometry u{0.0, 0.1, 1.0};
+      slam.predict(u);
+      truth = integrate_motion(truth, u);
+      std::vector<std::optional<double>> ranges;
+      for (double a : kFiveSensors) {
+        const auto r = rectangle_range(truth, a, 4.0, 3.0, 3.0);
+        ranges.push_back(r ? std::optional<double>(*r + rng.normal(0.0, 0.02)) : std::nullopt);
+      }
+      slam.update(kFiveSensors, ranges);
+    }
+    return core::Pose2::from_transform(frame * truth.as_transform());
+  };
+  drive(150, core::Transform2());
+  const core::Transform2 t(3.0, -1.0, core::deg2rad(40.0));
+  const core::Pose2 before = slam.pose();
+  const Eigen::Matrix3d p_before = slam.pose_covariance();
+  const auto polynomials = slam.map().landmarks.size();
+  const mapping::PolynomialMap map_before = slam.map();
+  ASSERT_GE(polynomials, 4u);
+  slam.change_frame(t);
+  const core::Pose2 expected = core::Pose2::from_transform(t * before.as_transform());
+  EXPECT_LT((slam.pose().position() - expected.position()).norm(), 1e-9);
+  EXPECT_NEAR(core::normalize_angle(slam.pose().theta - expected.theta), 0.0, 1e-9);
+  const Eigen::Matrix2d r = t.rotation_matrix();
+  const Eigen::Matrix2d moved = r * p_before.topLeftCorner(2, 2) * r.transpose();
+  EXPECT_TRUE(slam.pose_covariance().topLeftCorner(2, 2).isApprox(moved, 1e-9));
+  EXPECT_NEAR(slam.pose_covariance()(2, 2), p_before(2, 2), 1e-15);
+  ASSERT_EQ(slam.map().landmarks.size(), polynomials);
+  // Seen from the pose, the moved map is the old one: the refit adds far less than the map's own
+  // error (a few sensor sigmas).
+  const double error_before = map_error_seen_from_pose(map_before, before, truth, 4.0, 3.0);
+  EXPECT_NEAR(map_error_seen_from_pose(slam.map(), slam.pose(), truth, 4.0, 3.0, t.inverse()), error_before, 2e-3);
+  EXPECT_LT(error_before, 0.15);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(slam.filter().covariance());
+  EXPECT_GE(eig.eigenvalues().minCoeff(), -1e-12);
+  // It keeps localizing against its moved map (within 5 sigma of P0's position).
+  const core::Pose2 est_before_driving = slam.pose();
+  const core::Pose2 truth_before_driving = core::Pose2::from_transform(t * truth.as_transform());
+  const core::Pose2 truth_in_new = drive(60, t);
+  // The estimate's error (in the new frame) changes by less than the sensor noise over the turn.
+  const Eigen::Vector2d error_then = est_before_driving.position() - truth_before_driving.position();
+  const Eigen::Vector2d error_now = slam.pose().position() - truth_in_new.position();
+  EXPECT_LT((error_now - error_then).norm(), 0.02);
+}
+
+TEST(PolynomialSlam, OptionsAreValidated) {
+  PolynomialSlamOptions o;
+  o.rho_max = 0.01;
+  fleetmap::testing::expect_input_error([&] { validate(o); }, {"rho_max"});
+  o = {};
+  o.epsilon_m = 0;
+  fleetmap::testing::expect_input_error([&] { validate(o); }, {"epsilon_m"});
+  o = {};
+  o.cluster_tolerance = -1.0;
+  fleetmap::testing::expect_input_error([&] { PolynomialSlam(core::Pose2(), p0(), p0(), o); }, {"cluster_tolerance"});
+}
+
+}  // namespace
+}  // namespace fleetmap::localization
