@@ -121,7 +121,8 @@ Command add_slam_command(CLI::App& root) {
   app->add_option("--runs", f->runs, "Number of runs [default: the scenario's runs, 100 if it has none]")
       ->check(CLI::Range(1, 1'000'000));
   app->add_option("--seed", f->seed, "Random seed; run k uses its own streams derived from it [default: the scenario's, 1]");
-  app->add_option("--jobs", f->jobs, "Runs computed in parallel")->capture_default_str()->check(CLI::Range(1, 256));
+  app->add_option("--jobs", f->jobs, "Runs computed in parallel, one thread each; results do not depend on it [default: 1]")
+      ->check(CLI::Range(1, 256));
   app->add_option("--out", f->out, "Output folder, created if missing [default: out/slam_<scenario name>]");
   app->add_flag("--quiet,-q", f->quiet, "Print only the path of table1.md; no progress bar");
   return {app, [f]() { return run_slam(*f); }};
