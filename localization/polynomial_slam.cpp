@@ -210,8 +210,23 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
   std::vector<mapping::WeightedPoint> weighted;
   weighted.reserve(points.size());
   for (const auto& p : points) weighted.push_back({p.position, p.weight});
-  const auto fit = mapping::fit_polynomial(weighted, options_.order, mapping::principal_axis(weighted));
+  const mapping::PolynomialAxis axis = mapping::principal_axis(weighted);
+  auto fit = mapping::fit_polynomial(weighted, options_.order, axis);
   if (!fit || !(fit->max_residual <= max_residual)) return std::nullopt;
+  if (options_.lowest_order) {
+    // The lowest order whose fit explains the points as well as order m does, within the noise:
+    // its weighted RMS residual at most that of order m plus half a reading's standard deviation.
+    const double enough = fit->rms_residual + 0.5 * options_.range_noise;
+    for (int order = 1; order < options_.order; ++order) {
+      auto lower = mapping::fit_polynomial(weighted, order, axis);
+      if (lower && lower->rms_residual <= enough && lower->max_residual <= max_residual) {
+        // Kept as an order-m polynomial whose leading coefficients are zero.
+        lower->polynomial.shape.insert(lower->polynomial.shape.begin(), std::size_t(options_.order - order), 0.0);
+        fit = std::move(lower);
+        break;
+      }
+    }
+  }
   if (swing(fit->polynomial, weighted) > options_.sigma_max) return std::nullopt;
 
   // Seed 000 eq. (5): the gradient of c0_new = g(X, y) with respect to the pose, the source

@@ -55,6 +55,11 @@ struct PolynomialSlamOptions {
   // the curve and in heading when the curve was made, and the fit's slope) is added to V of each
   // reading of it, so that the fixed shape does not pin the pose. False: V is the sensor's alone.
   bool shape_noise = true;
+  // A new polynomial takes the lowest order (1..m) whose fit is as good as order m's within the
+  // noise (its leading coefficients zero): a cubic fitted to a short, noisy piece of a straight
+  // wall has a wrong slope and curvature that the filter, holding the shape fixed, cannot correct.
+  // False: always order m, as the paper.
+  bool lowest_order = true;
 };
 
 // Throws InputError naming the option for a value the algorithm cannot use.

@@ -175,6 +175,7 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
     o.domain_margin = p.number("domain_margin", o.domain_margin, -10.0, 10.0);
     o.cluster_tolerance = p.number("cluster_tolerance", o.cluster_tolerance, 1e-6, 10.0);
     o.shape_noise = p.boolean("shape_noise", o.shape_noise);
+    o.lowest_order = p.boolean("lowest_order", o.lowest_order);
     p.finish();
   }
   top.finish();

@@ -310,6 +310,41 @@ TEST(PolynomialSlam, ChangeFrameMovesPoseMapAndCovarianceTogether) {
   EXPECT_LT((error_now - error_then).norm(), 0.02);
 }
 
+TEST(PolynomialSlam, AShortNoisyPieceOfStraightWallBecomesALine) {
+  // Eleven readings 2 cm noisy of the wall x2 = 2 over 1 m: order 3 follows the noise (its ends
+  // bend away), the lowest order that fits as well within the noise is a line (b3 = b2 = 0) that
+  // stays within the noise of the wall.
+  const auto worst_off_the_wall = [](bool lowest_order, mapping::Polynomial* out) {
+    PolynomialSlamOptions o;
+    o.lowest_order = lowest_order;
+    o.cluster_tolerance = 0.1;
+    PolynomialSlam slam(core::Pose2(0.0, 0.0, std::numbers::pi / 2), p0(), Eigen::Matrix3d::Zero(), o);
+    core::Random rng(3);
+    std::vector<double> angles;
+    std::vector<std::optional<double>> ranges;
+    for (int i = -5; i <= 5; ++i) {
+      const double x = 0.1 * i;
+      angles.push_back(std::atan2(2.0, x) - std::numbers::pi / 2);
+      ranges.push_back(std::hypot(x, 2.0) + rng.normal(0.0, 0.02));
+    }
+    slam.update(angles, ranges);
+    EXPECT_EQ(slam.map().landmarks.size(), 1u);
+    if (slam.map().landmarks.empty()) return 1e9;
+    *out = slam.map().landmarks[0].polynomial;
+    double worst = 0.0;
+    for (const auto& q : mapping::sample_equally(*out, 50)) worst = std::max(worst, std::abs(q.y() - 2.0));
+    return worst;
+  };
+  mapping::Polynomial line, cubic;
+  const double line_error = worst_off_the_wall(true, &line);
+  const double cubic_error = worst_off_the_wall(false, &cubic);
+  EXPECT_EQ(line.shape[0], 0.0);
+  EXPECT_EQ(line.shape[1], 0.0);
+  EXPECT_NE(cubic.shape[0], 0.0);
+  EXPECT_LT(line_error, 2 * 0.02);  // a line through 11 points: well inside 2 sigma
+  EXPECT_LT(line_error, cubic_error);
+}
+
 TEST(PolynomialSlam, OptionsAreValidated) {
   PolynomialSlamOptions o;
   o.rho_max = 0.01;
