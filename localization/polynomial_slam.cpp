@@ -63,30 +63,6 @@ double spectral_norm(const Eigen::Matrix3d& m) {
 
 Eigen::Vector2d perp(const Eigen::Vector2d& v) { return {-v.y(), v.x()}; }
 
-// How far p strays between its points: the largest gap, over 200 samples of its domain, between
-// p and the broken line through the points sorted along its independent variable. A least-squares
-// cubic through points bunched at two places can swing far between them (a refit of Q_bad points
-// beyond p's end with R on p, say); such a polynomial maps nothing that was seen.
-double swing(const mapping::Polynomial& p, const std::vector<mapping::WeightedPoint>& points) {
-  std::vector<Eigen::Vector2d> local;
-  local.reserve(points.size());
-  for (const auto& q : points) local.push_back(p.local(q.position));
-  std::sort(local.begin(), local.end(), [](const auto& a, const auto& b) { return a.x() < b.x(); });
-  if (local.size() < 2) return 0.0;
-  double worst = 0.0;
-  std::size_t k = 1;
-  constexpr int kSamples = 200;
-  for (int i = 0; i <= kSamples; ++i) {
-    const double xi = p.lo + (p.hi - p.lo) * double(i) / kSamples;
-    while (k + 1 < local.size() && local[k].x() < xi) ++k;
-    const Eigen::Vector2d& a = local[k - 1];
-    const Eigen::Vector2d& b = local[k];
-    const double f = b.x() > a.x() ? std::clamp((xi - a.x()) / (b.x() - a.x()), 0.0, 1.0) : 0.5;
-    worst = std::max(worst, std::abs(p.value(xi) - (a.y() + f * (b.y() - a.y()))));
-  }
-  return worst;
-}
-
 // Readings below this standard deviation are treated as this, so that a noise-free sensor still
 // gives a positive innovation variance.
 constexpr double kMinRangeStd = 1e-6;
@@ -227,7 +203,9 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
       }
     }
   }
-  if (swing(fit->polynomial, weighted) > options_.sigma_max) return std::nullopt;
+  // A least-squares cubic through points bunched at two places can swing far between them (a
+  // refit of Q_bad points beyond p's end with R on p, say); such a polynomial maps nothing seen.
+  if (mapping::stray_between_points(fit->polynomial, weighted) > options_.sigma_max) return std::nullopt;
 
   // Seed 000 eq. (5): the gradient of c0_new = g(X, y) with respect to the pose, the source
   // landmarks' c0 and the readings, at x_k|k-1 and y_k.

@@ -176,6 +176,26 @@ std::vector<Eigen::Vector2d> position_gradient(const Polynomial& shape, const st
   return out;
 }
 
+double stray_between_points(const Polynomial& p, const std::vector<WeightedPoint>& points) {
+  std::vector<Eigen::Vector2d> local;
+  local.reserve(points.size());
+  for (const auto& q : points) local.push_back(p.local(q.position));
+  std::sort(local.begin(), local.end(), [](const auto& a, const auto& b) { return a.x() < b.x(); });
+  if (local.size() < 2) return 0.0;
+  double worst = 0.0;
+  std::size_t k = 1;
+  constexpr int kSamples = 200;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double xi = p.lo + (p.hi - p.lo) * double(i) / kSamples;
+    while (k + 1 < local.size() && local[k].x() < xi) ++k;
+    const Eigen::Vector2d& a = local[k - 1];
+    const Eigen::Vector2d& b = local[k];
+    const double f = b.x() > a.x() ? std::clamp((xi - a.x()) / (b.x() - a.x()), 0.0, 1.0) : 0.5;
+    worst = std::max(worst, std::abs(p.value(xi) - (a.y() + f * (b.y() - a.y()))));
+  }
+  return worst;
+}
+
 std::vector<Eigen::Vector2d> sample_equally(const Polynomial& p, double a, double b, int count) {
   std::vector<Eigen::Vector2d> out;
   if (count <= 0) return out;

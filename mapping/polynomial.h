@@ -85,6 +85,11 @@ std::optional<PolynomialFit> fit_polynomial(const std::vector<WeightedPoint>& po
 // state holds c_0 only, the shape being a landmark of the extraction step.
 std::vector<Eigen::Vector2d> position_gradient(const Polynomial& shape, const std::vector<WeightedPoint>& points);
 
+// How far p strays between `points`: the largest gap, over 201 samples of p's domain, between p
+// and the broken line through the points sorted along p's independent variable (metres, along
+// the dependent axis). 0 for fewer than two points.
+double stray_between_points(const Polynomial& p, const std::vector<WeightedPoint>& points);
+
 // `count` points equally spaced in the independent variable over the domain, ends included
 // (the sets R of §3.1 and Q_0..Q_m of §3.3); one point is the domain's middle.
 std::vector<Eigen::Vector2d> sample_equally(const Polynomial& p, int count);

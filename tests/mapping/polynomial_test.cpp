@@ -85,6 +85,20 @@ TEST(PolynomialLandmark, FitNeedsEnoughDistinctPoints) {
   EXPECT_EQ(principal_axis(three), PolynomialAxis::X1);
 }
 
+TEST(PolynomialLandmark, StrayBetweenPointsCatchesASwingingFit) {
+  // Points of the line x2 = 0 in two bunches, [0, 0.1] and [1.9, 2]: p = 10 x1 (x1 - 2) passes
+  // within 0.1 m of all of them (its ends) but swings 10 m away between them.
+  std::vector<WeightedPoint> points;
+  for (int k = 0; k <= 5; ++k) points.push_back({Eigen::Vector2d(0.02 * k, 0.0), 1.0});
+  for (int k = 0; k <= 5; ++k) points.push_back({Eigen::Vector2d(1.9 + 0.02 * k, 0.0), 1.0});
+  const Polynomial swing{PolynomialAxis::X1, {0.0, 10.0, -20.0}, 0.0, 0.0, 2.0};
+  EXPECT_NEAR(stray_between_points(swing, points), 10.0, 1e-9);
+  const auto line = fit_polynomial(points, 3, PolynomialAxis::X1);
+  ASSERT_TRUE(line.has_value());
+  EXPECT_LT(stray_between_points(line->polynomial, points), 1e-9);
+  EXPECT_EQ(stray_between_points(swing, {}), 0.0);
+}
+
 TEST(PolynomialLandmark, ApproximationErrorOnAndOffTheDomain) {
   const Polynomial p{PolynomialAxis::X1, {0.0, 0.0, 0.0}, 1.0, 0.0, 2.0};  // x2 = 1 for x1 in [0, 2]
   // Inside the domain: the residual.
