@@ -1,5 +1,6 @@
 // End-to-end: `fleetmap slam` as a user runs it.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -62,6 +63,22 @@ TEST(SlamCommand, BadInputGetsOneLine) {
   dir.write("wall.yaml", "room: {boundary: [[0, 0], [4, 0], [4, 3], [0, 3]]}\n"
                          "robots: {team: [{name: a, start: [1, 1, 0], path: [[9, 1]]}]}\n");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario wall.yaml", dir), "within its radius of a wall");
+}
+
+TEST(SlamCommand, ExploreUsesThePolynomialLocalizer) {
+  // The same filter as `explore --localization polynomial`: it learns polynomials from the scan
+  // and keeps every robot within 3 sigma of P0 (0.05 m) of the truth over a short run.
+  TempDir dir;
+  const auto r = run_fleetmap(
+      "explore --map office --robots 2 --localization polynomial --steps 80 --out out",
+      dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto m = nlohmann::json::parse(slurp(dir / "out" / "metrics.json"));
+  for (const auto& robot : m["per_robot"]) {
+    EXPECT_LT(robot["position_rmse_m"].get<double>(), 3 * 0.05) << robot.dump();
+    EXPECT_GE(robot["localizer"]["polynomials"].get<double>(), 4.0) << robot.dump();
+    EXPECT_GT(robot["localizer"]["polynomial_updates"].get<double>(), 100.0) << robot.dump();
+  }
 }
 
 }  // namespace
