@@ -105,15 +105,15 @@ int run_slam(const SlamFlags& f) {
 }  // namespace
 
 Command add_slam_command(CLI::App& root) {
-  CLI::App* app = root.add_subcommand(
-      "slam",
-      "Repeat a SLAM experiment: robots follow precomputed paths in a room, each maps it and localizes itself on\n"
-      "its own, and robots that see each other exchange maps. Writes Table 1 (means and standard deviations over\n"
-      "the runs) as table1.md and table1.csv, runs.csv, rendezvous.csv, and the first run's maps as map_<robot>.png\n"
-      "(and map_<robot>_alone.png for the scenario's single_robot).\n\n"
+  CLI::App* app = root.add_subcommand("slam", "Repeat a SLAM experiment over many runs (seed 000 section 4): Table 1 and figures");
+  app->footer(
+      "Robots follow precomputed paths in a room, each maps it and localizes itself on its own, and robots that\n"
+      "see each other exchange maps. Writes Table 1 (means and standard deviations over the runs) as table1.md and\n"
+      "table1.csv, runs.csv, rendezvous.csv, and the first run's maps as map_<robot>.png (and map_<robot>_alone.png\n"
+      "for the scenario's single_robot). Scenario keys: scenarios/dalfonso_3robots.yaml (commented) and README.md,\n\"Polynomial SLAM (seed 000)\".\n\n"
       "Methods (the scenario's `method`): " + method_names() +
-          "\n  polynomial: seed 000's polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
-          "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso");
+      "\n  polynomial: seed 000's polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
+      "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso");
   auto f = std::make_shared<SlamFlags>();
   app->add_option("--scenario", f->scenario, "SLAM scenario YAML (see scenarios/dalfonso_3robots.yaml)")
       ->required()
