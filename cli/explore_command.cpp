@@ -55,7 +55,7 @@ double parse_range(const std::string& text) {
 
 // A scenario map given as a relative path is relative to the scenario file.
 std::string resolve_map(const sim::Scenario& s) {
-  if (maps::is_builtin_map(s.map) && !fs::exists(s.map)) return s.map;
+  if (maps::is_builtin_map(s.map) && (!fs::exists(s.map) || fs::is_directory(s.map))) return s.map;
   const fs::path p = s.map;
   if (p.is_relative() && !s.base_dir.empty() && fs::exists(s.base_dir / p)) return (s.base_dir / p).string();
   return s.map;

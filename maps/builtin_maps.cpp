@@ -422,8 +422,13 @@ fs::path builtin_maps_dir() {
 mapping::OccupancyGrid load_map_source(const std::string& name_or_path, const mapping::MapLoadOptions& options) {
   if (name_or_path.empty()) throw InputError("map: empty name (built-in maps: " + builtin_map_names() + ")");
   std::error_code ec;
-  if (fs::exists(name_or_path, ec)) return mapping::load_map(name_or_path, options);
-  if (is_builtin_map(name_or_path)) {
+  // A file of that name wins; a folder named like a built-in map (e.g. the output folder of
+  // `fleetmap explore --map maze`, out/maze) does not hide the built-in map.
+  const bool builtin = is_builtin_map(name_or_path);
+  if (fs::exists(name_or_path, ec) && !(builtin && fs::is_directory(name_or_path, ec))) {
+    return mapping::load_map(name_or_path, options);
+  }
+  if (builtin) {
     const fs::path yaml = builtin_maps_dir() / (name_or_path + ".yaml");
     if (!fs::exists(yaml)) {
       throw InputError("map '" + name_or_path + "': built-in map file " + yaml.string() +

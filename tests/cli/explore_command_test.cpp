@@ -197,3 +197,17 @@ TEST(ExploreCommand, RobotsInTheirOwnFramesMergeAtRendezvous) {
 
 }  // namespace
 }  // namespace fleetmap::cli
+
+namespace fleetmap::cli {
+namespace {
+
+TEST(ExploreCommand, AFolderNamedLikeABuiltInMapDoesNotHideIt) {
+  TempDir dir;
+  std::filesystem::create_directories(dir / "maze");  // e.g. the outputs of an earlier run, out/maze
+  const auto r = run_fleetmap("explore --map maze --robots 1 --steps 2 --out o", dir);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(metrics(dir / "o")["map"], "maze");
+}
+
+}  // namespace
+}  // namespace fleetmap::cli
