@@ -58,6 +58,19 @@ struct RobotObservation {
   Eigen::Matrix3d other_covariance = Eigen::Matrix3d::Zero();
 };
 
+// This robot seen by another (seed 002 §III.C, eq. (15)): the detector's range and bearing (rad, in
+// the detector's frame) with their noise, and the detector's belief of its own pose, in this
+// robot's map frame.
+struct DetectedBy {
+  int detector = -1;
+  double range = 0.0;
+  double bearing = 0.0;
+  double range_noise = 0.0;
+  double bearing_noise = 0.0;
+  core::Pose2 detector_pose;
+  Eigen::Matrix3d detector_covariance = Eigen::Matrix3d::Zero();
+};
+
 // Noise models and filter settings shared by the localizers; each uses what it needs.
 struct LocalizerOptions {
   // Odometry noise per step (standard deviations), the model's Q: seed 000 uses 0.001 m and 0.01 deg.
@@ -85,6 +98,12 @@ struct LocalizerOptions {
   int slam_forget_after_steps = 0;
   // Robot-robot detections update the estimate (off by default).
   bool use_robot_detections = false;
+  // `mcl` and `rbpf`: particles per robot.
+  int mcl_particles = 2000;
+  int rbpf_particles = 30;
+  // `rbpf`: each particle's search starts from its odometry step drawn with the process noise
+  // (false: from the odometry step itself, so one particle is the scan matcher).
+  bool rbpf_sample_motion = true;
 };
 
 // What a localizer may be given at the start.
@@ -93,6 +112,10 @@ struct LocalizerContext {
   std::vector<Landmark> known_landmarks;  // for `ekf` (seed 003 §V: fixed artificial landmarks)
   LocalizerOptions options;
   std::uint64_t seed = 0;
+  // `mcl`: the known map, in the robot's map frame; `global_localization`: the robot does not know
+  // initial_pose and starts from a uniform belief over the map's free cells (seed 002 §IV).
+  std::shared_ptr<const mapping::OccupancyGrid> known_map;
+  bool global_localization = false;
 };
 
 class Localizer {
@@ -104,6 +127,8 @@ class Localizer {
   virtual void update_landmarks(const std::vector<LandmarkObservation>& /*observations*/) {}
   virtual void update_scan(const RangeScan& /*scan*/, const mapping::OccupancyGrid& /*own_map*/) {}
   virtual void update_robot(const RobotObservation& /*observation*/) {}
+  // This robot was detected by another (collaborative localization, seed 002 eq. (15)).
+  virtual void update_detected_by(const DetectedBy& /*detection*/) {}
   // Only the `ideal` localizer uses the simulator's truth.
   virtual void observe_truth(const core::Pose2& /*truth*/) {}
 
@@ -121,6 +146,8 @@ class Localizer {
   virtual std::vector<std::pair<std::string, double>> counters() const { return {}; }
   // Landmark estimates held in the state, if any (for pictures and metrics).
   virtual std::vector<Landmark> landmark_estimates() const { return {}; }
+  // The grid the localizer builds itself, if any (`rbpf`: the best particle's map).
+  virtual std::optional<mapping::OccupancyGrid> map_estimate() const { return std::nullopt; }
 };
 
 // The registered names, in the order --help lists them.

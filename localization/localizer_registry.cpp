@@ -24,6 +24,12 @@ const std::vector<Entry>& registry() {
        make_ekf_slam_localizer},
       {"polynomial", "seed 000's polynomial EKF-SLAM: walls as polynomials learnt from the range scan, c0 coefficients in the state",
        make_polynomial_localizer},
+      {"scan-matching", "ML incremental mapping: each scan aligned to the robot's own grid replaces the odometry step (seed 002 §II.A)",
+       make_scan_matching_localizer},
+      {"mcl", "Monte Carlo localization on the known map; collaborative with robot_detections, lost_robots start uniform (seed 002 §IV)",
+       make_mcl_localizer},
+      {"rbpf", "Rao-Blackwellized particle filter, a grid per particle, scan-matching proposal (seed 002 §II.C)",
+       make_rbpf_localizer},
   };
   return kEntries;
 }

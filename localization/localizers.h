@@ -15,5 +15,8 @@ std::unique_ptr<Localizer> make_odometry_localizer(const LocalizerContext& conte
 std::unique_ptr<Localizer> make_ekf_localizer(const LocalizerContext& context);       // ekf_localizer.cpp
 std::unique_ptr<Localizer> make_ekf_slam_localizer(const LocalizerContext& context);  // ekf_slam_localizer.cpp
 std::unique_ptr<Localizer> make_polynomial_localizer(const LocalizerContext& context);  // polynomial_localizer.cpp
+std::unique_ptr<Localizer> make_scan_matching_localizer(const LocalizerContext& context);  // scan_matching_localizer.cpp
+std::unique_ptr<Localizer> make_mcl_localizer(const LocalizerContext& context);            // mcl_localizer.cpp
+std::unique_ptr<Localizer> make_rbpf_localizer(const LocalizerContext& context);           // rbpf_localizer.cpp
 
 }  // namespace fleetmap::localization

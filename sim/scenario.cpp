@@ -167,6 +167,14 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     o.use_robot_detections = loc.boolean("robot_detections", o.use_robot_detections);
     o.initial_xy = loc.number("initial_sigma_xy", o.initial_xy, 0.0, 1e3);
     o.initial_theta = deg2rad(loc.number("initial_sigma_heading_deg", rad2deg(o.initial_theta), 0.0, 360.0));
+    o.mcl_particles = int(loc.integer("mcl_particles", o.mcl_particles, 1, 1000000));
+    o.rbpf_particles = int(loc.integer("rbpf_particles", o.rbpf_particles, 1, 10000));
+    for (double r : loc.numbers("lost_robots")) {
+      if (r != std::floor(r) || r < 1) {
+        throw InputError(loc.where("lost_robots") + ": expected robot numbers from 1, got " + fmt(r));
+      }
+      s.lost_robots.push_back(int(r));
+    }
     loc.finish();
   }
   {
@@ -237,6 +245,11 @@ void validate_scenario(const Scenario& s) {
   };
   check_name("exploration.strategy", s.exploration.strategy, exploration::strategy_names());
   check_name("localization", s.localization, localization::localizer_names());
+  for (int r : s.lost_robots) {
+    if (s.localization != "mcl") throw InputError("localization.lost_robots: only 'mcl' can start without its pose, not '" + s.localization + "'");
+    const int count = s.placement == Placement::List ? int(s.starts.size()) : s.robot_count;
+    if (r < 1 || r > count) throw InputError("localization.lost_robots: robot " + std::to_string(r) + " does not exist (robots 1.." + std::to_string(count) + ")");
+  }
   check_name("merging", s.merging, merging_names());
   check_name("merging.method", s.merge_method, merging::merge_method_names());
   check_name("exploration.path_planner", s.path_planner, path_planner_names());
@@ -283,6 +296,12 @@ std::string scenario_to_yaml(const Scenario& s) {
   y << "localization:\n  method: " << s.localization << "\n  known_associations: " << (o.known_associations ? "true" : "false")
     << "\n  association_gate: " << fmt(o.association_gate) << "\n  robot_detections: " << (o.use_robot_detections ? "true" : "false")
     << "\n  initial_sigma_xy: " << fmt(o.initial_xy) << "\n  initial_sigma_heading_deg: " << fmt(rad2deg(o.initial_theta)) << "\n";
+  y << "  mcl_particles: " << o.mcl_particles << "\n  rbpf_particles: " << o.rbpf_particles << "\n";
+  if (!s.lost_robots.empty()) {
+    y << "  lost_robots: [";
+    for (std::size_t i = 0; i < s.lost_robots.size(); ++i) y << (i ? ", " : "") << s.lost_robots[i];
+    y << "]\n";
+  }
   y << "communication:\n  range: " << fmt(s.communication.range_m) << "\n  line_of_sight: " << (s.communication.line_of_sight ? "true" : "false") << "\n";
   const auto& e = s.exploration;
   y << "exploration:\n  strategy: " << e.strategy << "\n  beta: " << fmt(e.strategy_options.beta)

@@ -42,6 +42,9 @@ struct Scenario {
 
   std::string localization = "ideal";
   localization::LocalizerOptions localization_options;
+  // Robots (numbered from 1) that do not know where they start: `mcl` starts them from a uniform
+  // belief over the map (global localization, seed 002 §IV).
+  std::vector<int> lost_robots;
   CommunicationOptions communication;
   exploration::ExplorationOptions exploration;
   // How robots bring others' maps into their frame: "known" (every robot knows its start pose in a

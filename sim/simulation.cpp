@@ -204,7 +204,11 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   context.options.bearing_noise = scenario_.landmark_sensor.bearing_noise_rad;
   context.options.scan_range_noise = scenario_.range.noise_m;
   context.options.known_associations = scenario_.landmark_sensor.report_ids && scenario_.localization_options.known_associations;
+  // `mcl` localizes on the known map, which is only meaningful in the world frame.
+  if (scenario_.merging == "known") context.known_map = std::make_shared<const mapping::OccupancyGrid>(world_.truth());
   for (int i = 0; i < n; ++i) {
+    context.global_localization = std::find(scenario_.lost_robots.begin(), scenario_.lost_robots.end(), i + 1) !=
+                                  scenario_.lost_robots.end();
     motion_rng_.push_back(rng_.fork(100 + std::uint64_t(i)));
     sensor_rng_.push_back(rng_.fork(200 + std::uint64_t(i)));
     // Each robot knows its start and the landmark map in its own map frame.
@@ -286,6 +290,18 @@ void Simulation::sense_and_map() {
         if (frame_of_[std::size_t(d.other)] != frame_of_[std::size_t(i)]) continue;  // its estimate means nothing here
         const auto& other = *localizers_[std::size_t(d.other)];
         loc.update_robot({d.other, d.range, d.bearing, other.pose(), other.covariance()});
+      }
+    }
+  }
+  // Collaborative localization (seed 002 eq. (15)): the detected robot learns from its detector.
+  if (scenario_.localization_options.use_robot_detections) {
+    for (int i = 0; i < n; ++i) {
+      for (const auto& d : detections_[std::size_t(i)]) {
+        if (frame_of_[std::size_t(d.other)] != frame_of_[std::size_t(i)]) continue;
+        const auto& detector = *localizers_[std::size_t(i)];
+        localizers_[std::size_t(d.other)]->update_detected_by({i, d.range, d.bearing, scenario_.detector.range_noise_m,
+                                                               scenario_.detector.bearing_noise_rad, detector.pose(),
+                                                               detector.covariance()});
       }
     }
   }

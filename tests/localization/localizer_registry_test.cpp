@@ -15,7 +15,7 @@ namespace {
 
 TEST(LocalizerRegistry, ListsTheLocalizersInHelpOrder) {
   const std::vector<std::string> names = localizer_names();
-  EXPECT_EQ(names, (std::vector<std::string>{"ideal", "odometry", "ekf", "ekf-slam", "polynomial"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"ideal", "odometry", "ekf", "ekf-slam", "polynomial", "scan-matching", "mcl", "rbpf"}));
   const std::string help = localizer_help();
   for (const auto& n : names) EXPECT_NE(help.find("  " + n + ": "), std::string::npos) << n;
 }
@@ -29,6 +29,14 @@ TEST(LocalizerRegistry, AnUnknownNameIsAnInputErrorListingTheValidNames) {
     EXPECT_NE(message.find("'kalman'"), std::string::npos) << message;
     for (const auto& n : localizer_names()) EXPECT_NE(message.find(n), std::string::npos) << message;
   }
+}
+
+// A 120 m square of free space centred on the loop, for the localizers that need a known map.
+std::shared_ptr<const mapping::OccupancyGrid> open_known_map() {
+  auto g = std::make_shared<mapping::OccupancyGrid>(core::GridGeometry(1.0, 120, 120, core::Pose2(-60.0, -60.0, 0.0)));
+  for (int y = 0; y < 120; ++y)
+    for (int x = 0; x < 120; ++x) g->set_state({x, y}, mapping::CellState::Free);
+  return g;
 }
 
 class EveryLocalizer : public ::testing::TestWithParam<std::string> {};
@@ -49,6 +57,7 @@ TEST_P(EveryLocalizer, FollowsTheRobotWithAFinitePoseAndCovariance) {
   c.known_landmarks = world.landmarks;
   c.options = o;
   c.seed = 5;
+  c.known_map = open_known_map();  // for `mcl`: free space around the loop
   auto localizer = make_localizer(GetParam(), c);
   EXPECT_EQ(localizer->name(), GetParam());
 

@@ -1,0 +1,94 @@
+// The grid-SLAM and MCL localizers inside the simulator (`fleetmap explore --localization ...`),
+// and the scenario keys they bring.
+#include <gtest/gtest.h>
+
+#include "core/angle.h"
+#include "maps/builtin_maps.h"
+#include "sim/run_output.h"
+#include "sim/scenario.h"
+#include "sim/simulation.h"
+#include "tests/test_support.h"
+
+namespace fleetmap::sim {
+namespace {
+
+using fleetmap::testing::expect_input_error;
+
+Scenario noisy(const std::string& localization, int robots, int steps) {
+  Scenario s;
+  s.map = "office";
+  s.robot_count = robots;
+  s.steps = steps;
+  // Visible motion noise: 2 cm and 1 degree per step, which dead reckoning cannot undo.
+  s.noise = {0.02, core::deg2rad(1.0)};
+  s.localization = localization;
+  s.localization_options.rbpf_particles = 12;
+  return s;
+}
+
+double rmse(const std::string& localization, int steps) {
+  const auto grid = maps::load_map_source("office");
+  return metrics_json(Simulation(noisy(localization, 1, steps), grid).run(), "office")["position_rmse_m"].get<double>();
+}
+
+// Scan matching on the robot's own grid, and the particle filter, undo most of the drift that
+// dead reckoning accumulates over the same run (same seed, same noise).
+TEST(GridSlamSimulation, ScanMatchingAndRbpfBeatDeadReckoningInExplore) {
+  const double odometry = rmse("odometry", 120);
+  const double scan = rmse("scan-matching", 120);
+  const double rbpf = rmse("rbpf", 120);
+  EXPECT_GT(odometry, 0.1);
+  EXPECT_LT(scan, 0.5 * odometry);
+  EXPECT_LT(rbpf, 0.5 * odometry);
+}
+
+// A lost robot (uniform belief) in the explore loop: alone it does not know where it starts; detected
+// by a teammate that knows its start, it ends the run localized.
+TEST(GridSlamSimulation, MclLostRobotIsLocalizedInExplore) {
+  const auto grid = maps::load_map_source("office");
+  Scenario s = noisy("mcl", 2, 60);
+  s.noise = {0.005, core::deg2rad(0.3)};
+  s.localization_options.mcl_particles = 1500;
+  s.lost_robots = {2};
+  const RunResult alone = Simulation(s, grid).run();
+  EXPECT_GT((alone.robots[1].estimate.front().position() - alone.robots[1].truth.front().position()).norm(), 0.5);
+  s.localization_options.use_robot_detections = true;
+  const RunResult r = Simulation(s, grid).run();
+  const auto& lost = r.robots[1];
+  EXPECT_LT((lost.estimate.back().position() - lost.truth.back().position()).norm(), 0.3);
+  double used = 0;
+  for (const auto& [k, v] : lost.localizer_counters) if (k == "robot_detections_used") used = v;
+  EXPECT_GT(used, 0);
+}
+
+TEST(GridSlamSimulation, MclNeedsTheKnownMapFrame) {
+  const auto grid = maps::load_map_source("office");
+  Scenario s = noisy("mcl", 2, 10);
+  s.merging = "rendezvous";
+  expect_input_error([&] { Simulation(s, grid); }, {"mcl", "merging: known"});
+}
+
+TEST(GridSlamScenario, ReadsAndWritesTheNewLocalizationKeys) {
+  const Scenario s = parse_scenario(
+      "localization:\n  method: mcl\n  mcl_particles: 500\n  rbpf_particles: 12\n  lost_robots: [2]\nrobots:\n  count: 3\n",
+      "t.yaml", ".");
+  EXPECT_EQ(s.localization_options.mcl_particles, 500);
+  EXPECT_EQ(s.localization_options.rbpf_particles, 12);
+  EXPECT_EQ(s.lost_robots, std::vector<int>{2});
+  const Scenario back = parse_scenario(scenario_to_yaml(s), "back.yaml", ".");
+  EXPECT_EQ(back.lost_robots, s.lost_robots);
+  EXPECT_EQ(back.localization_options.mcl_particles, 500);
+}
+
+TEST(GridSlamScenario, BadLocalizationKeysAreOneLineErrors) {
+  const auto parse = [](const std::string& text) { validate_scenario(parse_scenario(text, "t.yaml", ".")); };
+  expect_input_error([&] { parse("localization:\n  method: ekf\n  lost_robots: [1]\n"); }, {"lost_robots", "'ekf'"});
+  expect_input_error([&] { parse("localization:\n  method: mcl\n  lost_robots: [5]\nrobots:\n  count: 2\n"); },
+                     {"lost_robots", "robot 5"});
+  expect_input_error([&] { parse("localization:\n  method: mcl\n  lost_robots: [1.5]\n"); }, {"lost_robots", "1.5"});
+  expect_input_error([&] { parse("localization:\n  method: rbpf\n  rbpf_particles: 0\n"); }, {"rbpf_particles"});
+  expect_input_error([&] { parse("localization:\n  method: mcl\n  mcl_particles: -3\n"); }, {"mcl_particles"});
+}
+
+}  // namespace
+}  // namespace fleetmap::sim
