@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli/command.h"
+#include "cli/corridor_command.h"
 #include "cli/progress.h"
 #include "core/error.h"
 #include "sim/slam_experiment.h"
@@ -41,6 +42,11 @@ std::string method_names() {
 }
 
 int run_slam(const SlamFlags& f) {
+  // Seed 002's corridor experiment (experiment: leon_corridor) has its own runner.
+  if (is_corridor_scenario_file(f.scenario)) {
+    const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
+    return run_corridor_scenario(f.scenario, out, f.seed, f.quiet);
+  }
   sim::SlamScenario s = sim::load_slam_scenario(f.scenario);
   if (f.runs) s.runs = *f.runs;
   if (f.seed) s.seed = *f.seed;
@@ -113,7 +119,9 @@ Command add_slam_command(CLI::App& root) {
       "for the scenario's single_robot). Scenario keys: scenarios/dalfonso_3robots.yaml (commented) and README.md,\n\"Polynomial SLAM (seed 000)\".\n\n"
       "Methods (the scenario's `method`): " + method_names() +
       "\n  polynomial: seed 000's polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
-      "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso");
+      "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso\n\n"
+      "Scenarios with `experiment: leon_corridor` (scenarios/leon_corridor.yaml) run seed 002's corridor comparison\n"
+      "and merging by detection instead (--runs and --jobs do not apply); README.md, \"Grid SLAM and MCL (seed 002)\".");
   auto f = std::make_shared<SlamFlags>();
   app->add_option("--scenario", f->scenario, "SLAM scenario YAML (see scenarios/dalfonso_3robots.yaml)")
       ->required()
