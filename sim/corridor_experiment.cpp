@@ -376,8 +376,10 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
       free_space.at<std::uint8_t>(y, x) = result.truth.state({x, y}) == mapping::CellState::Occupied ? 0 : 255;
   cv::Mat wall_distance;
   cv::distanceTransform(free_space, wall_distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-  const mapping::OccupancyGrid& master_map = master_run.maps.front();
-  const mapping::OccupancyGrid& other_map = other_run.maps.front();
+  result.master_map = master_run.maps.front();
+  result.other_map = other_run.maps.front();
+  const mapping::OccupancyGrid& master_map = result.master_map;
+  const mapping::OccupancyGrid& other_map = result.other_map;
   for (double err_deg : o.detection_errors_deg) {
     DetectionMerge m;
     m.orientation_error_deg = err_deg;
@@ -387,7 +389,7 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
     m.rotation_error_deg = core::rad2deg(std::abs(core::normalize_angle(t.rotation() - true_other_to_master.rotation())));
     m.far_end_error_m = (t.apply(Eigen::Vector2d::Zero()) - true_other_to_master.apply(Eigen::Vector2d::Zero())).norm();
     m.merged = master_map;
-    merging::fuse_into(m.merged, other_map, t);
+    merging::fuse_into(m.merged, other_map, merging::cells_from_world(master_map.geometry(), other_map.geometry(), t));
     // The other's walls, placed by t, against the true walls.
     double sum = 0.0;
     int count = 0, misplaced = 0;

@@ -105,6 +105,7 @@ struct CorridorResult {
   MapDimensions real;          // measured on the true walls' faces (the free space's extent)
   std::vector<CorridorRun> runs;
   std::vector<DetectionMerge> merges;
+  mapping::OccupancyGrid master_map, other_map;        // each in its own frame, before merging
   std::vector<core::Pose2> master_path, other_path;  // true paths of the merge study, world frame
   core::Pose2 meeting_master, meeting_other;          // true poses at the meeting
 };

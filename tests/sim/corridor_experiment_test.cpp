@@ -78,6 +78,8 @@ TEST(CorridorExperiment, MeasuresEveryMethodAndShowsWhatADetectionErrorDoes) {
   EXPECT_GT(off.far_end_error_m, exact.far_end_error_m + 0.3);
   EXPECT_GT(off.mean_wall_distance_m, exact.mean_wall_distance_m);
   EXPECT_GT(off.misplaced_wall_share, exact.misplaced_wall_share);
+  // The merged map holds the other's corridors: the two maps overlap only at the meeting corner.
+  EXPECT_GT(exact.merged.known_count(), r.master_map.known_count() + r.other_map.known_count() / 2);
 }
 
 TEST(CorridorExperiment, WritesTablesFiguresAndJson) {
