@@ -20,5 +20,6 @@ Command add_merge_command(CLI::App& root);
 Command add_plan_command(CLI::App& root);
 Command add_slam_command(CLI::App& root);
 Command add_explore_command(CLI::App& root);
+Command add_bench_command(CLI::App& root);
 
 }  // namespace fleetmap::cli

@@ -67,6 +67,7 @@ int main(int argc, char** argv) {
 
   std::vector<fm::cli::Command> commands;
   commands.push_back(fm::cli::add_explore_command(app));
+  commands.push_back(fm::cli::add_bench_command(app));
   commands.push_back(fm::cli::add_maps_command(app));
   commands.push_back(fm::cli::add_merge_command(app));
   commands.push_back(fm::cli::add_plan_command(app));

@@ -9,6 +9,7 @@ packages=(
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev
+  slurm-wlm
 )
 # `--robustness` adds clang and its libFuzzer runtime, for the fuzzing stage of .ci/run.
 [[ "${1:-}" == "--robustness" ]] && packages+=(clang libclang-rt-14-dev)

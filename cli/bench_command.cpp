@@ -1,0 +1,260 @@
+// `fleetmap bench`: the coordination-strategy benchmark. Runs a sweep (maps x strategies x team
+// sizes x seeds) on a pool of threads, appending each run's row to results.csv; resumes an
+// interrupted sweep; runs one shard of it; combines shards; compares two strategies run by run.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli/command.h"
+#include "cli/progress.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "exploration/strategy.h"
+#include "maps/builtin_maps.h"
+#include "sim/scenario.h"
+#include "sim/sweep.h"
+#include "sim/sweep_report.h"
+#include "sim/sweep_results.h"
+#include "sim/sweep_runner.h"
+
+namespace fleetmap::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct BenchFlags {
+  std::string sweep_file;
+  sim::SweepOverrides sweep;
+  int jobs = std::max(1u, std::thread::hardware_concurrency());
+  std::string shard;
+  std::string out;
+  std::vector<std::string> combine;
+  std::vector<std::string> compare;
+  std::string metric = "steps_to_99";
+  bool quiet = false;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+bool any_sweep_flag(const BenchFlags& f) {
+  const auto& s = f.sweep;
+  return !f.sweep_file.empty() || !f.shard.empty() || s.maps || s.strategies || s.robots || s.seeds || s.first_seed ||
+         s.scenario || s.steps || s.localization || s.comm_range || s.sensor_range;
+}
+
+fs::path results_of(const std::string& dir, const std::string& flag) {
+  const fs::path d = dir;
+  if (!fs::is_directory(d)) throw InputError(flag + ": '" + dir + "' is not a folder");
+  if (!fs::is_regular_file(d / "results.csv")) {
+    throw InputError(flag + ": '" + dir + "' holds no results.csv (not an output folder of fleetmap bench)");
+  }
+  return d / "results.csv";
+}
+
+// The sweep a results folder was made by (its sweep.yaml), if it has one that still loads.
+std::optional<sim::Sweep> sweep_of(const fs::path& dir) {
+  if (!fs::is_regular_file(dir / "sweep.yaml")) return std::nullopt;
+  return sim::load_sweep(dir / "sweep.yaml");
+}
+
+void write_sweep_files(const fs::path& out, const sim::Sweep& sweep) {
+  core::write_file_atomic(out / "scenario.yaml", sim::scenario_to_yaml(sweep.base));
+  core::write_file_atomic(out / "sweep.yaml", sim::sweep_to_yaml(sweep, "scenario.yaml"));
+}
+
+void print_outputs(const fs::path& out, const std::vector<fs::path>& reports) {
+  std::printf("results: %s\nsummary: %s\n", (out / "results.csv").c_str(), (out / "summary.md").c_str());
+  std::printf("plots:");
+  for (const auto& p : reports) {
+    if (p.extension() == ".png") std::printf(" %s", p.filename().c_str());
+  }
+  std::printf("\n");
+}
+
+int run_compare(const BenchFlags& f) {
+  if (any_sweep_flag(f) || !f.combine.empty()) throw InputError("--compare A B DIR takes no sweep flags and no --combine");
+  const fs::path path = results_of(f.compare[2], "--compare");
+  const auto table = sim::read_results(path);
+  const auto comparison = sim::compare_strategies(table.records, f.compare[0], f.compare[1], f.metric);
+  std::printf("%s", sim::comparison_text(comparison).c_str());
+  return 0;
+}
+
+int run_combine(const BenchFlags& f) {
+  if (any_sweep_flag(f)) throw InputError("--combine DIR... takes only folders and --out (no sweep flags)");
+  if (f.out.empty()) throw InputError("--combine needs --out DIR: the folder for the combined results");
+  std::vector<sim::RunRecord> records;
+  std::map<sim::RunKey, std::pair<std::size_t, fs::path>> seen;
+  std::string settings;
+  fs::path settings_from;
+  std::optional<sim::Sweep> sweep;
+  for (const auto& dir : f.combine) {
+    const fs::path path = results_of(dir, "--combine");
+    auto table = sim::read_results(path);
+    if (settings.empty() && !table.records.empty()) settings = table.records.front().settings, settings_from = path;
+    sim::check_settings(table.records, settings, path);
+    if (!sweep) sweep = sweep_of(dir);
+    for (auto& r : table.records) {
+      if (const auto it = seen.find(r.key); it != seen.end()) {
+        if (sim::record_without_wall_time(records[it->second.first]) != sim::record_without_wall_time(r)) {
+          throw InputError("--combine: the run " + r.key.map + "/" + r.key.strategy + "/" + std::to_string(r.key.robots) +
+                           " robots/seed " + std::to_string(r.key.seed) + " differs between " + it->second.second.string() +
+                           " and " + path.string());
+        }
+        continue;
+      }
+      seen.emplace(r.key, std::make_pair(records.size(), path));
+      records.push_back(std::move(r));
+    }
+  }
+  const fs::path out = f.out;
+  core::ensure_directory(out);
+  std::size_t expected = 0;
+  if (sweep) {
+    const auto runs = sim::sweep_runs(*sweep);
+    expected = runs.size();
+    sim::sort_records(records, runs);
+    write_sweep_files(out, *sweep);
+  } else {
+    sim::sort_records(records, {});
+  }
+  sim::write_results(out / "results.csv", records);
+  const auto reports = sim::write_sweep_reports(out, records);
+  std::printf("combined %zu runs from %zu folders into %s\n", records.size(), f.combine.size(), out.c_str());
+  if (expected > records.size()) {
+    std::printf("note: %zu of the sweep's %zu runs are missing (shards not finished or not given)\n",
+                expected - records.size(), expected);
+  }
+  print_outputs(out, reports);
+  return 0;
+}
+
+int run_bench(const BenchFlags& f) {
+  if (f.compare.size() == 3) return run_compare(f);
+  if (!f.combine.empty()) return run_combine(f);
+
+  sim::Sweep sweep;
+  if (!f.sweep_file.empty()) sweep = sim::load_sweep(f.sweep_file);
+  sim::apply_overrides(sweep, f.sweep);
+  sim::validate_sweep(sweep);
+  const std::optional<sim::Shard> shard = f.shard.empty() ? std::nullopt : std::optional(sim::parse_shard(f.shard));
+
+  sim::SweepMaps maps;
+  for (const auto& source : sweep.maps) {
+    try {
+      maps.emplace(sim::map_label(source), maps::load_map_source(source));
+    } catch (const InputError& e) {
+      throw InputError(std::string(f.sweep.maps || f.sweep_file.empty() ? "--maps" : f.sweep_file + ": maps") + ": " + e.what());
+    }
+  }
+  sim::check_placements(sweep, maps);
+
+  const auto all_runs = sim::sweep_runs(sweep);
+  const auto runs = shard ? sim::shard_runs(all_runs, *shard) : all_runs;
+  const fs::path out = f.out.empty() ? fs::path("out/bench") : fs::path(f.out);
+  core::ensure_directory(out);
+  const fs::path results = out / "results.csv";
+  const std::string settings = sim::settings_id(sweep.base);
+
+  std::set<sim::RunKey> done;
+  if (fs::exists(results)) {
+    const auto table = sim::read_results(results);
+    sim::check_settings(table.records, settings, results);
+    for (const auto& r : table.records) done.insert(r.key);
+  }
+  std::vector<sim::SweepRun> todo;
+  for (const auto& r : runs) {
+    if (!done.count({r.map, r.strategy, r.robots, r.seed})) todo.push_back(r);
+  }
+  write_sweep_files(out, sweep);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  {
+    sim::ResultsAppender appender(results);
+    ProgressBar bar(!f.quiet);
+    long finished = 0;
+    bar.update(0, long(todo.size()));
+    sim::run_sweep(sweep, todo, maps, {f.jobs}, [&](const sim::RunRecord& r) {
+      appender.append(r);
+      bar.update(++finished, long(todo.size()),
+                 r.key.map + " " + r.key.strategy + " " + std::to_string(r.key.robots) + "r seed " + std::to_string(r.key.seed));
+    });
+    bar.finish();
+  }
+  const double elapsed = seconds_since(t0);
+
+  // The final tables: every row of results.csv, in the sweep's order.
+  auto records = sim::read_results(results).records;
+  sim::sort_records(records, all_runs);
+  sim::write_results(results, records);
+  const auto reports = sim::write_sweep_reports(out, records);
+
+  if (f.quiet) {
+    std::printf("%s\n", results.c_str());
+    return 0;
+  }
+  std::printf("%zu runs of %zu maps x %zu strategies x %zu team sizes x %d seeds", all_runs.size(), sweep.maps.size(),
+              sweep.strategies.size(), sweep.robots.size(), sweep.seeds);
+  if (shard) std::printf("; shard %d/%d: %zu runs", shard->index, shard->count, runs.size());
+  std::printf("\nran %zu runs in %.1f s with %d jobs; %zu were already in results.csv\n", todo.size(), elapsed,
+              std::max(1, std::min<int>(f.jobs, int(std::max<std::size_t>(1, todo.size())))), runs.size() - todo.size());
+  print_outputs(out, reports);
+  return 0;
+}
+
+}  // namespace
+
+Command add_bench_command(CLI::App& root) {
+  CLI::App* app = root.add_subcommand(
+      "bench",
+      "Benchmark coordination strategies: every combination of maps, strategies, team sizes and seeds, run in\n"
+      "parallel; writes results.csv (a row per run), summary.csv and summary.md (mean, standard deviation and 95%\n"
+      "confidence interval per map x strategy x team size) and plots into --out. Run it again with the same --out\n"
+      "after an interruption and it finishes the sweep without redoing finished runs.\n\n"
+      "  fleetmap bench --maps office,cave --strategies all --robots 1,2,4,9 --seeds 20 --jobs 2 --out DIR\n"
+      "  fleetmap bench --sweep scenarios/sweeps/seed003.yaml --shard 2/4 --out DIR/shard_2\n"
+      "  fleetmap bench --combine DIR/shard_1 DIR/shard_2 DIR/shard_3 DIR/shard_4 --out DIR/all\n"
+      "  fleetmap bench --compare coordinated uncoordinated DIR\n\n"
+      "Strategies:\n" +
+          exploration::strategy_help());
+  auto f = std::make_shared<BenchFlags>();
+  auto& s = f->sweep;
+  app->add_option("--sweep", f->sweep_file, "Sweep YAML file (see scenarios/sweeps/); flags below override it")
+      ->check(CLI::ExistingFile);
+  app->add_option("--maps", s.maps,
+                  "Comma-separated built-in maps or map files [default: empty,unstructured,office,corridor]");
+  app->add_option("--strategies", s.strategies, "Comma-separated strategies, or all [default: all]");
+  app->add_option("--robots", s.robots, "Team sizes, e.g. 1,2,4,9 or 1-9 [default: 1,2,4,9]");
+  app->add_option("--seeds", s.seeds, "Seeds per combination [default: 20]");
+  app->add_option("--first-seed", s.first_seed, "The first seed; runs use first-seed, first-seed + 1, ... [default: 1]");
+  app->add_option("--scenario", s.scenario,
+                  "Scenario file every run starts from (its map, strategy, robots and seed are replaced) "
+                  "[default: the scenario defaults of `fleetmap explore`]");
+  app->add_option("--steps", s.steps, "Step limit of each run [default: 2000]");
+  app->add_option("--localization", s.localization, "How robots know their pose [default: ideal]");
+  app->add_option("--comm-range", s.comm_range, "Communication range in metres, or inf [default: inf]");
+  app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]");
+  app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")->check(CLI::PositiveNumber);
+  app->add_option("--shard", f->shard, "Run only the K-th of N slices of the sweep, K/N (for clusters; see bench/slurm/)");
+  app->add_option("--out", f->out, "Output folder, created if missing [default: out/bench]");
+  app->add_option("--combine", f->combine, "Join the results of these output folders (shards) into --out")->expected(1, -1);
+  app->add_option("--compare", f->compare,
+                  "A B DIR: paired comparison of strategies A and B on the runs in DIR (same maps, team sizes and seeds)")
+      ->expected(3);
+  app->add_option("--metric", f->metric,
+                  "Metric of --compare: steps_to_95, steps_to_99, distance_m, redundancy, bytes_sent, efficiency, coverage")
+      ->capture_default_str();
+  app->add_flag("--quiet,-q", f->quiet, "Print only the path of results.csv; no progress bar");
+  return {app, [f]() { return run_bench(*f); }};
+}
+
+}  // namespace fleetmap::cli
