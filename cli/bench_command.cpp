@@ -48,7 +48,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 bool any_sweep_flag(const BenchFlags& f) {
   const auto& s = f.sweep;
   return !f.sweep_file.empty() || !f.shard.empty() || s.maps || s.strategies || s.robots || s.seeds || s.first_seed ||
-         s.scenario || s.steps || s.localization || s.comm_range || s.sensor_range;
+         s.scenario || s.steps || s.localization || s.merging || s.comm_range || s.sensor_range;
 }
 
 fs::path results_of(const std::string& dir, const std::string& flag) {
@@ -241,6 +241,9 @@ Command add_bench_command(CLI::App& root) {
                   "[default: the scenario defaults of `fleetmap explore`]");
   app->add_option("--steps", s.steps, "Step limit of each run [default: 2000]");
   app->add_option("--localization", s.localization, "How robots know their pose [default: ideal]");
+  app->add_option("--merging", s.merging,
+                  "How robots bring teammates' maps into their frame: known, rendezvous or overlap (see `fleetmap "
+                  "explore --help`) [default: known]");
   app->add_option("--comm-range", s.comm_range, "Communication range in metres, or inf [default: inf]");
   app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]");
   app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")->check(CLI::PositiveNumber);

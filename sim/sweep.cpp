@@ -186,6 +186,7 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
   sweep.first_seed = std::uint64_t(top.integer("first_seed", (long long)sweep.first_seed, 0));
   sweep.base.steps = int(top.integer("steps", sweep.base.steps, 1, 10'000'000));
   sweep.base.localization = top.text("localization", sweep.base.localization);
+  sweep.base.merging = top.choice("merging", sweep.base.merging, merging_names());
   if (const auto c = top.node("comm_range")) {
     if (!c->IsScalar()) throw InputError(top.where("comm_range") + ": expected metres >= 0 or 'inf'");
     sweep.base.communication.range_m = parse_comm_range(c->Scalar(), top.where("comm_range"));
@@ -222,6 +223,13 @@ void apply_overrides(Sweep& sweep, const SweepOverrides& f) {
     sweep.base.steps = *f.steps;
   }
   if (f.localization) sweep.base.localization = *f.localization;
+  if (f.merging) {
+    const auto names = merging_names();
+    if (std::find(names.begin(), names.end(), *f.merging) == names.end()) {
+      throw InputError("--merging: unknown mode '" + *f.merging + "' (valid: " + join(names) + ")");
+    }
+    sweep.base.merging = *f.merging;
+  }
   if (f.comm_range) sweep.base.communication.range_m = parse_comm_range(*f.comm_range, "--comm-range");
   if (f.sensor_range) {
     if (!(*f.sensor_range > 0.0)) throw InputError("--sensor-range: expected metres > 0");
@@ -270,6 +278,7 @@ std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file) 
   y += "scenario: " + quoted(scenario_file) + "\n";
   y += "steps: " + std::to_string(sweep.base.steps) + "\n";
   y += "localization: " + sweep.base.localization + "\n";
+  y += "merging: " + sweep.base.merging + "\n";
   y += "comm_range: " + number_text(sweep.base.communication.range_m) + "\n";
   y += "sensor_range: " + number_text(sweep.base.range.max_range_m) + "\n";
   return y;

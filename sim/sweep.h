@@ -33,6 +33,7 @@ struct SweepOverrides {
   std::optional<std::string> scenario;  // a scenario file: the base
   std::optional<int> steps;
   std::optional<std::string> localization;
+  std::optional<std::string> merging;     // known, rendezvous or overlap
   std::optional<std::string> comm_range;  // metres, or "inf"
   std::optional<double> sensor_range;
 };
@@ -50,7 +51,7 @@ std::vector<int> parse_team_sizes(const std::string& text, const std::string& wh
 double parse_comm_range(const std::string& text, const std::string& what);
 
 // Parses a sweep file. Keys: maps, strategies, robots, seeds, first_seed, scenario (a scenario file,
-// relative to the sweep file), steps, localization, comm_range, sensor_range. Relative map files are
+// relative to the sweep file), steps, localization, merging, comm_range, sensor_range. Relative map files are
 // resolved against `base_dir` when they exist there.
 Sweep parse_sweep(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 Sweep load_sweep(const std::filesystem::path& path);

@@ -168,11 +168,11 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
   const RunRecord& first = records.front();
   char settings[256];
   std::snprintf(settings, sizeof settings,
-                "localization %s, communication range %s, sensor range %g m, step limit %d (settings %s)",
-                first.localization.c_str(), std::isinf(first.comm_range_m) ? "unlimited" : (number(first.comm_range_m, 1) + " m").c_str(),
+                "localization %s, merging %s, communication range %s, sensor range %g m, step limit %d (settings %s)",
+                first.localization.c_str(), first.merging.c_str(), std::isinf(first.comm_range_m) ? "unlimited" : (number(first.comm_range_m, 1) + " m").c_str(),
                 first.sensor_range_m, first.step_limit, first.settings.c_str());
   md += std::to_string(records.size()) + " runs: maps " + join(maps) + "; strategies " + join(strategies) +
-        "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) + " seeds. " + settings + ".\n\n";
+        "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) + (seeds.size() == 1 ? " seed. " : " seeds. ") + settings + ".\n\n";
   md += "Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
         "reached the level. **Bold**: the best strategy in the column for that map and team size (lowest; highest for "
         "efficiency and coverage). Efficiency = lower bound / steps to 99% (README.md, \"Benchmarking strategies\").\n";

@@ -25,9 +25,9 @@ namespace {
 
 const std::vector<std::string>& columns() {
   static const std::vector<std::string> kColumns = {
-      "map", "strategy", "robots", "seed", "localization", "comm_range_m", "sensor_range_m", "step_limit", "settings",
+      "map", "strategy", "robots", "seed", "localization", "merging", "comm_range_m", "sensor_range_m", "step_limit", "settings",
       "steps", "finished", "coverage", "steps_to_95", "steps_to_99", "distance_m", "redundancy", "bytes_sent",
-      "meetings", "blocked_moves", "position_rmse_m", "lower_bound_steps", "lower_bound_travel_steps",
+      "meetings", "merges_made", "blocked_moves", "position_rmse_m", "lower_bound_steps", "lower_bound_travel_steps",
       "lower_bound_area_steps", "efficiency", "wall_time_s", "steps_to_percent"};
   return kColumns;
 }
@@ -154,6 +154,7 @@ RunRecord make_record(const RunResult& result, const World& world, const std::st
   RunRecord r;
   r.key = {map_label, s.exploration.strategy, s.robot_count, s.seed};
   r.localization = s.localization;
+  r.merging = s.merging;
   r.comm_range_m = s.communication.range_m;
   r.sensor_range_m = s.range.max_range_m;
   r.step_limit = s.steps;
@@ -167,6 +168,7 @@ RunRecord make_record(const RunResult& result, const World& world, const std::st
   r.redundancy = m["redundancy"].get<double>();
   r.bytes_sent = m["bytes_sent"].get<std::int64_t>();
   r.meetings = m["meetings"].get<int>();
+  r.merges_made = m["merges_made"].get<int>();
   r.blocked_moves = m["blocked_moves"].get<int>();
   r.position_rmse_m = m["position_rmse_m"].get<double>();
 
@@ -222,6 +224,7 @@ std::string record_without_wall_time(const RunRecord& r) {
                                       std::to_string(r.key.robots),
                                       std::to_string(r.key.seed),
                                       r.localization,
+                                      r.merging,
                                       std::isinf(r.comm_range_m) ? "inf" : fixed(r.comm_range_m, 3),
                                       fixed(r.sensor_range_m, 3),
                                       std::to_string(r.step_limit),
@@ -235,6 +238,7 @@ std::string record_without_wall_time(const RunRecord& r) {
                                       fixed(r.redundancy, 6),
                                       std::to_string(r.bytes_sent),
                                       std::to_string(r.meetings),
+                                      std::to_string(r.merges_made),
                                       std::to_string(r.blocked_moves),
                                       fixed(r.position_rmse_m, 6),
                                       std::to_string(r.lower_bound_steps),
@@ -259,6 +263,7 @@ RunRecord parse_record(const std::string& line, const std::string& where) {
   r.key.robots = int(in.integer(1));
   r.key.seed = in.unsigned_integer();
   r.localization = in.text();
+  r.merging = in.text();
   r.comm_range_m = in.number();
   r.sensor_range_m = in.number();
   r.step_limit = int(in.integer(1));
@@ -272,6 +277,7 @@ RunRecord parse_record(const std::string& line, const std::string& where) {
   r.redundancy = in.number();
   r.bytes_sent = in.integer(0);
   r.meetings = int(in.integer(0));
+  r.merges_made = int(in.integer(0));
   r.blocked_moves = int(in.integer(0));
   r.position_rmse_m = in.number();
   r.lower_bound_steps = int(in.integer(0));

@@ -30,6 +30,7 @@ struct RunRecord {
   RunKey key;
   // Settings shared by the sweep's runs (also in `settings`, with everything else).
   std::string localization;
+  std::string merging;        // how robots bring teammates' maps into their frame
   double comm_range_m = 0.0;  // +inf: unlimited
   double sensor_range_m = 0.0;
   int step_limit = 0;
@@ -43,6 +44,7 @@ struct RunRecord {
   double redundancy = 0.0;
   std::int64_t bytes_sent = 0;
   int meetings = 0;
+  int merges_made = 0;        // maps brought into a teammate's frame (rendezvous or overlap merging)
   int blocked_moves = 0;
   double position_rmse_m = 0.0;
   // sim/metrics.h.

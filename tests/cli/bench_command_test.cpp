@@ -58,6 +58,8 @@ TEST(BenchCommand, TinySweepWritesEveryOutputAndItsSummaryMatchesItsRows) {
     EXPECT_EQ(row.size(), results.header.size());
     keys.insert(row.at("map") + "/" + row.at("strategy") + "/" + row.at("robots") + "/" + row.at("seed"));
     EXPECT_EQ(row.at("step_limit"), "300");
+    EXPECT_EQ(row.at("merging"), "known");
+    EXPECT_EQ(row.at("merges_made"), "0");  // one frame for all: nothing to merge
     EXPECT_GT(number(row.at("lower_bound_steps")), 0.0);  // the maps are larger than one scan
     // No run beats the lower bound; efficiency is defined where 99% was reached.
     if (row.at("steps_to_99").empty()) {
@@ -276,6 +278,9 @@ TEST(BenchCommand, BadInputGetsOneLine) {
   EXPECT_ONE_LINE_ERROR(b.bench("--combine nowhere --out c"), "'nowhere' is not a folder");
   EXPECT_ONE_LINE_ERROR(b.bench("--combine empty_dir --out c"), "holds no results.csv");
   EXPECT_ONE_LINE_ERROR(b.bench("--compare coordinated --out c"), "--compare");
+  EXPECT_ONE_LINE_ERROR(b.bench("--compare coordinated market nowhere"), "--compare: 'nowhere' is not a folder");
+  EXPECT_ONE_LINE_ERROR(b.bench(small + " --merging telepathy --out x"), "--merging: unknown mode 'telepathy'");
+  EXPECT_ONE_LINE_ERROR(b.bench(small + " --localization psychic --out x"), "psychic");
   // results.csv of another sweep, or of something else.
   ASSERT_EQ(b.bench(small + " --out done").exit_code, 0);
   EXPECT_ONE_LINE_ERROR(b.bench(small + " --sensor-range 3 --out done"), "other settings");
@@ -286,6 +291,21 @@ TEST(BenchCommand, BadInputGetsOneLine) {
   // A sweep file with a mistake.
   b.dir.write("bad.yaml", "maps: [hall.yaml]\nrobot: [1, 2]\n");
   EXPECT_ONE_LINE_ERROR(b.bench("--sweep bad.yaml --out x"), "bad.yaml:2: unknown key 'robot'");
+}
+
+TEST(BenchCommand, MergingModeReachesEveryRun) {
+  // Robots that map in their own frames and merge when they meet: the rows say so and count merges.
+  BenchDir b;
+  const auto r = b.bench("--maps hall.yaml --strategies uncoordinated,market --robots 2 --seeds 2 --steps 40 "
+                         "--merging rendezvous --jobs 2 --out m");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CsvTable t = read_csv(b / "m" / "results.csv");
+  ASSERT_EQ(t.rows.size(), 4u);
+  for (const auto& row : t.rows) {
+    EXPECT_EQ(row.at("merging"), "rendezvous");
+    EXPECT_GE(number(row.at("merges_made")), 1.0) << "two robots placed together see each other and merge";
+  }
+  EXPECT_NE(slurp(b / "m" / "summary.md").find("merging rendezvous"), std::string::npos);
 }
 
 TEST(BenchCommand, ReadySweepFilesRun) {

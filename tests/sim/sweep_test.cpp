@@ -105,6 +105,7 @@ TEST(Sweep, SweepFileWithEveryKey) {
                               "first_seed: 10\n"
                               "scenario: base.yaml\n"
                               "localization: odometry\n"
+                              "merging: rendezvous\n"
                               "comm_range: 15\n");
   const Sweep s = load_sweep(path);
   EXPECT_EQ(s.maps, (std::vector<std::string>{"office", "cave"}));
@@ -116,6 +117,7 @@ TEST(Sweep, SweepFileWithEveryKey) {
   EXPECT_DOUBLE_EQ(s.base.range.max_range_m, 5.0);
   EXPECT_EQ(s.base.placement, Placement::Cluster);  // listed starts become a cluster of each team size
   EXPECT_EQ(s.base.localization, "odometry");
+  EXPECT_EQ(s.base.merging, "rendezvous");
   EXPECT_DOUBLE_EQ(s.base.communication.range_m, 15.0);
   const auto runs = sweep_runs(s);
   ASSERT_EQ(runs.size(), 2u * 2u * 3u * 4u);
@@ -126,7 +128,9 @@ TEST(Sweep, SweepFileWithEveryKey) {
   flags.robots = "9";
   flags.steps = 50;
   flags.comm_range = "inf";
+  flags.merging = "overlap";
   apply_overrides(o, flags);
+  EXPECT_EQ(o.base.merging, "overlap");
   EXPECT_EQ(o.robots, (std::vector<int>{9}));
   EXPECT_EQ(o.base.steps, 50);
   EXPECT_TRUE(std::isinf(o.base.communication.range_m));
@@ -145,6 +149,11 @@ TEST(Sweep, SweepFileErrorsNameTheFileLineAndKey) {
   expect_input_error([&] { load_sweep(dir.write("g.yaml", "maps: [a/lab.png, b/lab.png]\n")); }, {"g.yaml", "two maps are named 'lab'"});
   expect_input_error([&] { load_sweep(dir.write("h.yaml", "maps: {office: 1}\n")); }, {"h.yaml:1", "maps", "expected a list"});
   expect_input_error([&] { load_sweep(dir.write("i.yaml", "localization: psychic\n")); }, {"i.yaml", "localization", "psychic"});
+  expect_input_error([&] { load_sweep(dir.write("j.yaml", "merging: telepathy\n")); }, {"j.yaml:1", "merging", "telepathy"});
+  Sweep s;
+  SweepOverrides flags;
+  flags.merging = "telepathy";
+  expect_input_error([&] { apply_overrides(s, flags); }, {"--merging", "telepathy"});
 }
 
 TEST(Sweep, ReadySweepFiles) {
@@ -193,6 +202,7 @@ TEST(Sweep, WrittenSweepLoadsBackToTheSameRuns) {
   s.first_seed = 7;
   s.base.steps = 321;
   s.base.communication.range_m = 8.5;
+  s.base.merging = "rendezvous";
   dir.write("scenario.yaml", scenario_to_yaml(s.base));
   const Sweep back = load_sweep(dir.write("sweep.yaml", sweep_to_yaml(s, "scenario.yaml")));
   const auto a = sweep_runs(s), b = sweep_runs(back);
@@ -203,6 +213,7 @@ TEST(Sweep, WrittenSweepLoadsBackToTheSameRuns) {
     EXPECT_EQ(a[i].robots, b[i].robots);
     EXPECT_EQ(a[i].seed, b[i].seed);
   }
+  EXPECT_EQ(back.base.merging, "rendezvous");
   EXPECT_EQ(settings_id(s.base), settings_id(back.base));
 }
 
