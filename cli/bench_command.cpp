@@ -13,6 +13,7 @@
 
 #include "cli/command.h"
 #include "cli/progress.h"
+#include "cli/validators.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "exploration/strategy.h"
@@ -234,19 +235,20 @@ Command add_bench_command(CLI::App& root) {
                   "Comma-separated built-in maps or map files [default: empty,unstructured,office,corridor]");
   app->add_option("--strategies", s.strategies, "Comma-separated strategies, or all [default: all]");
   app->add_option("--robots", s.robots, "Team sizes, e.g. 1,2,4,9 or 1-9 [default: 1,2,4,9]");
-  app->add_option("--seeds", s.seeds, "Seeds per combination [default: 20]");
-  app->add_option("--first-seed", s.first_seed, "The first seed; runs use first-seed, first-seed + 1, ... [default: 1]");
+  app->add_option("--seeds", s.seeds, "Seeds per combination [default: 20]")->check(positive());
+  app->add_option("--first-seed", s.first_seed, "The first seed; runs use first-seed, first-seed + 1, ... [default: 1]")
+      ->check(whole_number());
   app->add_option("--scenario", s.scenario,
                   "Scenario file every run starts from (its map, strategy, robots and seed are replaced) "
                   "[default: the scenario defaults of `fleetmap explore`]");
-  app->add_option("--steps", s.steps, "Step limit of each run [default: 2000]");
+  app->add_option("--steps", s.steps, "Step limit of each run [default: 2000]")->check(positive());
   app->add_option("--localization", s.localization, "How robots know their pose [default: ideal]");
   app->add_option("--merging", s.merging,
                   "How robots bring teammates' maps into their frame: known, rendezvous or overlap (see `fleetmap "
                   "explore --help`) [default: known]");
   app->add_option("--comm-range", s.comm_range, "Communication range in metres, or inf [default: inf]");
-  app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]");
-  app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")->check(CLI::PositiveNumber);
+  app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]")->check(positive());
+  app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")->check(positive());
   app->add_option("--shard", f->shard, "Run only the K-th of N slices of the sweep, K/N (for clusters; see bench/slurm/)");
   app->add_option("--out", f->out, "Output folder, created if missing [default: out/bench]");
   app->add_option("--combine", f->combine, "Join the results of these output folders (shards) into --out")->expected(1, -1);

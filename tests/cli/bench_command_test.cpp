@@ -266,6 +266,8 @@ TEST(BenchCommand, BadInputGetsOneLine) {
   EXPECT_ONE_LINE_ERROR(b.bench("--robots 1,0 --out x"), "--robots: team size '0'");
   EXPECT_ONE_LINE_ERROR(b.bench("--robots 2,x --out x"), "--robots: team size 'x'");
   EXPECT_ONE_LINE_ERROR(b.bench("--seeds 0 --out x"), "--seeds");
+  EXPECT_ONE_LINE_ERROR(b.bench("--jobs 0 --out x"), "--jobs");
+  EXPECT_ONE_LINE_ERROR(b.bench("--sensor-range -1 --out x"), "--sensor-range");
   cv::Mat closet(20, 20, CV_8UC1, cv::Scalar(254));
   cv::rectangle(closet, cv::Rect(0, 0, 20, 20), cv::Scalar(0), 1);
   write_map(b.dir, "closet", closet);
