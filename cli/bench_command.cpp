@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "exploration/strategy.h"
+#include "localization/localizer.h"
 #include "maps/builtin_maps.h"
 #include "sim/scenario.h"
 #include "sim/sweep.h"
@@ -216,17 +217,22 @@ int run_bench(const BenchFlags& f) {
 
 Command add_bench_command(CLI::App& root) {
   CLI::App* app = root.add_subcommand(
-      "bench",
-      "Benchmark coordination strategies: every combination of maps, strategies, team sizes and seeds, run in\n"
-      "parallel; writes results.csv (a row per run), summary.csv and summary.md (mean, standard deviation and 95%\n"
-      "confidence interval per map x strategy x team size) and plots into --out. Run it again with the same --out\n"
-      "after an interruption and it finishes the sweep without redoing finished runs.\n\n"
+      "bench", "Benchmark coordination strategies over maps x strategies x team sizes x seeds: tables and plots");
+  app->footer(
+      "Runs every combination in parallel (--jobs), with a progress bar and ETA on stderr when it is a terminal,\n"
+      "and writes into --out: results.csv (a row per run, appended whole and flushed), summary.csv and summary.md\n"
+      "(mean, standard deviation and 95% confidence interval per map x strategy x team size, best marked),\n"
+      "coverage_<map>.png, time_<map>.png, efficiency.png, and sweep.yaml. efficiency = lower bound / steps to 99% (README.md, \"Benchmarking\n"
+      "strategies\"). Run it again with the same --out after an interruption and it finishes the sweep without\n"
+      "redoing finished runs. The same flags give the same rows whatever --jobs (only wall_time_s differs).\n\n"
+      "Examples:\n"
       "  fleetmap bench --maps office,cave --strategies all --robots 1,2,4,9 --seeds 20 --jobs 2 --out DIR\n"
       "  fleetmap bench --sweep scenarios/sweeps/seed003.yaml --shard 2/4 --out DIR/shard_2\n"
       "  fleetmap bench --combine DIR/shard_1 DIR/shard_2 DIR/shard_3 DIR/shard_4 --out DIR/all\n"
-      "  fleetmap bench --compare coordinated uncoordinated DIR\n\n"
-      "Strategies:\n" +
-          exploration::strategy_help());
+      "  fleetmap bench --compare coordinated uncoordinated DIR\n"
+      "  bench/slurm/submit.sh 16 OUT --sweep scenarios/sweeps/seed003.yaml     (a Slurm job array)\n\n"
+      "Strategies (--strategies):\n" +
+      exploration::strategy_help());
   auto f = std::make_shared<BenchFlags>();
   auto& s = f->sweep;
   app->add_option("--sweep", f->sweep_file, "Sweep YAML file (see scenarios/sweeps/); flags below override it")
@@ -242,7 +248,10 @@ Command add_bench_command(CLI::App& root) {
                   "Scenario file every run starts from (its map, strategy, robots and seed are replaced) "
                   "[default: the scenario defaults of `fleetmap explore`]");
   app->add_option("--steps", s.steps, "Step limit of each run [default: 2000]")->check(positive());
-  app->add_option("--localization", s.localization, "How robots know their pose [default: ideal]");
+  std::string localizers;
+  for (const auto& name : localization::localizer_names()) localizers += (localizers.empty() ? "" : ", ") + name;
+  app->add_option("--localization", s.localization,
+                  "How robots know their pose: " + localizers + " (see `fleetmap explore --help`) [default: ideal]");
   app->add_option("--merging", s.merging,
                   "How robots bring teammates' maps into their frame: known, rendezvous or overlap (see `fleetmap "
                   "explore --help`) [default: known]");
