@@ -43,6 +43,11 @@ struct BenchFlags {
   bool quiet = false;
 };
 
+// "1 map", "4 maps".
+std::string counted(std::size_t n, const std::string& one, const std::string& many = "") {
+  return std::to_string(n) + " " + (n == 1 ? one : many.empty() ? one + "s" : many);
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -204,8 +209,9 @@ int run_bench(const BenchFlags& f) {
     std::printf("%s\n", results.c_str());
     return 0;
   }
-  std::printf("%zu runs of %zu maps x %zu strategies x %zu team sizes x %d seeds", all_runs.size(), sweep.maps.size(),
-              sweep.strategies.size(), sweep.robots.size(), sweep.seeds);
+  std::printf("%zu runs of %s x %s x %s x %s", all_runs.size(), counted(sweep.maps.size(), "map").c_str(),
+              counted(sweep.strategies.size(), "strategy", "strategies").c_str(),
+              counted(sweep.robots.size(), "team size").c_str(), counted(std::size_t(sweep.seeds), "seed").c_str());
   if (shard) std::printf("; shard %d/%d: %zu runs", shard->index, shard->count, runs.size());
   std::printf("\nran %zu runs in %.1f s with %d jobs; %zu were already in results.csv\n", todo.size(), elapsed,
               std::max(1, std::min<int>(f.jobs, int(std::max<std::size_t>(1, todo.size())))), runs.size() - todo.size());
