@@ -213,16 +213,17 @@ int run_explore(const ExploreFlags& f) {
 Command add_explore_command(CLI::App& root) {
   CLI::App* app = root.add_subcommand(
       "explore",
-      "Explore a map with a team of simulated robots; writes the merged map, each robot's map, metrics and map files.\n\n"
+      "Explore a map with a team of simulated robots; writes the merged map, each robot's map, metrics and map files");
+  app->footer(
+      "Flags override the scenario file; without one, the defaults above apply.\n\n"
       "Strategies (--strategy):\n" +
-          exploration::strategy_help() + "\nLocalization (--localization):\n" + localization::localizer_help() +
-          "\nMerging (--merging): how robots bring each other's maps into their own frame\n"
-          "  known       every robot knows its start pose in one shared frame (default)\n"
-          "  rendezvous  each robot maps in its own frame; robots that detect each other take the\n"
-          "              relative transform from the detection (seed 000 section 3.2)\n"
-          "  overlap     each robot maps in its own frame; robots that can talk search their maps for\n"
-          "              the best overlap (as `fleetmap merge`) and merge only above a confidence\n"
-          "\nFlags override the scenario file; without one, the defaults below apply.");
+      exploration::strategy_help() + "\nLocalization (--localization):\n" + localization::localizer_help() +
+      "\nMerging (--merging): how robots bring each other's maps into their own frame\n"
+      "  known       every robot knows its start pose in one shared frame (default)\n"
+      "  rendezvous  each robot maps in its own frame; robots that detect each other take the\n"
+      "              relative transform from the detection (seed 000 section 3.2)\n"
+      "  overlap     each robot maps in its own frame; robots that can talk search their maps for\n"
+      "              the best overlap (as `fleetmap merge`) and merge only above a confidence\n");
   auto f = std::make_shared<ExploreFlags>();
   app->add_option("--scenario", f->scenario, "Scenario YAML file (see scenarios/); flags below override it")
       ->check(CLI::ExistingFile);

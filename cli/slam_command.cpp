@@ -111,7 +111,7 @@ int run_slam(const SlamFlags& f) {
 }  // namespace
 
 Command add_slam_command(CLI::App& root) {
-  CLI::App* app = root.add_subcommand("slam", "Repeat a SLAM experiment over many runs (seed 000 section 4): Table 1 and figures");
+  CLI::App* app = root.add_subcommand("slam", "Reproduce a SLAM experiment: seed 000 section 4 (Table 1) or seed 002 corridor loop (Table I), with figures");
   app->footer(
       "Robots follow precomputed paths in a room, each maps it and localizes itself on its own, and robots that\n"
       "see each other exchange maps. Writes Table 1 (means and standard deviations over the runs) as table1.md and\n"
