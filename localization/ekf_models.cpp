@@ -23,6 +23,22 @@ Eigen::Matrix3d motion_jacobian(const core::Pose2& pose, const Odometry& u) {
   return f;
 }
 
+void predict_augmented_state(Eigen::VectorXd& mean, Eigen::MatrixXd& covariance, const Odometry& u,
+                             const Eigen::Matrix3d& q) {
+  const core::Pose2 before(mean(0), mean(1), mean(2));
+  const Eigen::Matrix3d f = motion_jacobian(before, u);
+  const core::Pose2 after = integrate_motion(before, u);
+  mean.head<3>() << after.x, after.y, core::normalize_angle(after.theta);
+  const Eigen::Index m = covariance.rows() - 3;
+  const Eigen::Matrix3d prr = covariance.topLeftCorner<3, 3>();
+  covariance.topLeftCorner<3, 3>() = f * prr * f.transpose() + q;
+  if (m > 0) {
+    const Eigen::MatrixXd prl = f * covariance.topRightCorner(3, m);
+    covariance.topRightCorner(3, m) = prl;
+    covariance.bottomLeftCorner(m, 3) = prl.transpose();
+  }
+}
+
 Eigen::Matrix3d process_noise(const LocalizerOptions& o) {
   return Eigen::Vector3d(o.process_noise_xy * o.process_noise_xy, o.process_noise_xy * o.process_noise_xy,
                          o.process_noise_theta * o.process_noise_theta)

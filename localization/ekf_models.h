@@ -21,6 +21,11 @@ inline constexpr double kMinMeasurementStd = 1e-6;
 // when |omega * dt| < 1e-9).
 Eigen::Matrix3d motion_jacobian(const core::Pose2& pose, const Odometry& u);
 
+// The EKF prediction of a state [x, y, theta, landmarks...]: the pose moves by the motion model,
+// the pose block becomes F P F^T + Q and the pose-landmark blocks F P_xl; landmarks stay.
+void predict_augmented_state(Eigen::VectorXd& mean, Eigen::MatrixXd& covariance, const Odometry& u,
+                             const Eigen::Matrix3d& q);
+
 // Q = diag(sxy^2, sxy^2, sth^2): the process noise, additive in the world frame.
 Eigen::Matrix3d process_noise(const LocalizerOptions& options);
 // R = diag(range^2, bearing^2), each standard deviation at least kMinMeasurementStd.

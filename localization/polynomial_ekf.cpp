@@ -15,18 +15,7 @@ PolynomialEkf::PolynomialEkf(const core::Pose2& initial_pose, const Eigen::Matri
       covariance_(initial_covariance) {}
 
 void PolynomialEkf::predict(const Odometry& u, const Eigen::Matrix3d& q) {
-  const core::Pose2 before = pose();
-  const Eigen::Matrix3d f = motion_jacobian(before, u);
-  const core::Pose2 after = integrate_motion(before, u);
-  mean_.head<3>() << after.x, after.y, core::normalize_angle(after.theta);
-  const Eigen::Index m = covariance_.rows() - 3;
-  const Eigen::Matrix3d prr = covariance_.topLeftCorner<3, 3>();
-  covariance_.topLeftCorner<3, 3>() = f * prr * f.transpose() + q;
-  if (m > 0) {
-    const Eigen::MatrixXd prl = f * covariance_.topRightCorner(3, m);
-    covariance_.topRightCorner(3, m) = prl;
-    covariance_.bottomLeftCorner(m, 3) = prl.transpose();
-  }
+  predict_augmented_state(mean_, covariance_, u, q);
 }
 
 namespace {
