@@ -1,6 +1,7 @@
 // `ideal` and `odometry`: the two localizers that need no filter.
 #include <cmath>
 
+#include "localization/ekf_models.h"
 #include "localization/localizer.h"
 #include "core/error.h"
 #include "localization/localizers.h"
@@ -47,22 +48,13 @@ class IdealLocalizer final : public Localizer {
 // Dead reckoning: integrates odometry; the covariance grows with the process noise.
 class OdometryLocalizer final : public Localizer {
  public:
-  explicit OdometryLocalizer(const LocalizerContext& c) : pose_(c.initial_pose), options_(c.options) {
-    covariance_ = Eigen::Vector3d(c.options.initial_xy * c.options.initial_xy, c.options.initial_xy * c.options.initial_xy,
-                                  c.options.initial_theta * c.options.initial_theta)
-                      .asDiagonal();
-  }
+  explicit OdometryLocalizer(const LocalizerContext& c)
+      : pose_(c.initial_pose), options_(c.options), covariance_(initial_covariance(c.options)) {}
   std::string name() const override { return "odometry"; }
   void predict(const Odometry& u) override {
     // Linearised propagation of the pose covariance through the motion model.
-    Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
-    const double a = pose_.theta + 0.5 * u.omega * u.dt;
-    f(0, 2) = -u.v * u.dt * std::sin(a);
-    f(1, 2) = u.v * u.dt * std::cos(a);
-    const Eigen::Vector3d q(options_.process_noise_xy * options_.process_noise_xy,
-                            options_.process_noise_xy * options_.process_noise_xy,
-                            options_.process_noise_theta * options_.process_noise_theta);
-    covariance_ = f * covariance_ * f.transpose() + Eigen::Matrix3d(q.asDiagonal());
+    const Eigen::Matrix3d f = motion_jacobian(pose_, u);
+    covariance_ = f * covariance_ * f.transpose() + process_noise(options_);
     pose_ = integrate_motion(pose_, u);
   }
   core::Pose2 pose() const override { return pose_; }

@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "localization/cow_grid.h"
+#include "localization/ekf_models.h"
 #include "localization/localizer.h"
 #include "localization/localizers.h"
 #include "localization/scan_matcher.h"
@@ -23,23 +24,14 @@ namespace {
 
 class ScanMatchingLocalizer final : public Localizer {
  public:
-  explicit ScanMatchingLocalizer(const LocalizerContext& c) : pose_(c.initial_pose), options_(c.options) {
-    covariance_ = Eigen::Vector3d(c.options.initial_xy * c.options.initial_xy, c.options.initial_xy * c.options.initial_xy,
-                                  c.options.initial_theta * c.options.initial_theta)
-                      .asDiagonal();
-  }
+  explicit ScanMatchingLocalizer(const LocalizerContext& c)
+      : pose_(c.initial_pose), options_(c.options), covariance_(initial_covariance(c.options)) {}
   std::string name() const override { return "scan-matching"; }
 
   void predict(const Odometry& u) override {
-    Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
-    const double a = pose_.theta + 0.5 * u.omega * u.dt;
-    f(0, 2) = -u.v * u.dt * std::sin(a);
-    f(1, 2) = u.v * u.dt * std::cos(a);
+    const Eigen::Matrix3d f = motion_jacobian(pose_, u);
     covariance_ = f * covariance_ * f.transpose();
-    pending_ = Eigen::Vector3d(options_.process_noise_xy * options_.process_noise_xy,
-                               options_.process_noise_xy * options_.process_noise_xy,
-                               options_.process_noise_theta * options_.process_noise_theta)
-                   .asDiagonal();
+    pending_ = process_noise(options_);
     pose_ = integrate_motion(pose_, u);
   }
 
