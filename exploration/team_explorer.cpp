@@ -288,6 +288,19 @@ void TeamExplorer::make_way(int stuck, const std::vector<ExplorerRobot>& robots,
 }
 
 void TeamExplorer::update(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links) {
+  std::vector<ExplorerRobot> views = robots;
+  coarse_.resize(robots.size());
+  for (std::size_t i = 0; i < robots.size(); ++i) {
+    const double resolution = robots[i].map->resolution();
+    const int factor = int(std::floor(options_.planning_resolution_m / resolution + 1e-9));
+    if (factor < 2) continue;
+    coarse_[i] = mapping::coarsen(*robots[i].map, factor);
+    views[i].map = &coarse_[i];
+  }
+  decide(views, links);
+}
+
+void TeamExplorer::decide(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links) {
   const int n = int(robots_.size());
   std::vector<char> needy(std::size_t(n), false);
   for (int i = 0; i < n; ++i) {

@@ -35,6 +35,10 @@ struct ExplorationOptions {
   int max_attempts = 3;
   // A robot that made no progress for this many steps plans a detour around the robots it knows of.
   int detour_after_steps = 4;
+  // The explorer decides (traversability, frontiers, waves, paths) on cells of at least this size:
+  // a map finer than this is seen through cells a whole number of times larger (mapping::coarsen),
+  // so a 5 mm map costs what a 5 cm map costs. 0: always on the map's own cells.
+  double planning_resolution_m = 0.05;
 };
 
 // What the explorer sees of one robot in a round.
@@ -57,7 +61,8 @@ class TeamExplorer {
   // follow (every cell on it clear); otherwise from the wave. Detours around robots use the wave.
   void set_path_provider(PathProvider provider) { provider_ = std::move(provider); }
 
-  // One decision round. `links[i][j]` is true when robots i and j can talk now.
+  // One decision round. `links[i][j]` is true when robots i and j can talk now. Maps finer than
+  // the planning resolution are coarsened first; the path provider then gets the coarse map.
   void update(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
 
   // The rest of robot i's path in metres (cell centres from the next one to the goal); empty when
@@ -109,6 +114,8 @@ class TeamExplorer {
     core::GridGeometry geometry;  // of the robot's map, to turn cells into metres
   };
 
+  // The round on maps at the planning resolution.
+  void decide(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
   // false: the task was dropped.
   bool check_task(int i, const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
   void give_up(int i, std::int64_t known_cells);
@@ -127,6 +134,7 @@ class TeamExplorer {
   PathProvider provider_;
   std::vector<RobotState> robots_;
   WaveField wave_;  // reused storage
+  std::vector<mapping::OccupancyGrid> coarse_;  // per robot: its map at the planning resolution
   Stats stats_;
 };
 

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <ostream>
+#include <string>
 
 #include "core/error.h"
 
@@ -79,6 +81,48 @@ bool OccupancyGrid::same_states(const OccupancyGrid& other) const {
 std::ostream& operator<<(std::ostream& os, const OccupancyGrid& g) {
   return os << "OccupancyGrid(" << g.geometry() << ", " << g.count(CellState::Free) << " free, "
             << g.count(CellState::Occupied) << " occupied)";
+}
+
+OccupancyGrid coarsen(const OccupancyGrid& fine, int factor) {
+  if (factor < 1) throw Error("coarsen: factor must be at least 1, got " + std::to_string(factor));
+  if (factor == 1) return fine;
+  const int w = fine.width(), h = fine.height();
+  const int cw = (w + factor - 1) / factor, ch = (h + factor - 1) / factor;
+  OccupancyGrid coarse(GridGeometry(fine.resolution() * factor, cw, ch, fine.geometry().origin()), fine.options());
+  const float occupied = float(probability_to_log_odds(fine.options().occupied_threshold));
+  const float free = float(probability_to_log_odds(fine.options().free_threshold));
+  // Per coarse column of the current band of rows: free cells, their log-odds sum, the largest log-odds.
+  std::vector<int> free_cells(static_cast<std::size_t>(cw));
+  std::vector<float> free_sum(static_cast<std::size_t>(cw)), most(static_cast<std::size_t>(cw));
+  const auto& l = fine.log_odds_data();
+  for (int cy = 0; cy < ch; ++cy) {
+    std::fill(free_cells.begin(), free_cells.end(), 0);
+    std::fill(free_sum.begin(), free_sum.end(), 0.0f);
+    std::fill(most.begin(), most.end(), -std::numeric_limits<float>::infinity());
+    const int y_end = std::min(h, (cy + 1) * factor);
+    for (int y = cy * factor; y < y_end; ++y) {
+      const float* row = l.data() + std::size_t(y) * std::size_t(w);
+      for (int x = 0; x < w; ++x) {
+        const float v = row[x];
+        const auto cx = std::size_t(x / factor);
+        most[cx] = std::max(most[cx], v);
+        if (v < free) {
+          ++free_cells[cx];
+          free_sum[cx] += v;
+        }
+      }
+    }
+    const int rows = y_end - cy * factor;
+    for (int cx = 0; cx < cw; ++cx) {
+      const int cells = rows * (std::min(w, (cx + 1) * factor) - cx * factor);
+      const auto k = std::size_t(cx);
+      float v = 0.0f;
+      if (most[k] > occupied) v = most[k];
+      else if (2 * free_cells[k] >= cells) v = free_sum[k] / float(free_cells[k]);
+      if (v != 0.0f) coarse.set_log_odds({cx, cy}, v);
+    }
+  }
+  return coarse;
 }
 
 }  // namespace fleetmap::mapping

@@ -107,6 +107,14 @@ class OccupancyGrid {
 
 std::ostream& operator<<(std::ostream& os, const OccupancyGrid& g);
 
+// The grid seen through cells `factor` times larger (same origin; a partial block at the top or
+// right edge becomes a whole coarse cell). A coarse cell is Occupied when any of its cells is (a
+// wall never disappears; it takes the largest log-odds of the block), Free when at least half of
+// its cells are Free and none Occupied (mean log-odds of those free cells: the unseen gaps between
+// far beams do not turn free space into unknown), and Unknown otherwise. factor 1 returns a copy.
+// Throws fleetmap::Error unless factor >= 1.
+OccupancyGrid coarsen(const OccupancyGrid& fine, int factor);
+
 template <typename OnCell>
 int OccupancyGrid::integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit, OnCell&& on_cell) {
   const auto end_cell = geometry_.world_to_cell(to);

@@ -195,6 +195,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     e.targets.piece_radius_m = ex.number("piece_radius", e.targets.piece_radius_m, 1e-3, 1e6);
     e.targets.frontiers.min_region_cells = int(ex.integer("min_frontier_cells", e.targets.frontiers.min_region_cells, 1, 1'000'000));
     e.traversability.safety_margin_m = ex.number("safety_margin", e.traversability.safety_margin_m, 0.0, 100.0);
+    e.planning_resolution_m = ex.number("planning_resolution", e.planning_resolution_m, 0.0, 100.0);
     s.path_planner = ex.choice("path_planner", s.path_planner, path_planner_names());
     s.planner_time_s = ex.number("planner_time", s.planner_time_s, 1e-3, 3600.0);
     ex.finish();
@@ -309,7 +310,7 @@ std::string scenario_to_yaml(const Scenario& s) {
     << "\n  eight_connected: " << (e.wave.eight_connected ? "true" : "false") << "\n  occupancy_weight: " << fmt(e.wave.occupancy_weight)
     << "\n  stall_steps: " << e.stall_steps << "\n  piece_radius: " << fmt(e.targets.piece_radius_m)
     << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m)
-    << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s) << "\n";
+    << "\n  planning_resolution: " << fmt(e.planning_resolution_m) << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s) << "\n";
   y << "merging:\n  mode: " << s.merging << "\n  method: " << s.merge_method << "\n  min_confidence: "
     << fmt(s.merge_min_confidence) << "\n  attempt_every: " << s.merge_attempt_every << "\n";
   y << "lookahead: " << fmt(s.lookahead_m) << "\n";

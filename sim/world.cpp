@@ -29,9 +29,12 @@ double World::clearance(const Eigen::Vector2d& p, double horizon_m) const {
   if (!g.contains(c) || blocked(c)) return 0.0;
   const double res = g.resolution();
   // Fast path: the centre clearance bounds the true one from below by one cell diagonal.
-  const double lower = centre_clearance_m_[std::size_t(g.index(c))] - 1.4143 * res;
+  const double centre = centre_clearance_m_[std::size_t(g.index(c))];
+  const double lower = centre - 1.4143 * res;
   if (lower >= horizon_m) return horizon_m;
-  const int r = int(std::ceil(horizon_m / res)) + 1;
+  // The blocked cell nearest to the cell's centre is `centre` away from it, so the nearest blocked
+  // square to p lies within centre + one cell of c: no need to look farther than that.
+  const int r = int(std::ceil(std::min(horizon_m, centre) / res)) + 1;
   double best2 = horizon_m * horizon_m;
   for (int dy = -r; dy <= r; ++dy) {
     for (int dx = -r; dx <= r; ++dx) {

@@ -86,5 +86,47 @@ TEST(OccupancyGrid, RejectsInconsistentOptions) {
   EXPECT_THROW(OccupancyGrid(GridGeometry(1.0, 2, 2), o), Error);
 }
 
+TEST(Coarsen, WallsStayHalfSeenFreeSpaceStaysFreeTheRestIsUnknown) {
+  // 10 x 7 cells of 0.1 m seen through 4 x 4 blocks: 3 x 2 coarse cells of 0.4 m (the right and
+  // top blocks are partial).
+  OccupancyGrid fine(GridGeometry(0.1, 10, 7, core::Pose2(1.0, 2.0, 0.0)));
+  // Block (0, 0): all free but one occupied cell.
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) fine.set_state({x, y}, CellState::Free);
+  fine.set_state({2, 1}, CellState::Occupied);
+  // Block (1, 0): 8 of 16 free, the rest never seen (the gaps between far beams).
+  for (int y = 0; y < 4; y += 2)
+    for (int x = 4; x < 8; ++x) fine.set_state({x, y}, CellState::Free);
+  // Block (2, 0): 2 x 4 cells (partial); 3 of 8 free: less than half.
+  fine.set_state({8, 0}, CellState::Free);
+  fine.set_state({9, 0}, CellState::Free);
+  fine.set_state({8, 1}, CellState::Free);
+  // Block (0, 1): 4 x 3 cells (partial), all free.
+  for (int y = 4; y < 7; ++y)
+    for (int x = 0; x < 4; ++x) fine.set_state({x, y}, CellState::Free);
+
+  const OccupancyGrid coarse = coarsen(fine, 4);
+  EXPECT_EQ(coarse.width(), 3);
+  EXPECT_EQ(coarse.height(), 2);
+  EXPECT_DOUBLE_EQ(coarse.resolution(), 0.4);
+  EXPECT_EQ(coarse.geometry().origin(), fine.geometry().origin());
+  EXPECT_EQ(coarse.state({0, 0}), CellState::Occupied);
+  EXPECT_EQ(coarse.state({1, 0}), CellState::Free);
+  EXPECT_EQ(coarse.state({2, 0}), CellState::Unknown);
+  EXPECT_EQ(coarse.state({0, 1}), CellState::Free);
+  EXPECT_EQ(coarse.state({1, 1}), CellState::Unknown);
+  EXPECT_EQ(coarse.state({2, 1}), CellState::Unknown);
+  EXPECT_EQ(coarse.observed_count(), 3);
+  // The same place in metres holds the same thing.
+  EXPECT_EQ(coarse.geometry().world_to_cell(fine.geometry().cell_center({2, 1})), (Cell{0, 0}));
+}
+
+TEST(Coarsen, FactorOneIsACopyAndBelowOneIsRefused) {
+  OccupancyGrid fine(GridGeometry(0.1, 5, 5));
+  fine.integrate_ray({0.05, 0.05}, {0.45, 0.35}, true);
+  EXPECT_TRUE(coarsen(fine, 1).same_states(fine));
+  EXPECT_THROW(coarsen(fine, 0), Error);
+}
+
 }  // namespace
 }  // namespace fleetmap::mapping

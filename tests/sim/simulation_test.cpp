@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "core/angle.h"
 #include "maps/builtin_maps.h"
+#include "mapping/map_io.h"
 #include "sim/run_output.h"
 #include "tests/sim/sim_test_maps.h"
 #include "tests/test_support.h"
@@ -58,6 +61,24 @@ TEST(Simulation, ExploresASmallMapAndStopsWhenDone) {
   EXPECT_GT(r.bytes_sent, 0);
   EXPECT_GT(r.redundancy, 0.0);
   EXPECT_LT(r.redundancy, 1.0);
+}
+
+// A map finer than the planning resolution: the explorer decides on coarser cells, and the team
+// still explores all of it and stops by itself.
+TEST(Simulation, ExploresAFineMapDecidingOnCoarserCells) {
+  const mapping::OccupancyGrid office = maps::load_map_source("office");
+  cv::Mat image;
+  cv::resize(mapping::grid_to_image(office), image, {}, 2, 2, cv::INTER_NEAREST);
+  mapping::MapYaml meta;
+  meta.resolution = office.resolution() / 2;
+  const mapping::OccupancyGrid fine = mapping::grid_from_image(image, meta);
+  Scenario s = small("office", 3, 2000);
+  s.range.beams = 720;  // beams no farther apart than the cells near the robot
+  s.exploration.planning_resolution_m = 0.1;
+  const RunResult r = Simulation(s, fine).run();
+  EXPECT_TRUE(r.finished);
+  EXPECT_GE(r.coverage.back(), 0.99);
+  EXPECT_GT(r.exploration.targets_reached, 0);
 }
 
 TEST(Simulation, RendezvousOnlyCommunicationSendsLessThanAlways) {
