@@ -142,4 +142,23 @@ void YamlMap::finish() const {
   }
 }
 
+std::string yaml_quoted(const std::string& text) {
+  std::string q = "\"";
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      q += '\\';
+      q += c;
+    } else if (u < 0x20 || u == 0x7f) {
+      static constexpr char kHex[] = "0123456789ABCDEF";
+      q += "\\x";
+      q += kHex[u >> 4];
+      q += kHex[u & 15];
+    } else {
+      q += c;
+    }
+  }
+  return q + "\"";
+}
+
 }  // namespace fleetmap::core

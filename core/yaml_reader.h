@@ -56,4 +56,8 @@ YAML::Node parse_yaml(const std::string& text, const std::string& source);
 // The text of a scalar or a short description of a non-scalar, for messages.
 std::string describe_node(const YAML::Node& node);
 
+// `text` as a YAML double-quoted scalar that reads back as the same bytes: quotes and backslashes
+// escaped, control characters (line breaks included, which YAML would fold) as \xHH.
+std::string yaml_quoted(const std::string& text);
+
 }  // namespace fleetmap::core

@@ -56,15 +56,6 @@ std::string fmt(double v) {
   return buf;
 }
 
-// A double-quoted YAML scalar.
-std::string quoted(const std::string& text) {
-  std::string q = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') q += '\\';
-    q += c;
-  }
-  return q + "\"";
-}
 
 }  // namespace
 
@@ -260,7 +251,7 @@ void validate_scenario(const Scenario& s) {
 std::string scenario_to_yaml(const Scenario& s) {
   std::ostringstream y;
   y << "# fleetmap scenario\n";
-  y << "map: " << quoted(s.map) << "\n";
+  y << "map: " << core::yaml_quoted(s.map) << "\n";
   y << "seed: " << s.seed << "\nsteps: " << s.steps << "\nperiod: " << fmt(s.period_s) << "\n";
   y << "robots:\n";
   switch (s.placement) {

@@ -75,15 +75,6 @@ bool looks_like_file(const std::string& source) {
   return source.find('/') != std::string::npos || fs::path(source).has_extension();
 }
 
-// YAML double-quoted scalar.
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
-  }
-  return out + "\"";
-}
 
 std::string number_text(double v) {
   if (std::isinf(v)) return "inf";
@@ -268,14 +259,14 @@ void validate_sweep(const Sweep& sweep) {
 std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file) {
   std::string y = "# fleetmap bench sweep: run it again with `fleetmap bench --sweep FILE`\n";
   std::vector<std::string> maps;
-  for (const auto& m : sweep.maps) maps.push_back(quoted(looks_like_file(m) && fs::exists(m) ? fs::absolute(m).lexically_normal().string() : m));
+  for (const auto& m : sweep.maps) maps.push_back(core::yaml_quoted(looks_like_file(m) && fs::exists(m) ? fs::absolute(m).lexically_normal().string() : m));
   y += "maps: [" + join(maps) + "]\n";
   y += "strategies: [" + join(sweep.strategies) + "]\n";
   std::vector<std::string> robots;
   for (int n : sweep.robots) robots.push_back(std::to_string(n));
   y += "robots: [" + join(robots) + "]\n";
   y += "seeds: " + std::to_string(sweep.seeds) + "\nfirst_seed: " + std::to_string(sweep.first_seed) + "\n";
-  y += "scenario: " + quoted(scenario_file) + "\n";
+  y += "scenario: " + core::yaml_quoted(scenario_file) + "\n";
   y += "steps: " + std::to_string(sweep.base.steps) + "\n";
   y += "localization: " + sweep.base.localization + "\n";
   y += "merging: " + sweep.base.merging + "\n";

@@ -90,6 +90,16 @@ exploration: {strategy: market}
   EXPECT_TRUE(std::isinf(parse(scenario_to_yaml(parse("map: maze\n"))).communication.range_m));
 }
 
+// Found by fuzz_scenario: a map name with a line break came back with a space instead (YAML folds
+// line breaks in quoted scalars), so a saved scenario named another map.
+TEST(Scenario, MapNamesWithControlCharactersAndQuotesRoundTrip) {
+  Scenario a;
+  a.map = "two\nlines\tand \"quotes\" \\ \x01";
+  const Scenario b = parse(scenario_to_yaml(a));
+  EXPECT_EQ(b.map, a.map);
+  EXPECT_EQ(scenario_to_yaml(b), scenario_to_yaml(a));
+}
+
 TEST(ScenarioBadInput, ErrorsNameTheKeyAndTheLine) {
   expect_input_error([] { parse("map: office\nrobtos: 3\n"); }, {"test.yaml:2", "unknown key 'robtos'", "robots"});
   expect_input_error([] { parse("robots:\n  count: 0\n"); }, {"test.yaml:2", "'robots.count'", "got '0'"});
