@@ -22,7 +22,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const mapping::OccupancyGrid grid = mapping::grid_from_image(image, meta);
     // What map_saver would write loads back to the same settings.
     const mapping::MapYaml back = mapping::parse_map_yaml(mapping::format_map_yaml(meta), "round-trip.yaml");
-    if (back.resolution != meta.resolution || back.negate != meta.negate || back.mode != meta.mode) __builtin_trap();
+    if (back.image != meta.image || back.resolution != meta.resolution || !(back.origin == meta.origin) ||
+        back.negate != meta.negate || back.mode != meta.mode || back.occupied_thresh != meta.occupied_thresh ||
+        back.free_thresh != meta.free_thresh) {
+      __builtin_trap();
+    }
     (void)grid;
   } catch (const fleetmap::InputError&) {
   }

@@ -4,8 +4,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <sstream>
@@ -94,6 +96,84 @@ cv::Mat decode_png(const std::string& bytes, const std::string& source, const Ma
   return image;
 }
 
+// Decodes a Netpbm image (P1-P6) without OpenCV: cv::imdecode picks its decoder by content, and an
+// input that starts like a PGM can still reach another decoder (fuzz_map_image found a "P6" file
+// that sent OpenCV to its DICOM reader, which aborts). Samples are scaled to 0-255 by the file's
+// maxval (as ROS map_server reads them); grey (P1, P2, P4, P5) or BGR (P3, P6), 8-bit.
+cv::Mat decode_pnm(const std::string& bytes, const std::string& source, const MapLoadOptions& options) {
+  const char kind = bytes[1];
+  const bool bitmap = kind == '1' || kind == '4', binary = kind >= '4', colour = kind == '3' || kind == '6';
+  const auto fail = [&](const std::string& what) -> void {
+    throw InputError(source + ": cannot decode " + (colour ? "PPM" : (bitmap ? "PBM" : "PGM")) + " (" + what + ")");
+  };
+  std::size_t i = 2;
+  const auto skip_space = [&](bool comments) {
+    while (i < bytes.size()) {
+      if (comments && bytes[i] == '#') {
+        while (i < bytes.size() && bytes[i] != '\n') ++i;
+      } else if (std::isspace(static_cast<unsigned char>(bytes[i]))) {
+        ++i;
+      } else {
+        break;
+      }
+    }
+  };
+  // A decimal number up to `most`, after whitespace (and comments in the header).
+  const auto number = [&](bool comments, std::int64_t most, const char* what) {
+    skip_space(comments);
+    if (i >= bytes.size()) fail(std::string("file ends before the ") + what);
+    if (!std::isdigit(static_cast<unsigned char>(bytes[i]))) fail(std::string("expected a number for the ") + what);
+    std::int64_t v = 0;
+    while (i < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[i]))) {
+      v = v * 10 + (bytes[i++] - '0');
+      if (v > most) fail(std::string(what) + " too large");
+    }
+    return v;
+  };
+  const std::int64_t w = number(true, std::int64_t{1} << 40, "width"), h = number(true, std::int64_t{1} << 40, "height");
+  check_size(source, w, h, options);
+  const int maxval = bitmap ? 1 : int(number(true, 65535, "maxval"));
+  if (maxval < 1) fail("maxval must be 1 to 65535");
+  if (binary) {
+    if (i >= bytes.size() || !std::isspace(static_cast<unsigned char>(bytes[i]))) fail("no whitespace after the header");
+    ++i;
+  }
+  const int channels = colour ? 3 : 1;
+  const int sample_bytes = maxval > 255 ? 2 : 1;
+  const std::int64_t row_bytes = bitmap ? (w + 7) / 8 : w * channels * sample_bytes;
+  if (binary && std::int64_t(bytes.size() - i) < row_bytes * h) fail("truncated pixel data");
+  cv::Mat image(int(h), int(w), CV_8UC(channels));
+  const auto scaled = [&](std::int64_t v) {
+    if (v > maxval) fail("a sample is above maxval " + std::to_string(maxval));
+    return static_cast<std::uint8_t>((v * 255 + maxval / 2) / maxval);
+  };
+  const auto* raw = reinterpret_cast<const unsigned char*>(bytes.data());
+  for (int y = 0; y < int(h); ++y) {
+    auto* row = image.ptr<std::uint8_t>(y);
+    for (int x = 0; x < int(w); ++x) {
+      for (int c = 0; c < channels; ++c) {
+        std::int64_t v = 0;
+        if (kind == '4') {
+          v = (raw[i + std::size_t(x / 8)] >> (7 - x % 8)) & 1;
+        } else if (binary) {
+          const std::size_t at = i + std::size_t((std::int64_t(x) * channels + c) * sample_bytes);
+          v = sample_bytes == 2 ? (std::int64_t{raw[at]} << 8) | raw[at + 1] : raw[at];
+        } else if (kind == '1') {
+          skip_space(false);
+          if (i >= bytes.size() || (bytes[i] != '0' && bytes[i] != '1')) fail("expected 0 or 1");
+          v = bytes[i++] - '0';
+        } else {
+          v = number(false, 65535, "sample");
+        }
+        // PBM: 1 is black. PPM: OpenCV's channel order, blue first.
+        row[x * channels + (colour ? 2 - c : 0)] = bitmap ? (v ? 0 : 255) : scaled(v);
+      }
+    }
+    if (binary) i += std::size_t(row_bytes);
+  }
+  return image;
+}
+
 cv::Mat read_image(const fs::path& path, const MapLoadOptions& options) {
   return decode_map_image(core::read_file(path), path.string(), options);
 }
@@ -114,12 +194,7 @@ cv::Mat decode_map_image(const std::string& bytes, const std::string& source, co
   if (is_png) {
     image = decode_png(bytes, source, options);
   } else {
-    try {
-      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data())),
-                           cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception&) {
-      image.release();
-    }
+    image = decode_pnm(bytes, source, options);
   }
   if (image.empty()) throw InputError(source + ": cannot decode image (not a valid PNG/PGM, or truncated)");
   check_size(source, image.cols, image.rows, options);
@@ -169,15 +244,35 @@ MapYaml parse_map_yaml(std::string_view text, const std::string& source) {
   return y;
 }
 
+namespace {
+
+// As map_saver writes numbers ("%.6f", or "%.3f" for thresholds) when that reads back as the same
+// number, else the shortest text that does (a resolution of 0.05 / 3 must not lose digits).
+std::string exact_number(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  if (std::strtod(buf, nullptr) == v) return buf;
+  const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+  return std::string(buf, end);
+}
+
+// A file name as map_saver writes it (plain), or quoted when YAML would read a plain one otherwise.
+std::string yaml_file_name(const std::string& name) {
+  const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-' || c == '/';
+  });
+  return plain ? name : core::yaml_quoted(name);
+}
+
+}  // namespace
+
 std::string format_map_yaml(const MapYaml& y) {
-  char buf[512];
   const char* mode = y.mode == MapMode::Trinary ? "trinary" : (y.mode == MapMode::Scale ? "scale" : "raw");
-  std::snprintf(buf, sizeof buf,
-                "image: %s\nmode: %s\nresolution: %.6f\norigin: [%.6f, %.6f, %.6f]\nnegate: %d\n"
-                "occupied_thresh: %.3f\nfree_thresh: %.3f\n",
-                y.image.string().c_str(), mode, y.resolution, y.origin.x, y.origin.y, y.origin.theta,
-                y.negate ? 1 : 0, y.occupied_thresh, y.free_thresh);
-  return buf;
+  return "image: " + yaml_file_name(y.image.string()) + "\nmode: " + mode + "\nresolution: " + exact_number(y.resolution, 6) +
+         "\norigin: [" + exact_number(y.origin.x, 6) + ", " + exact_number(y.origin.y, 6) + ", " +
+         exact_number(y.origin.theta, 6) + "]\nnegate: " + (y.negate ? "1" : "0") +
+         "\noccupied_thresh: " + exact_number(y.occupied_thresh, 3) + "\nfree_thresh: " + exact_number(y.free_thresh, 3) +
+         "\n";
 }
 
 OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta, const OccupancyGridOptions& grid_options) {

@@ -61,6 +61,62 @@ TEST(MapIo, YamlMatchesMapSaverFormat) {
   EXPECT_DOUBLE_EQ(back.origin.y, -5.5);
 }
 
+// Numbers a user chose come back as chosen, not rounded to map_saver's six decimals; file names
+// that YAML would misread are quoted.
+TEST(MapIo, YamlKeepsEveryDigitAndOddFileNames) {
+  MapYaml y;
+  y.image = "my map: v2.pgm";
+  y.resolution = 0.05 / 3.0;
+  y.origin = core::Pose2(-10.0, 1e-7, 0.25);
+  y.free_thresh = 0.1965;
+  const std::string text = format_map_yaml(y);
+  const MapYaml back = parse_map_yaml(text, "test.yaml");
+  EXPECT_EQ(back.image, y.image);
+  EXPECT_EQ(back.resolution, y.resolution) << text;
+  EXPECT_EQ(back.origin, y.origin) << text;
+  EXPECT_EQ(back.free_thresh, y.free_thresh) << text;
+  EXPECT_NE(text.find("origin: [-10.000000, "), std::string::npos);  // map_saver's form where it is exact
+}
+
+cv::Mat decode(const std::string& bytes) { return decode_map_image(bytes, "test.pgm"); }
+
+std::vector<int> pixels(const cv::Mat& m) {
+  std::vector<int> v;
+  for (int y = 0; y < m.rows; ++y)
+    for (int x = 0; x < m.cols * m.channels(); ++x) v.push_back(m.ptr<std::uint8_t>(y)[x]);
+  return v;
+}
+
+// PGM, PBM and PPM, plain and raw, 8- and 16-bit: samples scaled to 0-255 by maxval; PBM 1 is black;
+// PPM comes out blue first, as OpenCV's images.
+TEST(MapIo, EveryNetpbmKindDecodes) {
+  EXPECT_EQ(pixels(decode("P2\n# a comment\n3 1\n15\n0 15 7\n")), (std::vector<int>{0, 255, 119}));
+  EXPECT_EQ(pixels(decode(std::string("P5 2 1 255\n\x00\xc8", 13))), (std::vector<int>{0, 200}));
+  EXPECT_EQ(pixels(decode(std::string("P5\n2 1\n65535\n\x00\x00\xff\xff", 17))), (std::vector<int>{0, 255}));
+  EXPECT_EQ(pixels(decode("P1\n3 1\n0 1 0\n")), (std::vector<int>{255, 0, 255}));
+  EXPECT_EQ(pixels(decode("P1\n3 1\n010")), (std::vector<int>{255, 0, 255}));
+  EXPECT_EQ(pixels(decode("P4\n3 1\n\x40")), (std::vector<int>{255, 0, 255}));
+  EXPECT_EQ(pixels(decode("P6 1 1 255\n\x0a\x14\x1e")), (std::vector<int>{30, 20, 10}));
+  EXPECT_EQ(pixels(decode("P3\n1 1\n255\n10 20 30\n")), (std::vector<int>{30, 20, 10}));
+  const cv::Mat decoded = decode("P2\n2 2\n255\n1 2\n3 4\n");
+  EXPECT_EQ(decoded.rows, 2);
+  EXPECT_EQ(decoded.at<std::uint8_t>(1, 0), 3);
+  // What OpenCV writes reads back the same.
+  cv::Mat image(5, 7, CV_8UC1);
+  for (int i = 0; i < 35; ++i) image.data[i] = std::uint8_t(i * 7);
+  std::vector<std::uint8_t> pgm;
+  cv::imencode(".pgm", image, pgm);
+  EXPECT_EQ(pixels(decode(std::string(pgm.begin(), pgm.end()))), pixels(image));
+}
+
+TEST(MapIoBadInput, BrokenNetpbmImages) {
+  expect_input_error([] { decode(std::string("P5\n4 4\n255\n\x00\x00", 13)); }, {"test.pgm", "cannot decode PGM", "truncated"});
+  expect_input_error([] { decode("P2\n2 1\n15\n3 16\n"); }, {"test.pgm", "above maxval 15"});
+  expect_input_error([] { decode("P2\n2 1\n0\n0 0\n"); }, {"test.pgm", "maxval"});
+  expect_input_error([] { decode("P2\n2 1\n255\n0\n"); }, {"test.pgm", "ends before"});
+  expect_input_error([] { decode("P3\n1 1\n255\n10 x 30\n"); }, {"test.pgm", "cannot decode PPM"});
+}
+
 // One row of grey pixels; map_server: occ = (255 - v) / 255, occupied > 0.65, free < 0.196.
 cv::Mat grey_row(const std::vector<int>& values) {
   cv::Mat m(1, int(values.size()), CV_8UC1);
