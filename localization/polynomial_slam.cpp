@@ -29,6 +29,16 @@ struct PolynomialSlam::SourcePoint {
   int group = -1;
   double variance = 0.0;
   double angle_variance = 0.0;
+
+  // A point measured by the laser (eq. (3)), as the map keeps it.
+  static SourcePoint measured(const mapping::MapPoint& q) {
+    SourcePoint s;
+    s.position = q.position;
+    s.weight = q.weight;
+    s.observer = q.observer;
+    s.beam = q.beam;
+    return s;
+  }
 };
 
 void validate(const PolynomialSlamOptions& o) {
@@ -319,14 +329,7 @@ void PolynomialSlam::refit(int index) {
   // §3.1: R = epsilon_M equally spaced points on p*, fitted with Q_bad(p*); the new polynomial
   // replaces p*. The refit is always accepted, as the paper has it.
   std::vector<SourcePoint> points = samples_of(index, options_.epsilon_m);
-  for (const auto& b : map_.landmarks[std::size_t(index)].bad_points) {
-    SourcePoint s;
-    s.position = b.position;
-    s.weight = b.weight;
-    s.observer = b.observer;
-    s.beam = b.beam;
-    points.push_back(s);
-  }
+  for (const auto& b : map_.landmarks[std::size_t(index)].bad_points) points.push_back(SourcePoint::measured(b));
   const auto id = add_landmark(points, -1, std::numeric_limits<double>::infinity());
   if (!id) {
     map_.landmarks[std::size_t(index)].bad_points.clear();
@@ -347,14 +350,7 @@ void PolynomialSlam::add_to_cluster(const mapping::MapPoint& point) {
   cluster.push_back(point);
   if (int(cluster.size()) <= options_.epsilon_z) return;
   std::vector<SourcePoint> points;
-  for (const auto& q : cluster) {
-    SourcePoint s;
-    s.position = q.position;
-    s.weight = q.weight;
-    s.observer = q.observer;
-    s.beam = q.beam;
-    points.push_back(s);
-  }
+  for (const auto& q : cluster) points.push_back(SourcePoint::measured(q));
   // A cluster whose points no polynomial approximates within sigma_k (e.g. one bent round a
   // corner) is not turned into one; its oldest point leaves it, so it slides along the boundary
   // until its points agree (a choice: the paper does not say).

@@ -67,6 +67,14 @@ std::vector<std::string> path_planner_names() {
   return names;
 }
 
+MotionNoise read_motion_noise(core::YamlMap noise, const MotionNoise& fallback) {
+  MotionNoise n;
+  n.position_m = noise.number("position", fallback.position_m, 0.0, 100.0);
+  n.heading_rad = deg2rad(noise.number("heading_deg", rad2deg(fallback.heading_rad), 0.0, 360.0));
+  noise.finish();
+  return n;
+}
+
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
   const YAML::Node root = core::parse_yaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
@@ -111,12 +119,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     robots.finish();
   }
 
-  {
-    auto noise = top.map("noise");
-    s.noise.position_m = noise.number("position", s.noise.position_m, 0.0, 100.0);
-    s.noise.heading_rad = deg2rad(noise.number("heading_deg", rad2deg(s.noise.heading_rad), 0.0, 360.0));
-    noise.finish();
-  }
+  s.noise = read_motion_noise(top.map("noise"), s.noise);
   {
     auto sensors = top.map("sensors");
     auto range = sensors.map("range");

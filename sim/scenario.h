@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/transform2.h"
+#include "core/yaml_reader.h"
 #include "exploration/team_explorer.h"
 #include "localization/localizer.h"
 #include "sim/communication.h"
@@ -67,6 +68,10 @@ std::vector<std::string> merging_names();
 std::vector<std::string> path_planner_names();
 
 // Parses scenario YAML; `source` names it in errors and `base_dir` anchors relative map paths.
+// The `noise:` mapping of a scenario ({position: m, heading_deg: deg} per step), keys not given
+// taken from `fallback`. Throws InputError naming the key.
+MotionNoise read_motion_noise(core::YamlMap noise, const MotionNoise& fallback);
+
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 Scenario load_scenario(const std::filesystem::path& path);
 // Every setting, explicitly, in the layout parse_scenario reads.

@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/yaml_reader.h"
+#include "sim/scenario.h"
 
 namespace fleetmap::sim {
 
@@ -119,12 +120,7 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
     }
     robots.finish();
   }
-  {
-    auto noise = top.map("noise");
-    s.noise.position_m = noise.number("position", s.noise.position_m, 0.0, 100.0);
-    s.noise.heading_rad = deg2rad(noise.number("heading_deg", rad2deg(s.noise.heading_rad), 0.0, 360.0));
-    noise.finish();
-  }
+  s.noise = read_motion_noise(top.map("noise"), s.noise);
   {
     auto sensors = top.map("sensors");
     auto range = sensors.map("range");
