@@ -75,6 +75,16 @@ MotionNoise read_motion_noise(core::YamlMap noise, const MotionNoise& fallback) 
   return n;
 }
 
+RobotDetectorOptions read_robot_detector(core::YamlMap det, const RobotDetectorOptions& fallback) {
+  RobotDetectorOptions d = fallback;
+  d.max_range_m = det.number("max_range", fallback.max_range_m, 0.0, 1e6);
+  d.fov_rad = deg2rad(det.number("fov_deg", rad2deg(fallback.fov_rad), 0.0, 360.0));
+  d.range_noise_m = det.number("range_noise", fallback.range_noise_m, 0.0, 100.0);
+  d.bearing_noise_rad = deg2rad(det.number("bearing_noise_deg", rad2deg(fallback.bearing_noise_rad), 0.0, 360.0));
+  det.finish();
+  return d;
+}
+
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
   const YAML::Node root = core::parse_yaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
@@ -136,12 +146,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
         deg2rad(lm.number("bearing_noise_deg", rad2deg(s.landmark_sensor.bearing_noise_rad), 0.0, 360.0));
     s.landmark_sensor.report_ids = lm.boolean("report_ids", s.landmark_sensor.report_ids);
     lm.finish();
-    auto det = sensors.map("robots");
-    s.detector.max_range_m = det.number("max_range", s.detector.max_range_m, 0.0, 1e6);
-    s.detector.fov_rad = deg2rad(det.number("fov_deg", rad2deg(s.detector.fov_rad), 0.0, 360.0));
-    s.detector.range_noise_m = det.number("range_noise", s.detector.range_noise_m, 0.0, 100.0);
-    s.detector.bearing_noise_rad = deg2rad(det.number("bearing_noise_deg", rad2deg(s.detector.bearing_noise_rad), 0.0, 360.0));
-    det.finish();
+    s.detector = read_robot_detector(sensors.map("robots"), s.detector);
     sensors.finish();
   }
   {

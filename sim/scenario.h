@@ -72,6 +72,10 @@ std::vector<std::string> path_planner_names();
 // taken from `fallback`. Throws InputError naming the key.
 MotionNoise read_motion_noise(core::YamlMap noise, const MotionNoise& fallback);
 
+// A detector mapping ({max_range, fov_deg, range_noise, bearing_noise_deg}: the scenario's
+// `sensors.robots`, the SLAM scenario's `sensors.camera`), keys not given taken from `fallback`.
+RobotDetectorOptions read_robot_detector(core::YamlMap detector, const RobotDetectorOptions& fallback);
+
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 Scenario load_scenario(const std::filesystem::path& path);
 // Every setting, explicitly, in the layout parse_scenario reads.

@@ -130,12 +130,7 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
     s.range.max_range_m = range.number("max_range", s.range.max_range_m, 1e-3, 1e6);
     s.range.noise_m = range.number("noise", s.range.noise_m, 0.0, 100.0);
     range.finish();
-    auto cam = sensors.map("camera");
-    s.camera.max_range_m = cam.number("max_range", s.camera.max_range_m, 0.0, 1e6);
-    s.camera.fov_rad = deg2rad(cam.number("fov_deg", rad2deg(s.camera.fov_rad), 0.0, 360.0));
-    s.camera.range_noise_m = cam.number("range_noise", s.camera.range_noise_m, 0.0, 100.0);
-    s.camera.bearing_noise_rad = deg2rad(cam.number("bearing_noise_deg", rad2deg(s.camera.bearing_noise_rad), 0.0, 360.0));
-    cam.finish();
+    s.camera = read_robot_detector(sensors.map("camera"), s.camera);
     sensors.finish();
   }
   {
