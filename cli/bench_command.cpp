@@ -1,6 +1,7 @@
 // `fleetmap bench`: the coordination-strategy benchmark. Runs a sweep (maps x strategies x team
 // sizes x seeds) on a pool of threads, appending each run's row to results.csv; resumes an
 // interrupted sweep; runs one shard of it; combines shards; compares two strategies run by run.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -73,9 +74,66 @@ std::optional<sim::Sweep> sweep_of(const fs::path& dir) {
   return sim::load_sweep(dir / "sweep.yaml");
 }
 
+// The two files that define a sweep in its results folder.
+std::pair<std::string, std::string> sweep_files(const fs::path& out, const sim::Sweep& sweep) {
+  return {sim::sweep_to_yaml(sweep, "scenario.yaml"), sim::scenario_to_yaml(sweep.base, out)};
+}
+
 void write_sweep_files(const fs::path& out, const sim::Sweep& sweep) {
-  core::write_file_atomic(out / "scenario.yaml", sim::scenario_to_yaml(sweep.base));
-  core::write_file_atomic(out / "sweep.yaml", sim::sweep_to_yaml(sweep, "scenario.yaml"));
+  const auto [sweep_yaml, scenario_yaml] = sweep_files(out, sweep);
+  core::write_file_atomic(out / "scenario.yaml", scenario_yaml);
+  core::write_file_atomic(out / "sweep.yaml", sweep_yaml);
+}
+
+// The first line where two texts differ, for messages: "seeds: 6" against "seeds: 4".
+std::pair<std::string, std::string> first_difference(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i <= a.size() || j <= b.size()) {
+    const std::size_t ie = std::min(a.find('\n', i), a.size()), je = std::min(b.find('\n', j), b.size());
+    std::string la = i <= a.size() ? a.substr(i, ie - i) : "", lb = j <= b.size() ? b.substr(j, je - j) : "";
+    if (la != lb) return {la.empty() ? "(nothing)" : la, lb.empty() ? "(nothing)" : lb};
+    i = ie + 1;
+    j = je + 1;
+  }
+  return {"", ""};
+}
+
+// A results folder is resumed only by the very same sweep (and shard): its sweep.yaml and
+// scenario.yaml must be what this sweep writes, and every row must be a run of this sweep.
+void check_same_sweep(const fs::path& out, const sim::Sweep& sweep, const std::vector<sim::SweepRun>& runs,
+                      const std::vector<sim::RunRecord>& records) {
+  const std::string where = "--out " + out.string() + ": ";
+  const auto [sweep_yaml, scenario_yaml] = sweep_files(out, sweep);
+  for (const auto& [name, now] : {std::pair{std::string("sweep.yaml"), sweep_yaml}, std::pair{std::string("scenario.yaml"), scenario_yaml}}) {
+    if (!fs::is_regular_file(out / name)) {
+      throw InputError(where + "holds results.csv but no " + name + ", so its sweep is unknown; choose another --out");
+    }
+    const std::string before = core::read_file(out / name, std::size_t{1} << 20);
+    if (before != now) {
+      const auto [was, is] = first_difference(before, now);
+      throw InputError(where + "holds the results of another sweep (" + name + " there has '" + core::printable(was) +
+                       "', this sweep '" + core::printable(is) +
+                       "'); resume only with the same sweep, or choose another --out");
+    }
+  }
+  std::set<sim::RunKey> ours;
+  for (const auto& r : runs) ours.insert({r.map, r.strategy, r.robots, r.seed});
+  for (const auto& r : records) {
+    if (ours.count(r.key)) continue;
+    throw InputError(where + "holds a run that is not part of this sweep" + std::string(runs.size() < sim::sweep_runs(sweep).size() ? " (shard)" : "") +
+                     " (" + r.key.map + ", " + r.key.strategy + ", " + std::to_string(r.key.robots) + " robots, seed " +
+                     std::to_string(r.key.seed) + "); resume only with the same sweep and shard, or choose another --out");
+  }
+}
+
+// The files a bench folder holds for these maps.
+std::vector<std::string> bench_files(const std::vector<std::string>& map_labels) {
+  std::vector<std::string> files = {"results.csv", "summary.csv", "summary.md", "sweep.yaml", "scenario.yaml", "efficiency.png"};
+  for (const auto& m : map_labels) {
+    files.push_back("coverage_" + m + ".png");
+    files.push_back("time_" + m + ".png");
+  }
+  return files;
 }
 
 void print_outputs(const fs::path& out, const std::vector<fs::path>& reports) {
@@ -124,18 +182,30 @@ int run_combine(const BenchFlags& f) {
     }
   }
   const fs::path out = f.out;
-  core::ensure_directory(out);
+  std::vector<fs::path> inputs;
+  for (const auto& dir : f.combine) inputs.push_back(fs::path(dir) / "results.csv");
+  std::vector<std::string> labels;
+  for (const auto& r : records) {
+    if (std::find(labels.begin(), labels.end(), r.key.map) == labels.end()) labels.push_back(r.key.map);
+  }
+  core::OutputFolder folder(out, "bench", bench_files(labels), inputs, "--out " + out.string());
+  folder.claim();
+  std::vector<fs::path> written;
   std::size_t expected = 0;
   if (sweep) {
     const auto runs = sim::sweep_runs(*sweep);
     expected = runs.size();
     sim::sort_records(records, runs);
     write_sweep_files(out, *sweep);
+    written = {out / "sweep.yaml", out / "scenario.yaml"};
   } else {
     sim::sort_records(records, {});
   }
   sim::write_results(out / "results.csv", records);
+  written.push_back(out / "results.csv");
   const auto reports = sim::write_sweep_reports(out, records);
+  written.insert(written.end(), reports.begin(), reports.end());
+  folder.finish(core::OutputFolder::names(written));
   std::printf("combined %zu runs from %zu folders into %s\n", records.size(), f.combine.size(), out.c_str());
   if (expected > records.size()) {
     std::printf("note: %zu of the sweep's %zu runs are missing (shards not finished or not given)\n",
@@ -155,6 +225,18 @@ int run_bench(const BenchFlags& f) {
   sim::validate_sweep(sweep);
   const std::optional<sim::Shard> shard = f.shard.empty() ? std::nullopt : std::optional(sim::parse_shard(f.shard));
 
+  // Every output is checked before the maps are read or a run starts.
+  const fs::path out = f.out.empty() ? fs::path("out/bench") : fs::path(f.out);
+  std::vector<fs::path> inputs;
+  if (!f.sweep_file.empty()) inputs.push_back(f.sweep_file);
+  if (f.sweep.scenario) inputs.push_back(*f.sweep.scenario);
+  std::vector<std::string> labels;
+  for (const auto& source : sweep.maps) {
+    labels.push_back(sim::map_label(source));
+    for (auto& file : maps::map_source_files(source)) inputs.push_back(std::move(file));
+  }
+  core::OutputFolder folder(out, "bench", bench_files(labels), inputs, "--out " + out.string());
+
   sim::SweepMaps maps;
   for (const auto& source : sweep.maps) {
     try {
@@ -167,14 +249,13 @@ int run_bench(const BenchFlags& f) {
 
   const auto all_runs = sim::sweep_runs(sweep);
   const auto runs = shard ? sim::shard_runs(all_runs, *shard) : all_runs;
-  const fs::path out = f.out.empty() ? fs::path("out/bench") : fs::path(f.out);
-  core::ensure_directory(out);
   const fs::path results = out / "results.csv";
   const std::string settings = sim::settings_id(sweep.base);
 
   std::set<sim::RunKey> done;
   if (fs::exists(results)) {
     const auto table = sim::read_results(results);
+    check_same_sweep(out, sweep, runs, table.records);
     sim::check_settings(table.records, settings, results);
     for (const auto& r : table.records) done.insert(r.key);
   }
@@ -182,6 +263,7 @@ int run_bench(const BenchFlags& f) {
   for (const auto& r : runs) {
     if (!done.count({r.map, r.strategy, r.robots, r.seed})) todo.push_back(r);
   }
+  folder.claim();
   write_sweep_files(out, sweep);
 
   const auto t0 = std::chrono::steady_clock::now();
@@ -204,6 +286,9 @@ int run_bench(const BenchFlags& f) {
   sim::sort_records(records, all_runs);
   sim::write_results(results, records);
   const auto reports = sim::write_sweep_reports(out, records);
+  std::vector<fs::path> written = {out / "sweep.yaml", out / "scenario.yaml", results};
+  written.insert(written.end(), reports.begin(), reports.end());
+  folder.finish(core::OutputFolder::names(written));
 
   if (f.quiet) {
     std::printf("%s\n", results.c_str());
@@ -247,13 +332,13 @@ Command add_bench_command(CLI::App& root) {
                   "Comma-separated built-in maps or map files [default: empty,unstructured,office,corridor]");
   app->add_option("--strategies", s.strategies, "Comma-separated strategies, or all [default: all]");
   app->add_option("--robots", s.robots, "Team sizes, e.g. 1,2,4,9 or 1-9 [default: 1,2,4,9]");
-  app->add_option("--seeds", s.seeds, "Seeds per combination [default: 20]")->check(positive());
+  app->add_option("--seeds", s.seeds, "Seeds per combination [default: 20]")->check(in_range(sim::kSeedCountRange));
   app->add_option("--first-seed", s.first_seed, "The first seed; runs use first-seed, first-seed + 1, ... [default: 1]")
-      ->check(whole_number());
+      ->check(seed_number());
   app->add_option("--scenario", s.scenario,
                   "Scenario file every run starts from (its map, strategy, robots and seed are replaced) "
                   "[default: the scenario defaults of `fleetmap explore`]");
-  app->add_option("--steps", s.steps, "Step limit of each run [default: 2000]")->check(positive());
+  app->add_option("--steps", s.steps, "Step limit of each run [default: 2000]")->check(in_range(sim::limits::kSteps));
   std::string localizers;
   for (const auto& name : localization::localizer_names()) localizers += (localizers.empty() ? "" : ", ") + name;
   app->add_option("--localization", s.localization,
@@ -261,11 +346,16 @@ Command add_bench_command(CLI::App& root) {
   app->add_option("--merging", s.merging,
                   "How robots bring teammates' maps into their frame: known, rendezvous or overlap (see `fleetmap "
                   "explore --help`) [default: known]");
-  app->add_option("--comm-range", s.comm_range, "Communication range in metres, or inf [default: inf]");
-  app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]")->check(positive());
-  app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")->check(positive());
+  app->add_option("--comm-range", s.comm_range, "Communication range in metres, or inf [default: inf]")
+      ->check(in_range(sim::limits::kCommRange));
+  app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]")
+      ->check(in_range(sim::limits::kSensorRange));
+  app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")
+      ->check(in_range(sim::kJobsRange));
   app->add_option("--shard", f->shard, "Run only the K-th of N slices of the sweep, K/N (for clusters; see bench/slurm/)");
-  app->add_option("--out", f->out, "Output folder, created if missing [default: out/bench]");
+  app->add_option("--out", f->out,
+                  "Output folder: new, empty, or of an earlier run of the very same sweep, which is resumed "
+                  "[default: out/bench]");
   app->add_option("--combine", f->combine, "Join the results of these output folders (shards) into --out")->expected(1, -1);
   app->add_option("--compare", f->compare,
                   "A B DIR: paired comparison of strategies A and B on the runs in DIR (same maps, team sizes and seeds)")

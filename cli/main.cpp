@@ -2,13 +2,18 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/core/utils/logger.hpp>
 
-#include <cstdio>
+#include <fmt/format.h>
+
 #include <exception>
+#include <filesystem>
+#include <new>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/file_io.h"
 
 namespace {
 
@@ -31,6 +36,12 @@ const CLI::App* deepest_parsed(const CLI::App* app) {
   return app;
 }
 
+// A word where a command was expected; `where` is the command path that expected it.
+struct UnknownCommand : std::runtime_error {
+  UnknownCommand(std::string where_, const std::string& what) : std::runtime_error(what), where(std::move(where_)) {}
+  std::string where;
+};
+
 // CLI11 reports an unknown subcommand as "a subcommand is required"; name the word instead.
 void check_subcommand_words(const CLI::App& app, int argc, char** argv) {
   const CLI::App* current = &app;
@@ -46,7 +57,7 @@ void check_subcommand_words(const CLI::App& app, int argc, char** argv) {
       names += (names.empty() ? "" : ", ") + s->get_name();
     }
     if (next == nullptr) {
-      throw CLI::ValidationError(current->get_name(), "unknown command '" + word + "' (commands: " + names + ")");
+      throw UnknownCommand(command_path(current), "unknown command '" + word + "' (commands: " + names + ")");
     }
     current = next;
   }
@@ -82,20 +93,32 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const UnknownCommand& e) {
+    fmt::print(stderr, "{}: {}\n", e.where, fm::core::printable(e.what()));
+    return kExitBadInput;
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "%s: %s (see --help)\n", command_path(deepest_parsed(&app)).c_str(), e.what());
+    fmt::print(stderr, "{}: {} (see --help)\n", command_path(deepest_parsed(&app)), fm::core::printable(e.what()));
     return kExitBadInput;
   }
 
+  // Every message is one line: names from the user are shown with their control characters escaped.
   try {
     for (const auto& c : commands) {
       if (c.app->parsed()) return c.run();
     }
   } catch (const fm::InputError& e) {
-    std::fprintf(stderr, "fleetmap: %s\n", e.what());
+    fmt::print(stderr, "fleetmap: {}\n", fm::core::printable(e.what()));
     return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "fleetmap: out of memory: the map, the team or the run is too large for this machine "
+                       "(see --max-cells and README.md, \"Outputs, reproducibility, size\")\n");
+    return kExitFailure;
+  } catch (const std::filesystem::filesystem_error& e) {
+    const std::string path = e.path1().empty() ? std::string() : e.path1().string() + ": ";
+    fmt::print(stderr, "fleetmap: {}{}\n", fm::core::printable(path), e.code().message());
+    return kExitFailure;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "fleetmap: error: %s\n", e.what());
+    fmt::print(stderr, "fleetmap: error: {}\n", fm::core::printable(e.what()));
     return kExitFailure;
   }
   return kExitFailure;

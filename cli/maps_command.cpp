@@ -1,11 +1,15 @@
 // `fleetmap maps list | show`: the built-in maps, and a picture of any map.
+#include <fmt/format.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <string>
 
 #include "cli/command.h"
+#include "cli/outputs.h"
 #include "cli/validators.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "maps/builtin_maps.h"
 #include "mapping/map_io.h"
 #include "mapping/render.h"
@@ -40,23 +44,22 @@ int run_list() {
 }
 
 int run_show(const ShowOptions& o) {
+  const fs::path out = o.out.empty() ? fs::path(fs::path(o.map).stem().string() + "_map.png") : fs::path(o.out);
+  mapping::check_picture_path(out, "--out");
+  const std::vector<OutputFile> outputs = {{"--out", out}};
+  check_outputs(outputs, maps::map_source_files(o.map));
   mapping::MapLoadOptions load;
   load.default_resolution = o.resolution;
   load.max_cells = o.max_cells;
   const auto grid = maps::load_map_source(o.map, load);
-  fs::path out = o.out;
-  if (out.empty()) out = fs::path(o.map).stem().string() + "_map.png";
-  std::error_code ec;
-  if (fs::exists(o.map) && fs::equivalent(out, o.map, ec)) {
-    throw InputError(out.string() + ": --out would overwrite the input map; choose another file");
-  }
   mapping::RenderOptions render;
   render.title = o.title.empty() ? fs::path(o.map).stem().string() : o.title;
-  mapping::write_image(out, mapping::render_map(grid, {}, render));
+  write_picture(out, mapping::render_map(grid, {}, render));
   const double free_m2 = double(grid.count(mapping::CellState::Free)) * grid.resolution() * grid.resolution();
-  std::printf("%s: %dx%d cells, %.2f m/cell, %.1f x %.1f m, free %.1f m^2\nwrote %s\n", o.map.c_str(), grid.width(),
-              grid.height(), grid.resolution(), grid.geometry().width_m(), grid.geometry().height_m(), free_m2,
-              out.c_str());
+  std::FILE* report = report_stream(outputs);
+  fmt::print(report, "{}: {}x{} cells, {} m/cell, {:.1f} x {:.1f} m, free {:.1f} m^2\n", o.map, grid.width(),
+             grid.height(), grid.resolution(), grid.geometry().width_m(), grid.geometry().height_m(), free_m2);
+  if (!core::is_standard_output(out)) fmt::print(report, "wrote {}\n", out.string());
   return 0;
 }
 
@@ -69,14 +72,14 @@ Command add_maps_command(CLI::App& root) {
   CLI::App* show = maps->add_subcommand("show", "Render a map (built-in name, PNG/PGM image or map_server YAML) to a PNG");
   auto o = std::make_shared<ShowOptions>();
   show->add_option("map", o->map, "Built-in map name, image file or map_server YAML")->required();
-  show->add_option("--out,-o", o->out, "Output PNG (default: <map name>_map.png in the current folder)");
+  show->add_option("--out,-o", o->out, "Output PNG, or - for the standard output (default: <map name>_map.png in the current folder)");
   show->add_option("--title", o->title, "Title in the legend panel (default: the map name)");
   show->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
       ->capture_default_str()
-      ->check(positive());
+      ->check(in_range(mapping::kResolutionRange));
   show->add_option("--max-cells", o->max_cells, "Refuse maps with more cells than this")
       ->capture_default_str()
-      ->check(positive());
+      ->check(in_range(kMaxCellsRange));
   return {maps, [list, show, o]() {
             if (list->parsed()) return run_list();
             if (show->parsed()) return run_show(*o);

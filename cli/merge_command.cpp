@@ -1,5 +1,6 @@
 // `fleetmap merge`: several robots' map images become one, with each input's transform into the
 // first input's pixel grid, a confidence, and a picture.
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "cli/command.h"
+#include "cli/outputs.h"
 #include "cli/validators.h"
 #include "core/angle.h"
 #include "core/error.h"
@@ -125,14 +127,14 @@ int run_merge(const MergeCommandOptions& o) {
     throw InputError("merge needs at least two maps, got one: " + o.maps.front());
   }
   merging::check_merge_method(o.method);
-  std::error_code ec;
-  for (const std::string& out : {o.out, o.json}) {
-    for (const auto& m : o.maps) {
-      if (!out.empty() && fs::exists(m) && fs::equivalent(out, m, ec)) {
-        throw InputError(out + ": would overwrite the input map; choose another file");
-      }
-    }
+  const std::vector<OutputFile> outputs = {{"--out", o.out}, {"--json", o.json}};
+  if (!o.out.empty()) mapping::check_picture_path(o.out, "--out");
+  std::vector<fs::path> inputs;
+  for (const auto& m : o.maps) {
+    for (auto& f : maps::map_source_files(m)) inputs.push_back(std::move(f));
   }
+  check_outputs(outputs, inputs);
+  std::FILE* report = report_stream(outputs);
   mapping::MapLoadOptions load;
   load.default_resolution = o.resolution;
   std::vector<mapping::OccupancyGrid> grids;
@@ -142,8 +144,8 @@ int run_merge(const MergeCommandOptions& o) {
     if (g.known_count() == 0) throw InputError(m + ": every cell is unknown; there is nothing to merge");
     const double r0 = grids.front().resolution();
     if (std::abs(g.resolution() - r0) > 1e-9 * r0) {
-      throw InputError(m + ": resolution " + std::to_string(g.resolution()) + " m differs from " + o.maps.front() +
-                       "'s " + std::to_string(r0) + " m; merge maps of one resolution");
+      throw InputError(fmt::format("{}: resolution {} m differs from {}'s {} m; merge maps of one resolution", m,
+                                   g.resolution(), o.maps.front(), r0));
     }
   }
   std::vector<const mapping::OccupancyGrid*> pointers;
@@ -168,7 +170,7 @@ int run_merge(const MergeCommandOptions& o) {
   j["method"] = o.method;
   j["transforms"] = nlohmann::json::array();
   int placed = 1;
-  std::printf("%s: the reference (first input)\n", o.maps.front().c_str());
+  fmt::print(report, "{}: the reference (first input)\n", o.maps.front());
   for (std::size_t i = 1; i < grids.size(); ++i) {
     const auto& name = o.maps[i];
     if (!merged.to_first[i]) {
@@ -177,7 +179,7 @@ int run_merge(const MergeCommandOptions& o) {
       t["merged"] = false;
       t["reason"] = merged.reason[i];
       j["transforms"].push_back(t);
-      std::printf("%s: not merged: %s\n", name.c_str(), merged.reason[i].c_str());
+      fmt::print(report, "{}: not merged: {}\n", name, merged.reason[i]);
       continue;
     }
     ++placed;
@@ -186,22 +188,23 @@ int run_merge(const MergeCommandOptions& o) {
     const auto& pair = pair_of(int(i), parent);
     j["transforms"].push_back(transform_json(name, pixels, pair, merged.confidence[i], merged.method[i],
                                              o.maps[std::size_t(parent)]));
-    std::printf("%s: tx %.2f ty %.2f px, theta %.3f deg, acceptance %.3f, confidence %.2f (%s, via %s)\n",
-                name.c_str(), pixels.translation().x(), pixels.translation().y(), core::rad2deg(pixels.rotation()),
-                pair.acceptance, merged.confidence[i], merged.method[i].c_str(), o.maps[std::size_t(parent)].c_str());
+    fmt::print(report, "{}: tx {:.2f} ty {:.2f} px, theta {:.3f} deg, acceptance {:.3f}, confidence {:.2f} ({}, via {})\n",
+               name, pixels.translation().x(), pixels.translation().y(), core::rad2deg(pixels.rotation()),
+               pair.acceptance, merged.confidence[i], merged.method[i], o.maps[std::size_t(parent)]);
   }
   j["merged_maps"] = placed;
   j["max_loop_gap_px"] = merged.max_loop_gap;
 
   const merging::FusedMap fused = merging::fuse_merged(pointers, merged);
   j["conflict_cells"] = fused.conflict_cells;
-  if (!o.json.empty()) core::write_file_atomic(o.json, j.dump(2) + "\n");
-  if (!o.out.empty()) mapping::write_image(o.out, picture(fused, o.maps));
-  if (!o.out.empty()) std::printf("wrote %s\n", o.out.c_str());
-  if (!o.json.empty()) std::printf("wrote %s\n", o.json.c_str());
+  if (!o.json.empty()) write_output(o.json, j.dump(2) + "\n");
+  if (!o.out.empty()) write_picture(o.out, picture(fused, o.maps));
+  for (const auto& out : outputs) {
+    if (!out.path.empty() && !core::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
+  }
   if (placed < int(grids.size())) {
-    std::fprintf(stderr, "fleetmap merge: %d of %zu maps merged; the others have no reliable overlap\n", placed,
-                 grids.size());
+    fmt::print(stderr, "fleetmap merge: {} of {} maps merged; the others have no reliable overlap\n", placed,
+               grids.size());
     return 1;
   }
   return 0;
@@ -226,15 +229,15 @@ Command add_merge_command(CLI::App& root) {
   merge->add_option("--method", o->method, "Alignment method: auto, overlap or features (see below)")
       ->capture_default_str()
       ->check(CLI::IsMember(merging::merge_method_names()));
-  merge->add_option("--out,-o", o->out, "Merged map picture (PNG)")->capture_default_str();
-  merge->add_option("--json", o->json, "Write the transforms and confidences to this JSON (default: none)");
+  merge->add_option("--out,-o", o->out, "Merged map picture (PNG; - for the standard output)")->capture_default_str();
+  merge->add_option("--json", o->json, "Write the transforms and confidences to this JSON; - for the standard output (default: none)");
   merge->add_option("--min-confidence", o->min_confidence, "Refuse merges below this confidence")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
-  merge->add_option("--seed", o->seed, "Seed of the RANSAC sampling (features)")->capture_default_str()->check(whole_number());
+      ->check(in_range(merging::kConfidenceRange));
+  merge->add_option("--seed", o->seed, "Seed of the RANSAC sampling (features)")->capture_default_str()->check(seed_number());
   merge->add_option("--resolution", o->resolution, "Metres per cell for bare images without YAML")
       ->capture_default_str()
-      ->check(positive());
+      ->check(in_range(mapping::kResolutionRange));
   return {merge, [o]() { return run_merge(*o); }};
 }
 

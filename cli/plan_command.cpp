@@ -1,4 +1,5 @@
 // `fleetmap plan`: a collision-free path for a disc robot on any map, by any registered planner.
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/outputs.h"
 #include "cli/plan_output.h"
 #include "cli/validators.h"
 #include "core/error.h"
@@ -23,6 +25,9 @@ namespace fleetmap::cli {
 namespace fs = std::filesystem;
 
 namespace {
+
+// Robot radii, in metres (0: a point robot).
+constexpr core::Range kRadiusRange{0, 100};
 
 struct PlanCommandOptions {
   std::string map;
@@ -103,17 +108,15 @@ cv::Mat picture(const PlanCommandOptions& o, const mapping::OccupancyGrid& grid,
 }
 
 int run_plan(const PlanCommandOptions& o) {
+  const std::vector<OutputFile> outputs = {{"--out", o.out}, {"--json", o.json}};
+  if (!o.out.empty()) mapping::check_picture_path(o.out, "--out");
+  check_outputs(outputs, maps::map_source_files(o.map));
+  std::FILE* report = report_stream(outputs);
   mapping::MapLoadOptions load;
   load.default_resolution = o.resolution;
   const mapping::OccupancyGrid grid = maps::load_map_source(o.map, load);
   const Endpoint start = endpoint("from", o.from, o.from_cell, grid);
   const Endpoint goal = endpoint("to", o.to, o.to_cell, grid);
-  std::error_code ec;
-  for (const std::string& out : {o.out, o.json}) {
-    if (!out.empty() && fs::exists(o.map) && fs::equivalent(out, o.map, ec)) {
-      throw InputError(out + ": would overwrite the input map; choose another file");
-    }
-  }
 
   planning::FreeSpaceOptions space_options;
   space_options.robot_radius_m = o.radius_m;
@@ -132,16 +135,17 @@ int run_plan(const PlanCommandOptions& o) {
     throw InputError(goal.flag + " " + goal.text + ": " + r.detail);
   }
 
-  if (!o.json.empty()) core::write_file_atomic(o.json, result_json(o, r, start, goal).dump(2) + "\n");
-  if (!o.out.empty()) mapping::write_image(o.out, picture(o, grid, space, r, start, goal));
+  if (!o.json.empty()) write_output(o.json, result_json(o, r, start, goal).dump(2) + "\n");
+  if (!o.out.empty()) write_picture(o.out, picture(o, grid, space, r, start, goal));
   if (!r.success()) {
-    std::fprintf(stderr, "fleetmap plan: no path on %s: %s\n", o.map.c_str(), r.detail.c_str());
+    fmt::print(stderr, "fleetmap plan: no path on {}: {}\n", o.map, r.detail);
     return 1;
   }
-  std::printf("%s: %.2f m in %zu waypoints; first path after %.3f s, %.3f s in all\n", r.planner.c_str(), r.length_m,
-              r.path.size(), r.first_solution_s.value_or(r.time_s), r.time_s);
-  if (!o.out.empty()) std::printf("wrote %s\n", o.out.c_str());
-  if (!o.json.empty()) std::printf("wrote %s\n", o.json.c_str());
+  fmt::print(report, "{}: {:.2f} m in {} waypoints; first path after {:.3f} s, {:.3f} s in all\n", r.planner, r.length_m,
+             r.path.size(), r.first_solution_s.value_or(r.time_s), r.time_s);
+  for (const auto& out : outputs) {
+    if (!out.path.empty() && !core::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
+  }
   return 0;
 }
 
@@ -163,17 +167,18 @@ Command add_plan_command(CLI::App& root) {
   plan->add_option("--planner", o->planner, "Planner name (see the list below)")
       ->capture_default_str()
       ->check(CLI::IsMember(planning::planner_names()));
-  plan->add_option("--time", o->time_s, "Time budget in seconds")->capture_default_str()->check(positive());
-  plan->add_option("--radius", o->radius_m, "Robot radius in metres")->capture_default_str()->check(non_negative());
+  plan->add_option("--time", o->time_s, "Time budget in seconds")->capture_default_str()->check(in_range(planning::kTimeBudgetRange));
+  plan->add_option("--radius", o->radius_m, "Robot radius in metres")->capture_default_str()->check(in_range(kRadiusRange));
   plan->add_option("--unknown", o->unknown, "Unknown cells are 'obstacle' or 'free'")
       ->capture_default_str()
       ->check(CLI::IsMember({"obstacle", "free"}));
-  plan->add_option("--seed", o->seed, "Seed of the sampling planners")->capture_default_str()->check(whole_number());
-  plan->add_option("--out,-o", o->out, "Draw the map and the path to this PNG (default: none)");
-  plan->add_option("--json", o->json, "Write planner, success, time, length and waypoints to this JSON (default: none)");
+  plan->add_option("--seed", o->seed, "Seed of the sampling planners")->capture_default_str()->check(seed_number());
+  plan->add_option("--out,-o", o->out, "Draw the map and the path to this PNG; - for the standard output (default: none)");
+  plan->add_option("--json", o->json,
+                   "Write planner, success, time, length and waypoints to this JSON; - for the standard output (default: none)");
   plan->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
       ->capture_default_str()
-      ->check(positive());
+      ->check(in_range(mapping::kResolutionRange));
   return {plan, [o]() { return run_plan(*o); }};
 }
 

@@ -1,6 +1,8 @@
 // `fleetmap slam`: a SLAM experiment repeated over many runs (seed 000 §4 with
 // scenarios/dalfonso_3robots.yaml): Table 1 as Markdown and CSV, every run's numbers, and the maps
 // of the first run as pictures. The scenario's `method` picks the SLAM method.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
@@ -15,10 +17,13 @@
 #include "cli/command.h"
 #include "cli/corridor_command.h"
 #include "cli/progress.h"
+#include "cli/validators.h"
+#include "core/file_io.h"
 #include "core/error.h"
 #include "sim/slam_experiment.h"
 #include "sim/slam_output.h"
 #include "sim/slam_scenario.h"
+#include "sim/sweep.h"
 
 namespace fleetmap::cli {
 
@@ -42,16 +47,15 @@ std::string method_names() {
 }
 
 int run_slam(const SlamFlags& f) {
-  // Seed 002's corridor experiment (experiment: leon_corridor) has its own runner.
-  if (is_corridor_scenario_file(f.scenario)) {
-    const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
-    return run_corridor_scenario(f.scenario, out, f.seed, f.quiet);
-  }
+  const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
+  // The corridor loop of León et al. (experiment: leon_corridor) has its own runner.
+  if (is_corridor_scenario_file(f.scenario)) return run_corridor_scenario(f.scenario, out, f.seed, f.quiet);
   sim::SlamScenario s = sim::load_slam_scenario(f.scenario);
   if (f.runs) s.runs = *f.runs;
   if (f.seed) s.seed = *f.seed;
+  core::OutputFolder folder(out, "slam", sim::slam_output_files(s), {f.scenario}, "--out " + out.string());
   const sim::SlamSetup setup = sim::prepare_slam(s);
-  const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
+  folder.claim();
 
   int single = -1;
   for (std::size_t i = 0; i < s.robots.size(); ++i) {
@@ -97,14 +101,15 @@ int run_slam(const SlamFlags& f) {
   if (failure) std::rethrow_exception(failure);
 
   const auto written = sim::write_slam_outputs(setup, campaign, out, s.paper_table);
+  folder.finish(core::OutputFolder::names(written));
   if (f.quiet) {
-    std::printf("%s\n", (out / "table1.md").c_str());
+    fmt::print("{}\n", (out / "table1.md").string());
     return 0;
   }
-  std::printf("%s", sim::slam_table_markdown(setup, campaign, s.paper_table).c_str());
-  std::printf("\nall outputs in %s/:", out.c_str());
-  for (const auto& p : written) std::printf(" %s", p.filename().c_str());
-  std::printf("\n");
+  fmt::print("{}", sim::slam_table_markdown(setup, campaign, s.paper_table));
+  std::string names;
+  for (const auto& p : written) names += " " + p.filename().string();
+  fmt::print("\nall outputs in {}/:{}\n", out.string(), names);
   return 0;
 }
 
@@ -127,11 +132,14 @@ Command add_slam_command(CLI::App& root) {
       ->required()
       ->check(CLI::ExistingFile);
   app->add_option("--runs", f->runs, "Number of runs [default: the scenario's runs, 100 if it has none]")
-      ->check(CLI::Range(1, 1'000'000));
-  app->add_option("--seed", f->seed, "Random seed; run k uses its own streams derived from it [default: the scenario's, 1]");
+      ->check(in_range(sim::kSlamRunsRange));
+  app->add_option("--seed", f->seed, "Random seed; run k uses its own streams derived from it [default: the scenario's, 1]")
+      ->check(seed_number());
   app->add_option("--jobs", f->jobs, "Runs computed in parallel, one thread each; results do not depend on it [default: 1]")
-      ->check(CLI::Range(1, 256));
-  app->add_option("--out", f->out, "Output folder, created if missing [default: out/slam_<scenario name>]");
+      ->check(in_range(sim::kJobsRange));
+  app->add_option("--out", f->out,
+                  "Output folder: new, empty, or of an earlier slam run (its files are replaced) "
+                  "[default: out/slam_<scenario name>]");
   app->add_flag("--quiet,-q", f->quiet, "Print only the path of table1.md; no progress bar");
   return {app, [f]() { return run_slam(*f); }};
 }

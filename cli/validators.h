@@ -1,53 +1,36 @@
 #pragma once
-// Option checks with messages a user can act on ("--steps: expected a number > 0, got '0'"), in
-// place of CLI11's built-in ones that print the whole range of a double.
+// Option checks with messages a user can act on ("--steps: expected a whole number from 1 to
+// 10000000, got '0'"). The ranges are the ones the scenario and map readers use (core::Range), so
+// a flag accepts exactly what a file accepts.
 #include <CLI/CLI.hpp>
 
-#include <cmath>
-#include <cstdlib>
 #include <string>
+
+#include "core/range.h"
 
 namespace fleetmap::cli {
 
-namespace detail {
-inline bool parse_finite(const std::string& text, double& value) {
-  char* end = nullptr;
-  value = std::strtod(text.c_str(), &end);
-  return !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
-}
-}  // namespace detail
-
-// A finite number greater than zero.
-inline CLI::Validator positive() {
+// A number in `range`; the text stays as typed (CLI11 then converts it).
+inline CLI::Validator in_range(const core::Range& range) {
   return CLI::Validator(
-      [](std::string& text) -> std::string {
-        double v = 0.0;
-        if (detail::parse_finite(text, v) && v > 0.0) return {};
-        return "expected a number > 0, got '" + text + "'";
+      [range](std::string& text) -> std::string {
+        if (core::parse_in_range(text, range)) return {};
+        return "expected " + core::expected_text(range) + ", got '" + text + "'";
       },
-      "POSITIVE");
+      "NUMBER");
 }
 
-// A finite number greater than or equal to zero.
-inline CLI::Validator non_negative() {
-  return CLI::Validator(
-      [](std::string& text) -> std::string {
-        double v = 0.0;
-        if (detail::parse_finite(text, v) && v >= 0.0) return {};
-        return "expected a number >= 0, got '" + text + "'";
-      },
-      "NONNEGATIVE");
-}
+// --max-cells of every command that reads maps.
+inline constexpr core::Range kMaxCellsRange{1, 1e12, true};
 
-// A whole number of decimal digits (seeds: no sign, no exponent, fits 64 bits).
-inline CLI::Validator whole_number() {
+// A seed: a whole number from 0 to 2^64 - 1.
+inline CLI::Validator seed_number() {
   return CLI::Validator(
       [](std::string& text) -> std::string {
-        const bool digits = !text.empty() && text.size() <= 19 && text.find_first_not_of("0123456789") == std::string::npos;
-        if (digits) return {};
-        return "expected a whole number >= 0, got '" + text + "'";
+        if (core::parse_seed(text)) return {};
+        return std::string("expected ") + core::kSeedExpected + ", got '" + text + "'";
       },
-      "UINT");
+      "SEED");
 }
 
 }  // namespace fleetmap::cli

@@ -30,6 +30,17 @@ YamlMap::YamlMap(const YAML::Node& node, std::string source, std::string prefix)
     throw InputError(where_node(node_) + ": " + (prefix_.empty() ? std::string("the file") : "key '" + prefix_ + "'") +
                      ": expected a mapping of keys, got " + describe_node(node_));
   }
+  if (!node_ || !node_.IsMap()) return;
+  std::vector<std::pair<std::string, YAML::Mark>> seen;
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : describe_node(kv.first);
+    for (const auto& [other, mark] : seen) {
+      if (other != key) continue;
+      throw InputError(where_node(kv.first) + ": key '" + full_key(key) + "' is given twice (first on line " +
+                       std::to_string(mark.line + 1) + ")");
+    }
+    seen.emplace_back(key, kv.first.Mark());
+  }
 }
 
 std::string YamlMap::where_node(const YAML::Node& n) const {
@@ -84,6 +95,22 @@ long long YamlMap::integer(const std::string& key, long long fallback, long long
                      ", got " + describe_node(*n));
   }
   return v;
+}
+
+double YamlMap::number(const std::string& key, double fallback, const Range& range) {
+  const auto n = node(key);
+  if (!n) return fallback;
+  const auto v = n->IsScalar() ? parse_in_range(n->Scalar(), range) : std::nullopt;
+  if (!v) throw InputError(where(key) + ": expected " + expected_text(range) + ", got " + describe_node(*n));
+  return *v;
+}
+
+std::uint64_t YamlMap::seed(const std::string& key, std::uint64_t fallback) {
+  const auto n = node(key);
+  if (!n) return fallback;
+  const auto v = n->IsScalar() ? parse_seed(n->Scalar()) : std::nullopt;
+  if (!v) throw InputError(where(key) + ": expected " + std::string(kSeedExpected) + ", got " + describe_node(*n));
+  return *v;
 }
 
 bool YamlMap::boolean(const std::string& key, bool fallback) {

@@ -4,10 +4,13 @@
 // was expected.
 #include <yaml-cpp/yaml.h>
 
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "core/range.h"
 
 namespace fleetmap::core {
 
@@ -15,6 +18,8 @@ class YamlMap {
  public:
   // `source` names the file in messages; `prefix` is the dotted path of this mapping ("" at top).
   // Throws InputError when `node` is not a mapping.
+  // Throws InputError when `node` is not a mapping, or holds a key twice (YAML keeps both and
+  // readers would silently take one).
   YamlMap(const YAML::Node& node, std::string source, std::string prefix = "");
 
   bool has(const std::string& key) const;
@@ -28,6 +33,9 @@ class YamlMap {
                 double hi = std::numeric_limits<double>::infinity(), bool allow_inf = false);
   long long integer(const std::string& key, long long fallback, long long lo = std::numeric_limits<long long>::min(),
                     long long hi = std::numeric_limits<long long>::max());
+  // A number in `range` (a whole one when range.whole).
+  double number(const std::string& key, double fallback, const Range& range);
+  std::uint64_t seed(const std::string& key, std::uint64_t fallback);
   bool boolean(const std::string& key, bool fallback);
   std::string text(const std::string& key, const std::string& fallback);
   std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& valid);

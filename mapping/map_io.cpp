@@ -1,5 +1,7 @@
 #include "mapping/map_io.h"
 
+#include <fmt/format.h>
+
 #include <png.h>
 #include <yaml-cpp/yaml.h>
 
@@ -23,6 +25,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// No image side is longer (2^40 pixels); a header declaring more is refused as such.
+constexpr std::int64_t kHugeSide = std::int64_t{1} << 40;
+
 // Reads width and height from a PNG or PNM header without decoding the image.
 std::optional<std::pair<std::int64_t, std::int64_t>> peek_image_size(const std::string& bytes) {
   static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
@@ -45,8 +50,9 @@ std::optional<std::pair<std::int64_t, std::int64_t>> peek_image_size(const std::
         }
       }
       if (i >= bytes.size() || !std::isdigit(static_cast<unsigned char>(bytes[i]))) return std::nullopt;
-      while (i < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[i])) && dims[k] < (std::int64_t{1} << 40)) {
-        dims[k] = dims[k] * 10 + (bytes[i] - '0');
+      // Every digit is read; past kHugeSide the value stays just above it.
+      while (i < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[i]))) {
+        dims[k] = std::min(dims[k] * 10 + (bytes[i] - '0'), kHugeSide + 1);
         ++i;
       }
     }
@@ -56,14 +62,14 @@ std::optional<std::pair<std::int64_t, std::int64_t>> peek_image_size(const std::
 }
 
 void check_size(const std::string& path, std::int64_t w, std::int64_t h, const MapLoadOptions& options) {
-  if (w <= 0 || h <= 0) {
-    throw InputError(path + ": image has no pixels (" + std::to_string(w) + "x" + std::to_string(h) + ")");
+  if (w <= 0 || h <= 0) throw InputError(fmt::format("{}: image has no pixels ({}x{})", path, w, h));
+  if (w > kHugeSide || h > kHugeSide) {
+    throw InputError(fmt::format("{}: image declares a {} of more than {} pixels, over the size limit of {} cells", path,
+                                 w > kHugeSide ? "width" : "height", kHugeSide, options.max_cells));
   }
   if (w > options.max_cells / h) {  // w * h > max_cells, without overflow
-    const std::string cells = w <= INT64_MAX / h ? std::to_string(w * h) : std::string("too many");
-    throw InputError(path + ": image is " + std::to_string(w) + "x" + std::to_string(h) + " = " + cells +
-                     " cells, over the size limit of " +
-                     std::to_string(options.max_cells) + " cells");
+    throw InputError(fmt::format("{}: image is {}x{} = {} cells, over the size limit of {} cells", path, w, h, w * h,
+                                 options.max_cells));
   }
 }
 
@@ -130,7 +136,7 @@ cv::Mat decode_pnm(const std::string& bytes, const std::string& source, const Ma
     }
     return v;
   };
-  const std::int64_t w = number(true, std::int64_t{1} << 40, "width"), h = number(true, std::int64_t{1} << 40, "height");
+  const std::int64_t w = number(true, kHugeSide, "width"), h = number(true, kHugeSide, "height");
   check_size(source, w, h, options);
   const int maxval = bitmap ? 1 : int(number(true, 65535, "maxval"));
   if (maxval < 1) fail("maxval must be 1 to 65535");
@@ -214,16 +220,26 @@ MapYaml parse_map_yaml(std::string_view text, const std::string& source) {
   y.image = m.text("image", "");
   if (y.image.empty()) throw InputError(m.where("image") + ": expected a file name");
   if (!m.has("resolution")) throw InputError(source + ": missing key 'resolution' (metres per cell)");
-  y.resolution = m.number("resolution", 0.0);
-  if (!(y.resolution > 0.0)) {
-    throw InputError(m.where("resolution") + ": expected a positive number of metres per cell, got " +
-                     core::describe_node(*m.node("resolution")));
+  {
+    const auto n = *m.node("resolution");
+    const auto v = n.IsScalar() ? core::parse_in_range(n.Scalar(), kResolutionRange) : std::nullopt;
+    if (!v) {
+      throw InputError(m.where("resolution") + ": expected metres per cell, " + core::expected_text(kResolutionRange) +
+                       ", got " + core::describe_node(n));
+    }
+    y.resolution = *v;
   }
   if (const auto o = m.node("origin")) {
     if (!o->IsSequence() || o->size() != 3) {
       throw InputError(m.where("origin") + ": expected [x, y, yaw], got " + core::describe_node(*o));
     }
     const auto v = m.numbers("origin", 3);
+    for (const double c : v) {
+      if (!core::parse_in_range(fmt::format("{}", c), kOriginRange)) {
+        throw InputError(m.where("origin") + ": expected [x, y, yaw] with each " + core::expected_text(kOriginRange) +
+                         ", got " + fmt::format("{}", c));
+      }
+    }
     y.origin = core::Pose2(v[0], v[1], v[2]);
   }
   if (const auto n = m.node("negate")) {
@@ -235,8 +251,8 @@ MapYaml parse_map_yaml(std::string_view text, const std::string& source) {
   y.occupied_thresh = m.number("occupied_thresh", y.occupied_thresh, 0.0, 1.0);
   y.free_thresh = m.number("free_thresh", y.free_thresh, 0.0, 1.0);
   if (y.free_thresh > y.occupied_thresh) {
-    throw InputError(source + ": free_thresh (" + std::to_string(y.free_thresh) + ") is above occupied_thresh (" +
-                     std::to_string(y.occupied_thresh) + ")");
+    throw InputError(fmt::format("{}: free_thresh ({}) is above occupied_thresh ({})", source, y.free_thresh,
+                                 y.occupied_thresh));
   }
   const std::string mode = m.choice("mode", "trinary", {"trinary", "scale", "raw"});
   y.mode = mode == "trinary" ? MapMode::Trinary : (mode == "scale" ? MapMode::Scale : MapMode::Raw);
@@ -339,31 +355,58 @@ OccupancyGrid load_map(const fs::path& path, const MapLoadOptions& options) {
   if (ext == ".yaml" || ext == ".yml") {
     const MapYaml meta = parse_map_yaml(core::read_file(path, 1 << 20), path.string());
     const fs::path image_path = meta.image.is_absolute() ? meta.image : path.parent_path() / meta.image;
-    if (!fs::exists(image_path)) {
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(image_path, ec))) {
       throw InputError(path.string() + ": key 'image': file '" + image_path.string() + "' does not exist");
     }
     return grid_from_image(read_image(image_path, options), meta, options.grid);
   }
-  if (!(options.default_resolution > 0.0)) {
-    throw InputError(path.string() + ": resolution must be positive, got " + std::to_string(options.default_resolution));
+  if (!core::parse_in_range(fmt::format("{}", options.default_resolution), kResolutionRange)) {
+    throw InputError(fmt::format("{}: resolution: expected metres per cell, {}, got {}", path.string(),
+                                 core::expected_text(kResolutionRange), options.default_resolution));
   }
   MapYaml meta;
   meta.resolution = options.default_resolution;
   return grid_from_image(read_image(path, options), meta, options.grid);
 }
 
-void write_image(const fs::path& path, const cv::Mat& image) {
+std::vector<fs::path> map_files(const fs::path& path) {
+  const std::string ext = path.extension().string();
+  if (ext != ".yaml" && ext != ".yml") return {path};
+  try {
+    const MapYaml meta = parse_map_yaml(core::read_file(path, 1 << 20), path.string());
+    return {path, meta.image.is_absolute() ? meta.image : path.parent_path() / meta.image};
+  } catch (const Error&) {
+    return {path};
+  }
+}
+
+std::string encode_image(const std::string& ext, const cv::Mat& image, const std::string& what) {
+  if (ext.empty()) throw InputError(what + ": output image needs an extension (.png, .pgm)");
   std::vector<std::uint8_t> buffer;
-  std::string ext = path.extension().string();
-  if (ext.empty()) throw InputError(path.string() + ": output image needs an extension (.png, .pgm, ...)");
   bool ok = false;
   try {
-    ok = cv::imencode(ext, image, buffer);
+    ok = (ext == ".png" || ext == ".pgm") && cv::imencode(ext, image, buffer);
   } catch (const cv::Exception&) {
     ok = false;
   }
-  if (!ok) throw InputError(path.string() + ": cannot encode an image as '" + ext + "'");
-  core::write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(buffer.data()), buffer.size()));
+  if (!ok) {
+    throw InputError(what + ": cannot write " + (image.channels() == 1 ? "a map image" : "a picture") + " as '" + ext +
+                     "' (" + (image.channels() == 1 ? "use .png or .pgm" : "use .png") + ")");
+  }
+  return std::string(reinterpret_cast<const char*>(buffer.data()), buffer.size());
+}
+
+void check_picture_path(const fs::path& path, const std::string& what) {
+  if (core::is_standard_output(path)) return;
+  const std::string ext = path.extension().string();
+  if (ext != ".png") {
+    throw InputError(what + " " + path.string() + ": pictures are written as PNG; give a .png name (or - for the standard output)");
+  }
+}
+
+void write_image(const fs::path& path, const cv::Mat& image) {
+  core::write_file_atomic(path, encode_image(path.extension().string(), image, path.string()));
 }
 
 void save_map_image(const OccupancyGrid& grid, const fs::path& path) { write_image(path, grid_to_image(grid)); }

@@ -8,13 +8,20 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "core/range.h"
 #include "core/transform2.h"
 #include "mapping/occupancy_grid.h"
 
 namespace fleetmap::mapping {
 
 enum class MapMode { Trinary, Scale, Raw };
+
+// Metres per cell a map may have (map YAML files and --resolution alike), and how far its origin
+// may be from zero, in metres: anything beyond is a typing error, not a map.
+inline constexpr core::Range kResolutionRange{1e-4, 1000};
+inline constexpr core::Range kOriginRange{-1e7, 1e7};
 
 // The keys of a map_server YAML file, with map_server's defaults.
 struct MapYaml {
@@ -53,6 +60,17 @@ cv::Mat grid_to_image(const OccupancyGrid& grid);
 // Loads a map from a map_server YAML (.yaml / .yml) or an image (PNG, PGM, ...).
 // Throws InputError naming the file for anything missing, unreadable, empty or too large.
 OccupancyGrid load_map(const std::filesystem::path& path, const MapLoadOptions& options = {});
+
+// The files load_map(path) reads: a map_server YAML and the image it names, or the image alone.
+// For checks that no output replaces an input; a YAML that cannot be read gives just itself.
+std::vector<std::filesystem::path> map_files(const std::filesystem::path& path);
+
+// The bytes of `image` in the format an extension names (".png", ".pgm"). Throws InputError
+// naming `what` when fleetmap cannot write that format for this image.
+std::string encode_image(const std::string& extension, const cv::Mat& image, const std::string& what);
+// Throws InputError (before any work) unless pictures can be written to `path`: a .png name, or
+// the standard output ("-", which gets PNG).
+void check_picture_path(const std::filesystem::path& path, const std::string& what);
 
 // Encodes `image` (extension picks the format) and writes it atomically.
 void write_image(const std::filesystem::path& path, const cv::Mat& image);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -419,22 +420,37 @@ fs::path builtin_maps_dir() {
   return source;
 }
 
-mapping::OccupancyGrid load_map_source(const std::string& name_or_path, const mapping::MapLoadOptions& options) {
-  if (name_or_path.empty()) throw InputError("map: empty name (built-in maps: " + builtin_map_names() + ")");
+namespace {
+
+// Where load_map_source takes `name_or_path` from: a file, or a built-in map's YAML.
+std::optional<fs::path> map_file(const std::string& name_or_path) {
   std::error_code ec;
   // A file of that name wins; a folder named like a built-in map (e.g. the output folder of
   // `fleetmap explore --map maze`, out/maze) does not hide the built-in map.
   const bool builtin = is_builtin_map(name_or_path);
-  if (fs::exists(name_or_path, ec) && !(builtin && fs::is_directory(name_or_path, ec))) {
-    return mapping::load_map(name_or_path, options);
+  // A link that leads nowhere (or in a loop) is still the user's file: reading it says what is wrong.
+  if (fs::exists(fs::symlink_status(name_or_path, ec)) && !(builtin && fs::is_directory(name_or_path, ec))) {
+    return fs::path(name_or_path);
   }
-  if (builtin) {
-    const fs::path yaml = builtin_maps_dir() / (name_or_path + ".yaml");
-    if (!fs::exists(yaml)) {
-      throw InputError("map '" + name_or_path + "': built-in map file " + yaml.string() +
+  if (builtin) return builtin_maps_dir() / (name_or_path + ".yaml");
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::vector<fs::path> map_source_files(const std::string& name_or_path) {
+  const auto file = map_file(name_or_path);
+  return file ? mapping::map_files(*file) : std::vector<fs::path>{};
+}
+
+mapping::OccupancyGrid load_map_source(const std::string& name_or_path, const mapping::MapLoadOptions& options) {
+  if (name_or_path.empty()) throw InputError("map: empty name (built-in maps: " + builtin_map_names() + ")");
+  if (const auto file = map_file(name_or_path)) {
+    if (is_builtin_map(name_or_path) && *file != fs::path(name_or_path) && !fs::exists(*file)) {
+      throw InputError("map '" + name_or_path + "': built-in map file " + file->string() +
                        " is missing (set FLEETMAP_MAPS_DIR to the maps/ folder)");
     }
-    return mapping::load_map(yaml, options);
+    return mapping::load_map(*file, options);
   }
   const bool looks_like_path = name_or_path.find_first_of("/.") != std::string::npos;
   if (looks_like_path) throw InputError(name_or_path + ": no such file");

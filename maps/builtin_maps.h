@@ -43,5 +43,8 @@ std::filesystem::path builtin_maps_dir();
 // Throws InputError that names the input, listing the built-in names when it is neither.
 mapping::OccupancyGrid load_map_source(const std::string& name_or_path,
                                        const mapping::MapLoadOptions& options = {});
+// The files load_map_source reads for `name_or_path` (a built-in map's PNG and YAML too), so that
+// no output is ever written over them.
+std::vector<std::filesystem::path> map_source_files(const std::string& name_or_path);
 
 }  // namespace fleetmap::maps

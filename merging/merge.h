@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/random.h"
+#include "core/range.h"
 #include "core/transform2.h"
 #include "mapping/occupancy_grid.h"
 #include "merging/acceptance.h"
@@ -49,6 +50,9 @@ struct ConfidenceOptions {
   double distinct_rotation_deg = 2.0;
   double min_contradiction_rate = 0.005;
 };
+
+// The confidences a threshold may be (the scenario's merging.min_confidence, merge --min-confidence).
+inline constexpr core::Range kConfidenceRange{0, 1};
 
 struct MergeOptions {
   std::string method = "auto";   // a name of merge_method_names()

@@ -124,7 +124,9 @@ class OmplPlanner final : public Planner {
     static std::once_flag quiet;
     std::call_once(quiet, [] { ompl::msg::noOutputHandler(); });
     // OMPL draws every instance's seed from one process-wide generator; reseeding it here makes a
-    // call reproducible up to the timing of its budget (concurrent calls are not reproducible).
+    // call reproducible. Calls take turns, or one call's draws would change another's.
+    static std::mutex one_at_a_time;
+    const std::lock_guard<std::mutex> turn(one_at_a_time);
     ompl::RNG::setSeed(static_cast<std::uint_fast32_t>(options.seed % 0xFFFFFFFFull) + 1);
 
     const GridGeometry& g = space.geometry();
@@ -168,7 +170,14 @@ class OmplPlanner final : public Planner {
         options.simplify ? deadline - std::chrono::duration_cast<Clock::duration>(
                                           std::chrono::duration<double>(kSimplifyShare * options.time_budget_s))
                          : deadline;
-    ob::PlannerTerminationCondition until([solve_deadline] { return Clock::now() >= solve_deadline; });
+    // Time, and with an iteration budget also a count of the planner's checks (the same on every machine).
+    const auto budget = [&options](Clock::time_point end, long iterations) {
+      if (options.iteration_budget <= 0) return ob::PlannerTerminationCondition([end] { return Clock::now() >= end; });
+      return ob::PlannerTerminationCondition([end, iterations, checks = 0L]() mutable {
+        return ++checks > iterations || Clock::now() >= end;
+      });
+    };
+    ob::PlannerTerminationCondition until = budget(solve_deadline, options.iteration_budget);
     if (algorithm_ == OmplAlgorithm::PrmStar) {
       const ob::PlannerTerminationCondition poll(
           [&] {
@@ -196,7 +205,7 @@ class OmplPlanner final : public Planner {
     if (options.simplify) {
       og::PathGeometric simplified = path;
       og::PathSimplifier simplifier(si, problem->getGoal(), objective);
-      const ob::PlannerTerminationCondition simplify_until([deadline] { return Clock::now() >= deadline; });
+      const ob::PlannerTerminationCondition simplify_until = budget(deadline, std::max(1L, options.iteration_budget / 10));
       if (simplifier.simplify(simplified, simplify_until) && simplified.check()) path = simplified;
     }
     for (std::size_t i = 0; i < path.getStateCount(); ++i) s.path.push_back(to_world(g, path.getState(i)));

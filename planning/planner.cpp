@@ -70,8 +70,8 @@ std::ostream& operator<<(std::ostream& os, PlanStatus s) { return os << to_strin
 
 PlanResult Planner::plan(const FreeSpace& space, const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
                          const PlannerOptions& options) {
-  if (!(options.time_budget_s > 0.0) || !std::isfinite(options.time_budget_s)) {
-    throw InputError("planning time budget must be a positive number of seconds, got " +
+  if (!(options.time_budget_s >= kTimeBudgetRange.lo && options.time_budget_s <= kTimeBudgetRange.hi)) {
+    throw InputError("planning time budget: expected " + core::expected_text(kTimeBudgetRange) + " seconds, got " +
                      std::to_string(options.time_budget_s));
   }
   const Clock::time_point t0 = Clock::now();

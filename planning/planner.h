@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/range.h"
 #include "mapping/occupancy_grid.h"
 #include "planning/free_space.h"
 
@@ -65,12 +66,21 @@ struct ReactiveOptions {
   double max_travel_factor = 4.0;
 };
 
+// The time budgets a planner accepts, in seconds (the CLI flags and scenario keys use it too).
+inline constexpr core::Range kTimeBudgetRange{1e-3, 3600};
+
 struct PlannerOptions {
-  // Wall-clock budget of the whole call. Optimising planners (RRT*, PRM*, BIT*) use all of it;
-  // the others stop at their first path. 10% is kept for OMPL's path simplification.
+  // Wall-clock budget of the whole call, within kTimeBudgetRange. Optimising planners (RRT*,
+  // PRM*, BIT*) use all of it; the others stop at their first path. 10% is kept for OMPL's path
+  // simplification.
   double time_budget_s = 1.0;
-  // OMPL planners reseed OMPL's process-wide generator with it at each call: reproducible for one
-  // caller at a time (RRT-Connect exactly; the anytime planners up to how far their budget gets).
+  // When > 0, OMPL planners also stop after this many iterations (checks of their termination
+  // condition), and path simplification after a tenth as many: a budget that gives the same path
+  // on every machine however busy, as long as the time budget is not reached first.
+  long iteration_budget = 0;
+  // OMPL planners reseed OMPL's process-wide generator with it at each call, one call at a time:
+  // reproducible (RRT-Connect exactly; the anytime planners exactly with an iteration budget,
+  // otherwise up to how far their time budget gets).
   std::uint64_t seed = 1;
   // OMPL: shortcutting and smoothing of the solution; astar: any-angle smoothing of the grid path;
   // reactive: merging collinear steps.

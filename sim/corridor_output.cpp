@@ -147,6 +147,19 @@ nlohmann::json corridor_json(const CorridorResult& r) {
   return j;
 }
 
+std::vector<std::string> corridor_output_files(const CorridorOptions& o) {
+  std::vector<std::string> names = {"corridor_table.md", "corridor_table.csv", "corridor.json"};
+  for (const auto& method : o.methods) {
+    for (int laps : o.laps) names.push_back("corridor_" + method + "_" + std::to_string(laps) + "lap.png");
+  }
+  if (!o.detection_errors_deg.empty()) {
+    names.push_back("merge_detection.md");
+    names.push_back("merge_detection.csv");
+    for (double e : o.detection_errors_deg) names.push_back("merge_detection_" + error_name(e) + "deg.png");
+  }
+  return names;
+}
+
 std::vector<std::filesystem::path> write_corridor_outputs(const CorridorResult& r, const std::filesystem::path& dir) {
   core::ensure_directory(dir);
   std::vector<std::filesystem::path> written;

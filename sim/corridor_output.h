@@ -21,6 +21,8 @@ std::string detection_merge_csv(const CorridorResult& result);
 nlohmann::json corridor_json(const CorridorResult& result);
 
 // Writes every output into `dir` (created if missing); returns the paths written.
+// The names write_corridor_outputs gives its files for an experiment with these options.
+std::vector<std::string> corridor_output_files(const CorridorOptions& options);
 std::vector<std::filesystem::path> write_corridor_outputs(const CorridorResult& result, const std::filesystem::path& dir);
 
 }  // namespace fleetmap::sim

@@ -181,6 +181,14 @@ cv::Mat render_robot(const RunResult& r, int robot, const std::string& map_label
                              render_options(map_label + ": robot " + std::to_string(robot + 1) + "'s map"));
 }
 
+std::vector<std::string> run_output_files(const Scenario& scenario) {
+  std::vector<std::string> names = {"merged.png"};
+  const int robots = scenario.placement == Placement::List ? int(scenario.starts.size()) : scenario.robot_count;
+  for (int i = 1; i <= robots; ++i) names.push_back("robot_" + std::to_string(i) + ".png");
+  for (const char* n : {"metrics.json", "map.pgm", "map.yaml", "map.bt", "scenario.yaml"}) names.push_back(n);
+  return names;
+}
+
 std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& map_label, const fs::path& dir,
                                         const mapping::Overlays& extra) {
   core::ensure_directory(dir);
@@ -200,7 +208,7 @@ std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& m
   add(dir / "map.yaml");
   mapping::save_octomap(r.merged, dir / "map.bt");
   add(dir / "map.bt");
-  core::write_file_atomic(dir / "scenario.yaml", scenario_to_yaml(r.scenario));
+  core::write_file_atomic(dir / "scenario.yaml", scenario_to_yaml(r.scenario, dir));
   add(dir / "scenario.yaml");
   return written;
 }

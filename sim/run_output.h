@@ -24,8 +24,11 @@ cv::Mat render_merged(const RunResult& result, const std::string& map_label, con
 // Robot i's own map with its trajectory.
 cv::Mat render_robot(const RunResult& result, int robot, const std::string& map_label);
 
+// The names write_run_outputs gives its files for a run of `scenario`.
+std::vector<std::string> run_output_files(const Scenario& scenario);
+
 // Writes merged.png, robot_<k>.png (k from 1), metrics.json, map.pgm + map.yaml, map.bt and
-// scenario.yaml into `dir`. Returns the files written.
+// scenario.yaml (its map path relative to `dir`) into `dir`. Returns the files written.
 std::vector<std::filesystem::path> write_run_outputs(const RunResult& result, const std::string& map_label,
                                                      const std::filesystem::path& dir,
                                                      const mapping::Overlays& extra = {});

@@ -11,6 +11,7 @@
 #include "core/file_io.h"
 #include "core/yaml_reader.h"
 #include "exploration/strategy.h"
+#include "maps/builtin_maps.h"
 #include "merging/merge.h"
 #include "planning/planner.h"
 
@@ -62,25 +63,28 @@ std::string fmt(double v) {
 std::vector<std::string> merging_names() { return {"known", "rendezvous", "overlap"}; }
 
 std::vector<std::string> path_planner_names() {
+  // OMPL's PRM* grows its roadmap for fixed wall-clock times in two threads: runs would not repeat.
   std::vector<std::string> names = {"wave"};
-  for (const auto& n : planning::planner_names()) names.push_back(n);
+  for (const auto& n : planning::planner_names()) {
+    if (n != "prmstar") names.push_back(n);
+  }
   return names;
 }
 
 MotionNoise read_motion_noise(core::YamlMap noise, const MotionNoise& fallback) {
   MotionNoise n;
-  n.position_m = noise.number("position", fallback.position_m, 0.0, 100.0);
-  n.heading_rad = deg2rad(noise.number("heading_deg", rad2deg(fallback.heading_rad), 0.0, 360.0));
+  n.position_m = noise.number("position", fallback.position_m, limits::kNoiseMetres);
+  n.heading_rad = deg2rad(noise.number("heading_deg", rad2deg(fallback.heading_rad), limits::kAngleDeg));
   noise.finish();
   return n;
 }
 
 RobotDetectorOptions read_robot_detector(core::YamlMap det, const RobotDetectorOptions& fallback) {
   RobotDetectorOptions d = fallback;
-  d.max_range_m = det.number("max_range", fallback.max_range_m, 0.0, 1e6);
-  d.fov_rad = deg2rad(det.number("fov_deg", rad2deg(fallback.fov_rad), 0.0, 360.0));
-  d.range_noise_m = det.number("range_noise", fallback.range_noise_m, 0.0, 100.0);
-  d.bearing_noise_rad = deg2rad(det.number("bearing_noise_deg", rad2deg(fallback.bearing_noise_rad), 0.0, 360.0));
+  d.max_range_m = det.number("max_range", fallback.max_range_m, limits::kDetectorRange);
+  d.fov_rad = deg2rad(det.number("fov_deg", rad2deg(fallback.fov_rad), limits::kAngleDeg));
+  d.range_noise_m = det.number("range_noise", fallback.range_noise_m, limits::kNoiseMetres);
+  d.bearing_noise_rad = deg2rad(det.number("bearing_noise_deg", rad2deg(fallback.bearing_noise_rad), limits::kAngleDeg));
   det.finish();
   return d;
 }
@@ -93,13 +97,13 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
   s.base_dir = base_dir;
   s.map = top.text("map", s.map);
   if (s.map.empty()) throw InputError(top.where("map") + ": expected a map name or file");
-  s.seed = std::uint64_t(top.integer("seed", 1, 0));
-  s.steps = int(top.integer("steps", s.steps, 1, 10'000'000));
-  s.period_s = top.number("period", s.period_s, 1e-6, 3600.0);
+  s.seed = top.seed("seed", 1);
+  s.steps = int(top.number("steps", s.steps, limits::kSteps));
+  s.period_s = top.number("period", s.period_s, limits::kPeriod);
 
   // robots: a count (packed cluster), `random: N`, or `starts: [[x, y, heading_deg], ...]`.
   if (const auto r = top.node("robots"); r && r->IsScalar()) {
-    s.robot_count = int(top.integer("robots", 4, 1, 64));
+    s.robot_count = int(top.number("robots", 4, limits::kRobots));
   } else {
     auto robots = top.map("robots");
     const bool has_count = robots.has("count"), has_random = robots.has("random"), has_starts = robots.has("starts");
@@ -107,10 +111,10 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
       throw InputError(robots.where(has_starts ? "starts" : "random") +
                        ": give only one of 'count' (a cluster), 'random: N' or 'starts'");
     }
-    s.robot_count = int(robots.integer("count", s.robot_count, 1, 64));
+    s.robot_count = int(robots.number("count", s.robot_count, limits::kRobots));
     if (has_random) {
       s.placement = Placement::Random;
-      s.robot_count = int(robots.integer("random", 4, 1, 64));
+      s.robot_count = int(robots.number("random", 4, limits::kRobots));
     }
     for (const auto& row : number_rows(robots, "starts", 2, 3, "[x, y] or [x, y, heading_deg]")) {
       s.starts.emplace_back(row[0], row[1], row.size() > 2 ? deg2rad(row[2]) : 0.0);
@@ -122,10 +126,10 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
       s.robot_count = int(s.starts.size());
     }
     if (const auto at = robots.numbers("cluster_at", 2); !at.empty()) s.cluster_at = Eigen::Vector2d(at[0], at[1]);
-    s.min_separation_m = robots.number("min_separation", s.min_separation_m, 0.0, 1e6);
-    s.robot.radius_m = robots.number("radius", s.robot.radius_m, 1e-3, 100.0);
-    s.robot.max_speed_mps = robots.number("max_speed", s.robot.max_speed_mps, 0.0, 100.0);
-    s.robot.max_turn_rate_rps = deg2rad(robots.number("max_turn_rate_deg", rad2deg(s.robot.max_turn_rate_rps), 0.0, 36000.0));
+    s.min_separation_m = robots.number("min_separation", s.min_separation_m, limits::kSeparation);
+    s.robot.radius_m = robots.number("radius", s.robot.radius_m, limits::kRadius);
+    s.robot.max_speed_mps = robots.number("max_speed", s.robot.max_speed_mps, limits::kSpeed);
+    s.robot.max_turn_rate_rps = deg2rad(robots.number("max_turn_rate_deg", rad2deg(s.robot.max_turn_rate_rps), limits::kTurnRateDeg));
     robots.finish();
   }
 
@@ -133,17 +137,17 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
   {
     auto sensors = top.map("sensors");
     auto range = sensors.map("range");
-    s.range.beams = int(range.integer("beams", s.range.beams, 1, 100000));
+    s.range.beams = int(range.number("beams", s.range.beams, limits::kBeams));
     for (double a : range.numbers("angles_deg")) s.range.angles_rad.push_back(deg2rad(a));
     if (range.has("angles_deg") && s.range.angles_rad.empty()) throw InputError(range.where("angles_deg") + ": needs at least one angle");
-    s.range.max_range_m = range.number("max_range", s.range.max_range_m, 1e-3, 1e6);
-    s.range.noise_m = range.number("noise", s.range.noise_m, 0.0, 100.0);
+    s.range.max_range_m = range.number("max_range", s.range.max_range_m, limits::kSensorRange);
+    s.range.noise_m = range.number("noise", s.range.noise_m, limits::kNoiseMetres);
     range.finish();
     auto lm = sensors.map("landmarks");
-    s.landmark_sensor.max_range_m = lm.number("max_range", s.landmark_sensor.max_range_m, 0.0, 1e6);
-    s.landmark_sensor.range_noise_m = lm.number("range_noise", s.landmark_sensor.range_noise_m, 0.0, 100.0);
+    s.landmark_sensor.max_range_m = lm.number("max_range", s.landmark_sensor.max_range_m, limits::kDetectorRange);
+    s.landmark_sensor.range_noise_m = lm.number("range_noise", s.landmark_sensor.range_noise_m, limits::kNoiseMetres);
     s.landmark_sensor.bearing_noise_rad =
-        deg2rad(lm.number("bearing_noise_deg", rad2deg(s.landmark_sensor.bearing_noise_rad), 0.0, 360.0));
+        deg2rad(lm.number("bearing_noise_deg", rad2deg(s.landmark_sensor.bearing_noise_rad), limits::kAngleDeg));
     s.landmark_sensor.report_ids = lm.boolean("report_ids", s.landmark_sensor.report_ids);
     lm.finish();
     s.detector = read_robot_detector(sensors.map("robots"), s.detector);
@@ -152,7 +156,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
   {
     auto lm = top.map("landmarks");
     for (const auto& row : number_rows(lm, "points", 2, 2, "[x, y]")) s.landmarks.emplace_back(row[0], row[1]);
-    s.landmarks_along_walls = lm.number("along_walls", 0.0, 0.0, 100.0);
+    s.landmarks_along_walls = lm.number("along_walls", 0.0, limits::kLandmarksPerMetre);
     lm.finish();
   }
   if (const auto l = top.node("localization"); l && l->IsScalar()) {
@@ -162,12 +166,12 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     s.localization = loc.text("method", s.localization);
     auto& o = s.localization_options;
     o.known_associations = loc.boolean("known_associations", o.known_associations);
-    o.association_gate = loc.number("association_gate", o.association_gate, 0.0, 1e6);
+    o.association_gate = loc.number("association_gate", o.association_gate, limits::kGate);
     o.use_robot_detections = loc.boolean("robot_detections", o.use_robot_detections);
-    o.initial_xy = loc.number("initial_sigma_xy", o.initial_xy, 0.0, 1e3);
-    o.initial_theta = deg2rad(loc.number("initial_sigma_heading_deg", rad2deg(o.initial_theta), 0.0, 360.0));
-    o.mcl_particles = int(loc.integer("mcl_particles", o.mcl_particles, 1, 1000000));
-    o.rbpf_particles = int(loc.integer("rbpf_particles", o.rbpf_particles, 1, 10000));
+    o.initial_xy = loc.number("initial_sigma_xy", o.initial_xy, limits::kInitialSigma);
+    o.initial_theta = deg2rad(loc.number("initial_sigma_heading_deg", rad2deg(o.initial_theta), limits::kAngleDeg));
+    o.mcl_particles = int(loc.number("mcl_particles", o.mcl_particles, limits::kMclParticles));
+    o.rbpf_particles = int(loc.number("rbpf_particles", o.rbpf_particles, limits::kRbpfParticles));
     for (double r : loc.numbers("lost_robots")) {
       if (r != std::floor(r) || r < 1) {
         throw InputError(loc.where("lost_robots") + ": expected robot numbers from 1, got " + fmt(r));
@@ -178,7 +182,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
   }
   {
     auto comm = top.map("communication");
-    s.communication.range_m = comm.number("range", s.communication.range_m, 0.0, kInf, true);
+    s.communication.range_m = comm.number("range", s.communication.range_m, limits::kCommRange);
     s.communication.line_of_sight = comm.boolean("line_of_sight", s.communication.line_of_sight);
     comm.finish();
   }
@@ -186,17 +190,18 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     auto ex = top.map("exploration");
     auto& e = s.exploration;
     e.strategy = ex.choice("strategy", e.strategy, exploration::strategy_names());
-    e.strategy_options.beta = ex.number("beta", e.strategy_options.beta, 0.0, 1e6);
-    e.strategy_options.directional_weight = ex.number("directional_weight", e.strategy_options.directional_weight, 0.0, 1e6);
+    e.strategy_options.beta = ex.number("beta", e.strategy_options.beta, limits::kWeight);
+    e.strategy_options.directional_weight = ex.number("directional_weight", e.strategy_options.directional_weight, limits::kWeight);
     e.wave.eight_connected = ex.boolean("eight_connected", e.wave.eight_connected);
-    e.wave.occupancy_weight = ex.number("occupancy_weight", e.wave.occupancy_weight, 0.0, 1e6);
-    e.stall_steps = int(ex.integer("stall_steps", e.stall_steps, 1, 1'000'000));
-    e.targets.piece_radius_m = ex.number("piece_radius", e.targets.piece_radius_m, 1e-3, 1e6);
-    e.targets.frontiers.min_region_cells = int(ex.integer("min_frontier_cells", e.targets.frontiers.min_region_cells, 1, 1'000'000));
-    e.traversability.safety_margin_m = ex.number("safety_margin", e.traversability.safety_margin_m, 0.0, 100.0);
-    e.planning_resolution_m = ex.number("planning_resolution", e.planning_resolution_m, 0.0, 100.0);
+    e.wave.occupancy_weight = ex.number("occupancy_weight", e.wave.occupancy_weight, limits::kWeight);
+    e.stall_steps = int(ex.number("stall_steps", e.stall_steps, limits::kCount));
+    e.targets.piece_radius_m = ex.number("piece_radius", e.targets.piece_radius_m, limits::kLength);
+    e.targets.frontiers.min_region_cells = int(ex.number("min_frontier_cells", e.targets.frontiers.min_region_cells, limits::kCount));
+    e.traversability.safety_margin_m = ex.number("safety_margin", e.traversability.safety_margin_m, limits::kMargin);
+    e.planning_resolution_m = ex.number("planning_resolution", e.planning_resolution_m, limits::kMargin);
     s.path_planner = ex.choice("path_planner", s.path_planner, path_planner_names());
-    s.planner_time_s = ex.number("planner_time", s.planner_time_s, 1e-3, 3600.0);
+    s.planner_time_s = ex.number("planner_time", s.planner_time_s, limits::kPlannerTime);
+    s.planner_iterations = int(ex.number("planner_iterations", s.planner_iterations, limits::kPlannerIterations));
     ex.finish();
   }
   if (const auto m = top.node("merging"); m && m->IsScalar()) {
@@ -205,11 +210,11 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     auto merge = top.map("merging");
     s.merging = merge.choice("mode", s.merging, merging_names());
     s.merge_method = merge.choice("method", s.merge_method, merging::merge_method_names());
-    s.merge_min_confidence = merge.number("min_confidence", s.merge_min_confidence, 0.0, 1.0);
-    s.merge_attempt_every = int(merge.integer("attempt_every", s.merge_attempt_every, 1, 1'000'000));
+    s.merge_min_confidence = merge.number("min_confidence", s.merge_min_confidence, limits::kConfidence);
+    s.merge_attempt_every = int(merge.number("attempt_every", s.merge_attempt_every, limits::kCount));
     merge.finish();
   }
-  s.lookahead_m = top.number("lookahead", s.lookahead_m, 0.0, 1e6);
+  s.lookahead_m = top.number("lookahead", s.lookahead_m, limits::kLookahead);
   top.finish();
   validate_scenario(s);
   return s;
@@ -220,23 +225,53 @@ Scenario load_scenario(const std::filesystem::path& path) {
 }
 
 void validate_scenario(const Scenario& s) {
-  if (s.robot_count < 1) throw InputError("robots: need at least one robot, got " + std::to_string(s.robot_count));
-  if (s.robot_count > 64) throw InputError("robots: at most 64 robots, got " + std::to_string(s.robot_count));
-  if (s.steps < 1) throw InputError("steps: need at least one step, got " + std::to_string(s.steps));
-  const auto non_negative = [](double v, const char* key) {
-    if (!(v >= 0.0)) throw InputError(std::string(key) + ": must not be negative, got " + fmt(v));
+  // The same ranges as the parser's, for scenarios made in code or changed by flags.
+  const auto check = [](const char* key, double value, const core::Range& range) {
+    if (core::parse_in_range(fmt(value), range) || (range.allow_inf && value == kInf)) return;
+    throw InputError(std::string(key) + ": expected " + core::expected_text(range) + ", got " + fmt(value));
   };
-  non_negative(s.noise.position_m, "noise.position");
-  non_negative(s.noise.heading_rad, "noise.heading_deg");
-  non_negative(s.range.noise_m, "sensors.range.noise");
-  non_negative(s.communication.range_m, "communication.range");
-  non_negative(s.detector.max_range_m, "sensors.robots.max_range");
-  non_negative(s.landmark_sensor.max_range_m, "sensors.landmarks.max_range");
-  non_negative(s.landmark_sensor.range_noise_m, "sensors.landmarks.range_noise");
-  non_negative(s.detector.range_noise_m, "sensors.robots.range_noise");
-  if (!(s.range.max_range_m > 0.0)) throw InputError("sensors.range.max_range: must be positive, got " + fmt(s.range.max_range_m));
-  if (!(s.robot.radius_m > 0.0)) throw InputError("robots.radius: must be positive, got " + fmt(s.robot.radius_m));
-  if (!(s.period_s > 0.0)) throw InputError("period: must be positive, got " + fmt(s.period_s));
+  const int count = s.placement == Placement::List ? int(s.starts.size()) : s.robot_count;
+  check("robots", count, limits::kRobots);
+  check("steps", s.steps, limits::kSteps);
+  check("period", s.period_s, limits::kPeriod);
+  check("robots.min_separation", s.min_separation_m, limits::kSeparation);
+  check("robots.radius", s.robot.radius_m, limits::kRadius);
+  check("robots.max_speed", s.robot.max_speed_mps, limits::kSpeed);
+  check("robots.max_turn_rate_deg", rad2deg(s.robot.max_turn_rate_rps), limits::kTurnRateDeg);
+  check("noise.position", s.noise.position_m, limits::kNoiseMetres);
+  check("noise.heading_deg", rad2deg(s.noise.heading_rad), limits::kAngleDeg);
+  check("sensors.range.beams", s.range.beams, limits::kBeams);
+  check("sensors.range.max_range", s.range.max_range_m, limits::kSensorRange);
+  check("sensors.range.noise", s.range.noise_m, limits::kNoiseMetres);
+  check("sensors.landmarks.max_range", s.landmark_sensor.max_range_m, limits::kDetectorRange);
+  check("sensors.landmarks.range_noise", s.landmark_sensor.range_noise_m, limits::kNoiseMetres);
+  check("sensors.landmarks.bearing_noise_deg", rad2deg(s.landmark_sensor.bearing_noise_rad), limits::kAngleDeg);
+  check("sensors.robots.max_range", s.detector.max_range_m, limits::kDetectorRange);
+  check("sensors.robots.fov_deg", rad2deg(s.detector.fov_rad), limits::kAngleDeg);
+  check("sensors.robots.range_noise", s.detector.range_noise_m, limits::kNoiseMetres);
+  check("sensors.robots.bearing_noise_deg", rad2deg(s.detector.bearing_noise_rad), limits::kAngleDeg);
+  check("landmarks.along_walls", s.landmarks_along_walls, limits::kLandmarksPerMetre);
+  const auto& o = s.localization_options;
+  check("localization.association_gate", o.association_gate, limits::kGate);
+  check("localization.initial_sigma_xy", o.initial_xy, limits::kInitialSigma);
+  check("localization.initial_sigma_heading_deg", rad2deg(o.initial_theta), limits::kAngleDeg);
+  check("localization.mcl_particles", o.mcl_particles, limits::kMclParticles);
+  check("localization.rbpf_particles", o.rbpf_particles, limits::kRbpfParticles);
+  check("communication.range", s.communication.range_m, limits::kCommRange);
+  const auto& e = s.exploration;
+  check("exploration.beta", e.strategy_options.beta, limits::kWeight);
+  check("exploration.directional_weight", e.strategy_options.directional_weight, limits::kWeight);
+  check("exploration.occupancy_weight", e.wave.occupancy_weight, limits::kWeight);
+  check("exploration.stall_steps", e.stall_steps, limits::kCount);
+  check("exploration.piece_radius", e.targets.piece_radius_m, limits::kLength);
+  check("exploration.min_frontier_cells", e.targets.frontiers.min_region_cells, limits::kCount);
+  check("exploration.safety_margin", e.traversability.safety_margin_m, limits::kMargin);
+  check("exploration.planning_resolution", e.planning_resolution_m, limits::kMargin);
+  check("exploration.planner_time", s.planner_time_s, limits::kPlannerTime);
+  check("exploration.planner_iterations", s.planner_iterations, limits::kPlannerIterations);
+  check("merging.min_confidence", s.merge_min_confidence, limits::kConfidence);
+  check("merging.attempt_every", s.merge_attempt_every, limits::kCount);
+  check("lookahead", s.lookahead_m, limits::kLookahead);
   const auto check_name = [](const std::string& key, const std::string& value, const std::vector<std::string>& valid) {
     if (std::find(valid.begin(), valid.end(), value) != valid.end()) return;
     std::string names;
@@ -247,19 +282,41 @@ void validate_scenario(const Scenario& s) {
   check_name("localization", s.localization, localization::localizer_names());
   for (int r : s.lost_robots) {
     if (s.localization != "mcl") throw InputError("localization.lost_robots: only 'mcl' can start without its pose, not '" + s.localization + "'");
-    const int count = s.placement == Placement::List ? int(s.starts.size()) : s.robot_count;
     if (r < 1 || r > count) throw InputError("localization.lost_robots: robot " + std::to_string(r) + " does not exist (robots 1.." + std::to_string(count) + ")");
+  }
+  // Landmark localizers without landmarks would quietly be dead reckoning.
+  if ((s.localization == "ekf" || s.localization == "ekf-slam") && s.landmarks.empty() && s.landmarks_along_walls <= 0.0) {
+    throw InputError("localization '" + s.localization +
+                     "' localizes against landmarks, and there are none: add some (--landmarks 0.5 places one per "
+                     "2 m of wall; in a scenario, landmarks: {along_walls: 0.5} or landmarks: {points: [[x, y]]}), "
+                     "or choose a localizer that needs none (odometry, scan-matching, rbpf, mcl, polynomial)");
   }
   check_name("merging", s.merging, merging_names());
   check_name("merging.method", s.merge_method, merging::merge_method_names());
   check_name("exploration.path_planner", s.path_planner, path_planner_names());
-  if (!(s.planner_time_s > 0.0)) throw InputError("exploration.planner_time: must be positive, got " + fmt(s.planner_time_s));
 }
 
-std::string scenario_to_yaml(const Scenario& s) {
+std::string map_source(const Scenario& s) {
+  namespace fs = std::filesystem;
+  const fs::path p = s.map;
+  const fs::path in_folder = p.is_relative() && !s.base_dir.empty() ? s.base_dir / p : p;
+  std::error_code ec;
+  if (maps::is_builtin_map(s.map) && !fs::is_regular_file(in_folder, ec)) return s.map;
+  return in_folder.string();
+}
+
+std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& file_dir) {
+  namespace fs = std::filesystem;
+  std::string map = map_source(s);
+  if (!maps::is_builtin_map(map) && !file_dir.empty()) {
+    std::error_code ec;
+    const fs::path absolute = fs::absolute(map, ec).lexically_normal();
+    const fs::path relative = ec ? fs::path() : absolute.lexically_relative(fs::absolute(file_dir, ec).lexically_normal());
+    map = (!ec && !relative.empty() ? relative : absolute).string();
+  }
   std::ostringstream y;
   y << "# fleetmap scenario\n";
-  y << "map: " << core::yaml_quoted(s.map) << "\n";
+  y << "map: " << core::yaml_quoted(map) << "\n";
   y << "seed: " << s.seed << "\nsteps: " << s.steps << "\nperiod: " << fmt(s.period_s) << "\n";
   y << "robots:\n";
   switch (s.placement) {
@@ -309,7 +366,8 @@ std::string scenario_to_yaml(const Scenario& s) {
     << "\n  eight_connected: " << (e.wave.eight_connected ? "true" : "false") << "\n  occupancy_weight: " << fmt(e.wave.occupancy_weight)
     << "\n  stall_steps: " << e.stall_steps << "\n  piece_radius: " << fmt(e.targets.piece_radius_m)
     << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m)
-    << "\n  planning_resolution: " << fmt(e.planning_resolution_m) << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s) << "\n";
+    << "\n  planning_resolution: " << fmt(e.planning_resolution_m) << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s)
+    << "\n  planner_iterations: " << s.planner_iterations << "\n";
   y << "merging:\n  mode: " << s.merging << "\n  method: " << s.merge_method << "\n  min_confidence: "
     << fmt(s.merge_min_confidence) << "\n  attempt_every: " << s.merge_attempt_every << "\n";
   y << "lookahead: " << fmt(s.lookahead_m) << "\n";

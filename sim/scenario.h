@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 #include "core/yaml_reader.h"
 #include "exploration/team_explorer.h"
 #include "localization/localizer.h"
+#include "merging/merge.h"
+#include "planning/planner.h"
 #include "sim/communication.h"
 #include "sim/motion.h"
 #include "sim/sensors.h"
@@ -19,6 +22,40 @@
 namespace fleetmap::sim {
 
 enum class Placement { Cluster, Random, List };
+
+// The values every number of a scenario accepts. The scenario parser, validate_scenario and the
+// command-line flags all use these, so a flag accepts exactly what a scenario file accepts and a
+// saved scenario.yaml always loads again.
+namespace limits {
+using core::Range;
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+inline constexpr Range kSteps{1, 10'000'000, true};
+inline constexpr Range kPeriod{1e-6, 3600};
+inline constexpr Range kRobots{1, 64, true};
+inline constexpr Range kSeparation{0, 1e6};
+inline constexpr Range kRadius{1e-3, 100};
+inline constexpr Range kSpeed{0, 100};
+inline constexpr Range kTurnRateDeg{0, 36000};
+inline constexpr Range kNoiseMetres{0, 100};
+inline constexpr Range kAngleDeg{0, 360};
+inline constexpr Range kBeams{1, 100'000, true};
+inline constexpr Range kSensorRange{1e-3, 1e6};
+inline constexpr Range kDetectorRange{0, 1e6};
+inline constexpr Range kLandmarksPerMetre{0, 100};
+inline constexpr Range kGate{0, 1e6};
+inline constexpr Range kInitialSigma{0, 1e3};
+inline constexpr Range kMclParticles{1, 1'000'000, true};
+inline constexpr Range kRbpfParticles{1, 10'000, true};
+inline constexpr Range kCommRange{0, kInf, false, true};
+inline constexpr Range kWeight{0, 1e6};
+inline constexpr Range kCount{1, 1'000'000, true};
+inline constexpr Range kLength{1e-3, 1e6};
+inline constexpr Range kMargin{0, 100};
+inline constexpr Range kPlannerTime = planning::kTimeBudgetRange;
+inline constexpr Range kPlannerIterations{1, 100'000'000, true};
+inline constexpr Range kConfidence = merging::kConfidenceRange;
+inline constexpr Range kLookahead{0, 1e6};
+}  // namespace limits
 
 struct Scenario {
   std::string map = "office";       // built-in name, or a PNG/PGM/YAML path
@@ -58,9 +95,12 @@ struct Scenario {
   int merge_attempt_every = 20;              // overlap: steps between attempts of the same pair
   double lookahead_m = 0.5;                  // path following
   // How robots get a path to their target: "wave" (the wave's steepest descent) or a planner of
-  // planning/ by name (astar, rrtconnect, rrtstar, ...), given `planner_time_s` per path.
+  // planning/ by name (astar, rrtconnect, rrtstar, ...). A sampling planner stops after
+  // `planner_iterations` iterations, so that a run is the same on every machine; `planner_time_s`
+  // only caps a path's wall time (a run whose planner hits it may not repeat exactly).
   std::string path_planner = "wave";
-  double planner_time_s = 0.1;
+  double planner_time_s = 10.0;
+  int planner_iterations = 2000;
 };
 
 std::vector<std::string> merging_names();
@@ -78,8 +118,14 @@ RobotDetectorOptions read_robot_detector(core::YamlMap detector, const RobotDete
 
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 Scenario load_scenario(const std::filesystem::path& path);
-// Every setting, explicitly, in the layout parse_scenario reads.
-std::string scenario_to_yaml(const Scenario& scenario);
+// The map to load: a built-in name as is (unless a file of that name is in the scenario's folder),
+// else the file path, relative paths taken from the scenario's folder (base_dir), or from the
+// working directory when the scenario came from flags.
+std::string map_source(const Scenario& scenario);
+// Every setting, explicitly, in the layout parse_scenario reads, for a file in `file_dir`: a map
+// file is written relative to that folder (or absolute when it has no relative path), so the
+// file finds its map from wherever it is run.
+std::string scenario_to_yaml(const Scenario& scenario, const std::filesystem::path& file_dir = {});
 
 // Checks values that need no map (counts, ranges, noise, names). Throws InputError naming the key.
 void validate_scenario(const Scenario& scenario);

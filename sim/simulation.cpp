@@ -229,6 +229,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
     plan.space.robot_radius_m = scenario_.exploration.traversability.robot_radius_m +
                                 scenario_.exploration.traversability.safety_margin_m;
     plan.search.time_budget_s = scenario_.planner_time_s;
+    plan.search.iteration_budget = scenario_.planner_iterations;
     plan.search.seed = scenario_.seed;
     explorer_.set_path_provider([plan](const mapping::OccupancyGrid& map, const Eigen::Vector2d& from,
                                        const Eigen::Vector2d& to) {

@@ -279,6 +279,13 @@ cv::Mat render_slam_robot(const SlamSetup& setup, const SlamRunResult& run, int 
   return mapping::render_map(room, o, options);
 }
 
+std::vector<std::string> slam_output_files(const SlamScenario& s) {
+  std::vector<std::string> names = {"table1.md", "table1.csv", "runs.csv", "rendezvous.csv"};
+  for (const auto& r : s.robots) names.push_back("map_" + r.name + ".png");
+  if (!s.single_robot.empty()) names.push_back("map_" + s.single_robot + "_alone.png");
+  return names;
+}
+
 std::vector<std::filesystem::path> write_slam_outputs(const SlamSetup& setup, const SlamCampaign& c,
                                                       const std::filesystem::path& dir, bool paper_columns) {
   core::ensure_directory(dir);

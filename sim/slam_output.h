@@ -45,6 +45,8 @@ cv::Mat render_slam_robot(const SlamSetup& setup, const SlamRunResult& run, int 
 
 // Writes table1.md, table1.csv, runs.csv, rendezvous.csv, map_<name>.png for each robot of the
 // first team run and map_<name>_alone.png for the first single-robot run. Returns the files.
+// The names write_slam_outputs gives its files for this scenario.
+std::vector<std::string> slam_output_files(const SlamScenario& scenario);
 std::vector<std::filesystem::path> write_slam_outputs(const SlamSetup& setup, const SlamCampaign& campaign,
                                                       const std::filesystem::path& dir, bool paper_columns);
 

@@ -1,6 +1,7 @@
 #include "sim/slam_scenario.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 
 #include "core/angle.h"
@@ -73,8 +74,8 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
   core::YamlMap top(root, source);
   SlamScenario s;
   s.method = top.choice("method", s.method, slam_method_names());
-  s.seed = std::uint64_t(top.integer("seed", 1, 0));
-  s.runs = int(top.integer("runs", s.runs, 1, 1'000'000));
+  s.seed = top.seed("seed", 1);
+  s.runs = int(top.number("runs", s.runs, kSlamRunsRange));
   s.steps = int(top.integer("steps", s.steps, 1, 1'000'000));
   s.period_s = top.number("period", s.period_s, 1e-6, 3600.0);
   {
@@ -109,6 +110,18 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
       core::YamlMap r((*team)[i], source, "robots.team[" + std::to_string(i) + "]");
       SlamRobot robot;
       robot.name = r.text("name", std::string("r").append(std::to_string(i + 1)));
+      // Names become file names (map_<name>.png) and table columns.
+      const bool plain = !robot.name.empty() && robot.name.size() <= 32 &&
+                         std::all_of(robot.name.begin(), robot.name.end(), [](char c) {
+                           return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+                         });
+      if (!plain) {
+        throw InputError(r.where("name") + ": expected a name of up to 32 letters, digits, _ or -, got " +
+                         core::describe_node(*r.node("name")));
+      }
+      for (const auto& other : s.robots) {
+        if (other.name == robot.name) throw InputError(r.where("name") + ": two robots are named '" + robot.name + "'");
+      }
       if (!r.has("start")) throw InputError(robots.where("team") + ": robot " + std::to_string(i + 1) + " needs 'start: [x, y, heading_deg]'");
       const auto start = r.numbers("start", 3);
       robot.start = core::Pose2(start[0], start[1], core::normalize_angle(deg2rad(start[2])));

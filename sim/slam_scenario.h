@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "core/range.h"
 #include "core/transform2.h"
 #include "localization/polynomial_slam.h"
 #include "mapping/polynomial_map.h"
@@ -36,6 +37,9 @@ struct SlamRobot {
   std::vector<Eigen::Vector2d> path;   // waypoints after the start
   double speed_mps = 0.1;              // forward speed along the path
 };
+
+// Runs of a SLAM experiment (`fleetmap slam --runs`, the SLAM scenario's `runs`).
+inline constexpr core::Range kSlamRunsRange{1, 1'000'000, true};
 
 struct SlamScenario {
   std::string method = "polynomial";

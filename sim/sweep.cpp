@@ -140,15 +140,8 @@ std::vector<int> parse_team_sizes(const std::string& text, const std::string& wh
 }
 
 double parse_comm_range(const std::string& text, const std::string& what) {
-  const std::string t = trim(text);
-  if (t == "inf" || t == ".inf" || t == "infinite" || t == "unlimited") return std::numeric_limits<double>::infinity();
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(t, &used);
-    if (used == t.size() && v >= 0.0 && std::isfinite(v)) return v;
-  } catch (const std::exception&) {
-  }
-  throw InputError(what + ": expected metres >= 0 or 'inf', got '" + text + "'");
+  if (const auto v = core::parse_in_range(trim(text), limits::kCommRange)) return *v;
+  throw InputError(what + ": expected " + core::expected_text(limits::kCommRange) + ", got '" + text + "'");
 }
 
 Sweep parse_sweep(const std::string& text, const std::string& source, const fs::path& base_dir) {
@@ -168,21 +161,22 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
   if (const auto maps = list_text(top, "maps")) {
     sweep.maps = parse_map_list(*maps, top.where("maps"));
     for (auto& m : sweep.maps) {
-      if (looks_like_file(m) && fs::path(m).is_relative() && fs::exists(base_dir / m)) m = (base_dir / m).string();
+      // A file is relative to the sweep file; a built-in name stays a name unless such a file is there.
+      if (fs::path(m).is_relative() && (looks_like_file(m) || fs::is_regular_file(base_dir / m))) m = (base_dir / m).string();
     }
   }
   if (const auto s = list_text(top, "strategies")) sweep.strategies = parse_strategy_list(*s, top.where("strategies"));
   if (const auto r = list_text(top, "robots")) sweep.robots = parse_team_sizes(*r, top.where("robots"));
-  sweep.seeds = int(top.integer("seeds", sweep.seeds, 1, 1'000'000));
-  sweep.first_seed = std::uint64_t(top.integer("first_seed", (long long)sweep.first_seed, 0));
-  sweep.base.steps = int(top.integer("steps", sweep.base.steps, 1, 10'000'000));
+  sweep.seeds = int(top.number("seeds", sweep.seeds, kSeedCountRange));
+  sweep.first_seed = top.seed("first_seed", sweep.first_seed);
+  sweep.base.steps = int(top.number("steps", sweep.base.steps, limits::kSteps));
   sweep.base.localization = top.text("localization", sweep.base.localization);
   sweep.base.merging = top.choice("merging", sweep.base.merging, merging_names());
   if (const auto c = top.node("comm_range")) {
     if (!c->IsScalar()) throw InputError(top.where("comm_range") + ": expected metres >= 0 or 'inf'");
     sweep.base.communication.range_m = parse_comm_range(c->Scalar(), top.where("comm_range"));
   }
-  sweep.base.range.max_range_m = top.number("sensor_range", sweep.base.range.max_range_m, 1e-3, 1e6);
+  sweep.base.range.max_range_m = top.number("sensor_range", sweep.base.range.max_range_m, limits::kSensorRange);
   top.finish();
   try {
     validate_sweep(sweep);
@@ -204,15 +198,9 @@ void apply_overrides(Sweep& sweep, const SweepOverrides& f) {
   if (f.maps) sweep.maps = parse_map_list(*f.maps, "--maps");
   if (f.strategies) sweep.strategies = parse_strategy_list(*f.strategies, "--strategies");
   if (f.robots) sweep.robots = parse_team_sizes(*f.robots, "--robots");
-  if (f.seeds) {
-    if (*f.seeds < 1) throw InputError("--seeds: expected at least 1 seed, got " + std::to_string(*f.seeds));
-    sweep.seeds = *f.seeds;
-  }
+  if (f.seeds) sweep.seeds = *f.seeds;
   if (f.first_seed) sweep.first_seed = *f.first_seed;
-  if (f.steps) {
-    if (*f.steps < 1) throw InputError("--steps: expected at least 1, got " + std::to_string(*f.steps));
-    sweep.base.steps = *f.steps;
-  }
+  if (f.steps) sweep.base.steps = *f.steps;
   if (f.localization) sweep.base.localization = *f.localization;
   if (f.merging) {
     const auto names = merging_names();
@@ -222,17 +210,16 @@ void apply_overrides(Sweep& sweep, const SweepOverrides& f) {
     sweep.base.merging = *f.merging;
   }
   if (f.comm_range) sweep.base.communication.range_m = parse_comm_range(*f.comm_range, "--comm-range");
-  if (f.sensor_range) {
-    if (!(*f.sensor_range > 0.0)) throw InputError("--sensor-range: expected metres > 0");
-    sweep.base.range.max_range_m = *f.sensor_range;
-  }
+  if (f.sensor_range) sweep.base.range.max_range_m = *f.sensor_range;
 }
 
 void validate_sweep(const Sweep& sweep) {
   if (sweep.maps.empty()) throw InputError("maps: the sweep needs at least one map");
   if (sweep.strategies.empty()) throw InputError("strategies: the sweep needs at least one strategy");
   if (sweep.robots.empty()) throw InputError("robots: the sweep needs at least one team size");
-  if (sweep.seeds < 1) throw InputError("seeds: expected at least 1 seed, got " + std::to_string(sweep.seeds));
+  if (!core::parse_in_range(std::to_string(sweep.seeds), kSeedCountRange)) {
+    throw InputError("seeds: expected " + core::expected_text(kSeedCountRange) + ", got " + std::to_string(sweep.seeds));
+  }
   check_unique(sweep.maps, "maps");
   check_unique(sweep.strategies, "strategies");
   check_unique(sweep.robots, "robots");

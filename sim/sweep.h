@@ -8,10 +8,15 @@
 #include <string>
 #include <vector>
 
+#include "core/range.h"
 #include "exploration/strategy.h"
 #include "sim/scenario.h"
 
 namespace fleetmap::sim {
+
+// Seeds per combination, and parallel runs, that a sweep accepts (the file and the flags alike).
+inline constexpr core::Range kSeedCountRange{1, 1'000'000, true};
+inline constexpr core::Range kJobsRange{1, 1024, true};
 
 struct Sweep {
   // Built-in map names or map files (PNG/PGM/map_server YAML); a run's `map` is the label.
@@ -51,15 +56,17 @@ std::vector<int> parse_team_sizes(const std::string& text, const std::string& wh
 double parse_comm_range(const std::string& text, const std::string& what);
 
 // Parses a sweep file. Keys: maps, strategies, robots, seeds, first_seed, scenario (a scenario file,
-// relative to the sweep file), steps, localization, merging, comm_range, sensor_range. Relative map files are
-// resolved against `base_dir` when they exist there.
+// relative to the sweep file), steps, localization, merging, comm_range, sensor_range. Relative map
+// files are relative to `base_dir` (the sweep file's folder).
 Sweep parse_sweep(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 Sweep load_sweep(const std::filesystem::path& path);
 // Applies flags over `sweep` (relative paths in flags are relative to the working directory).
+// Numbers are checked by the flags' own validators (the same ranges as the file's).
 void apply_overrides(Sweep& sweep, const SweepOverrides& flags);
 // Non-empty lists without repeats, distinct map labels, seeds >= 1, and a valid base scenario.
 void validate_sweep(const Sweep& sweep);
-// The sweep file that defines `sweep` with its base scenario in `scenario_file` (scenario_to_yaml).
+// The sweep file that defines `sweep` with its base scenario in `scenario_file` (scenario_to_yaml);
+// map files are written with absolute paths. Two sweeps are the same sweep when these texts are.
 std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file);
 
 struct SweepRun {

@@ -285,9 +285,9 @@ TEST(BenchCommand, BadInputGetsOneLine) {
   EXPECT_ONE_LINE_ERROR(b.bench(small + " --localization psychic --out x"), "psychic");
   // results.csv of another sweep, or of something else.
   ASSERT_EQ(b.bench(small + " --out done").exit_code, 0);
-  EXPECT_ONE_LINE_ERROR(b.bench(small + " --sensor-range 3 --out done"), "other settings");
+  EXPECT_ONE_LINE_ERROR(b.bench(small + " --sensor-range 3 --out done"), "holds the results of another sweep");
   b.dir.write("foreign/results.csv", "name,score\nx,1\n");
-  EXPECT_ONE_LINE_ERROR(b.bench(small + " --out foreign"), "not a results table");
+  EXPECT_ONE_LINE_ERROR(b.bench(small + " --out foreign"), "holds a file that no earlier 'fleetmap bench' run wrote ('results.csv')");
   EXPECT_ONE_LINE_ERROR(b.bench("--combine done foreign --out c"), "not a results table");
   EXPECT_ONE_LINE_ERROR(b.bench("--compare coordinated market done"), "no runs of strategy 'coordinated'");
   // A sweep file with a mistake.

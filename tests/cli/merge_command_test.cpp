@@ -139,7 +139,7 @@ TEST(MergeCommand, BadInputGetsOneLineNamingItAndExitCode2) {
   EXPECT_ONE_LINE_ERROR(r, "magic");
   EXPECT_EQ(r.exit_code, 2);
   r = run_fleetmap("merge a.png b.png --out a.png", dir);
-  EXPECT_ONE_LINE_ERROR(r, "would overwrite the input map");
+  EXPECT_ONE_LINE_ERROR(r, "--out a.png: is the input a.png; fleetmap never overwrites an input");
   EXPECT_EQ(r.exit_code, 2);
   dir.write("coarse.yaml", "image: b.png\nresolution: 0.1\n");
   r = run_fleetmap("merge a.png coarse.yaml", dir);

@@ -116,7 +116,7 @@ TEST(PlanCommand, BadInputGetsOneLineAndExitCodeTwo) {
   expect_bad(map + "--from 0.5,0.5 --to 1,1 --unknown maybe", "--unknown");
   expect_bad("plan --map nosuchmap --from 0.5,0.5 --to 1,1", "unknown map 'nosuchmap'");
   expect_bad("plan --from 0.5,0.5 --to 1,1", "--map");
-  expect_bad(map + "--from 0.5,0.5 --to 1,1 --out " + room, "would overwrite the input map");
+  expect_bad(map + "--from 0.5,0.5 --to 1,1 --out " + room, "fleetmap never overwrites an input");
   // Unknown space blocks by default and is free by option.
   cv::Mat img(20, 20, CV_8UC1, cv::Scalar(205));
   img(cv::Rect(2, 2, 10, 10)).setTo(254);

@@ -235,7 +235,7 @@ TEST(MapIoBadInput, YamlProblemsNameTheKey) {
   expect_input_error([&] { load_map(yaml("noimage.yaml", "resolution: 0.05\n")); }, {"noimage.yaml", "missing key 'image'"});
   expect_input_error([&] { load_map(yaml("nores.yaml", "image: m.png\n")); }, {"nores.yaml", "missing key 'resolution'"});
   expect_input_error([&] { load_map(yaml("zero.yaml", "image: m.png\nresolution: 0\n")); },
-                     {"zero.yaml:2", "'resolution'", "positive"});
+                     {"zero.yaml:2", "'resolution'", "a number >= 0.0001 and <= 1000"});
   expect_input_error([&] { load_map(yaml("neg.yaml", "image: m.png\nresolution: -0.1\n")); },
                      {"neg.yaml:2", "'resolution'", "-0.1"});
   expect_input_error([&] { load_map(yaml("text.yaml", "image: m.png\nresolution: fine\n")); },

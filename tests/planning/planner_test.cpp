@@ -211,7 +211,7 @@ TEST(PlannerRegistry, MisuseThrowsInputError) {
   PlannerOptions options;
   options.time_budget_s = 0.0;
   fleetmap::testing::expect_input_error([&] { make_planner("astar")->plan(space, {0.5, 0.5}, {1.5, 1.5}, options); },
-                                        {"time budget", "positive"});
+                                        {"time budget", "a number >= 0.001 and <= 3600"});
 }
 
 TEST(PlanPath, PlansOnAGridInOneCall) {

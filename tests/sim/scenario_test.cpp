@@ -66,7 +66,7 @@ merging: known
   EXPECT_FALSE(s.exploration.wave.eight_connected);
   EXPECT_EQ(parse("robots: {random: 6, min_separation: 1.5}\n").placement, Placement::Random);
   EXPECT_EQ(parse("robots: 9\n").robot_count, 9);
-  EXPECT_EQ(parse("localization: ekf\n").localization, "ekf");
+  EXPECT_EQ(parse("localization: ekf\nlandmarks: {along_walls: 0.5}\n").localization, "ekf");
 }
 
 TEST(Scenario, RoundTripsThroughYaml) {
