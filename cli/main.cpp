@@ -1,5 +1,6 @@
 // fleetmap: the command-line program. Thin: parses flags, calls the libraries, reports.
 #include <CLI/CLI.hpp>
+#include <opencv2/core.hpp>
 #include <opencv2/core/utils/logger.hpp>
 
 #include <fmt/format.h>
@@ -20,6 +21,9 @@ namespace {
 // Exit codes: 0 success, 1 a failure while running, 2 bad input or usage.
 constexpr int kExitFailure = 1;
 constexpr int kExitBadInput = 2;
+constexpr const char* kOutOfMemory =
+    "out of memory: the map, the team or the run is too large for this machine (see --max-cells and README.md, "
+    "\"Outputs, reproducibility, size\")";
 
 std::string command_path(const CLI::App* app) {
   std::string path;
@@ -110,8 +114,14 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "fleetmap: {}\n", fm::core::printable(e.what()));
     return kExitBadInput;
   } catch (const std::bad_alloc&) {
-    fmt::print(stderr, "fleetmap: out of memory: the map, the team or the run is too large for this machine "
-                       "(see --max-cells and README.md, \"Outputs, reproducibility, size\")\n");
+    fmt::print(stderr, "fleetmap: {}\n", kOutOfMemory);
+    return kExitFailure;
+  } catch (const cv::Exception& e) {
+    if (e.code == cv::Error::StsNoMem) {
+      fmt::print(stderr, "fleetmap: {}\n", kOutOfMemory);
+    } else {
+      fmt::print(stderr, "fleetmap: error: {}\n", fm::core::printable(e.err));
+    }
     return kExitFailure;
   } catch (const std::filesystem::filesystem_error& e) {
     const std::string path = e.path1().empty() ? std::string() : e.path1().string() + ": ";

@@ -120,8 +120,11 @@ bool is_standard_output(const fs::path& path) { return path == "-" || path == "/
 
 bool same_file(const fs::path& a, const fs::path& b) {
   std::error_code ec;
-  const bool same = fs::equivalent(a, b, ec);
-  return !ec && same;
+  if (fs::equivalent(a, b, ec) && !ec) return true;
+  // "missing/../x" names x once the missing folder is made: compare where the paths lead.
+  std::error_code ea, eb;
+  const fs::path ca = fs::weakly_canonical(fs::absolute(a, ea), ea), cb = fs::weakly_canonical(fs::absolute(b, eb), eb);
+  return !ea && !eb && ca == cb && fs::exists(cb, eb);
 }
 
 namespace {

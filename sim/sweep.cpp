@@ -220,6 +220,10 @@ void validate_sweep(const Sweep& sweep) {
   if (!core::parse_in_range(std::to_string(sweep.seeds), kSeedCountRange)) {
     throw InputError("seeds: expected " + core::expected_text(kSeedCountRange) + ", got " + std::to_string(sweep.seeds));
   }
+  if (sweep.first_seed > std::numeric_limits<std::uint64_t>::max() - std::uint64_t(sweep.seeds - 1)) {
+    throw InputError("first_seed: " + std::to_string(sweep.first_seed) + " with " + std::to_string(sweep.seeds) +
+                     " seeds runs past the largest seed, 18446744073709551615");
+  }
   check_unique(sweep.maps, "maps");
   check_unique(sweep.strategies, "strategies");
   check_unique(sweep.robots, "robots");
@@ -253,7 +257,7 @@ std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file) 
   for (int n : sweep.robots) robots.push_back(std::to_string(n));
   y += "robots: [" + join(robots) + "]\n";
   y += "seeds: " + std::to_string(sweep.seeds) + "\nfirst_seed: " + std::to_string(sweep.first_seed) + "\n";
-  y += "scenario: " + core::yaml_quoted(scenario_file) + "\n";
+  if (!scenario_file.empty()) y += "scenario: " + core::yaml_quoted(scenario_file) + "\n";
   y += "steps: " + std::to_string(sweep.base.steps) + "\n";
   y += "localization: " + sweep.base.localization + "\n";
   y += "merging: " + sweep.base.merging + "\n";

@@ -65,7 +65,8 @@ Sweep load_sweep(const std::filesystem::path& path);
 void apply_overrides(Sweep& sweep, const SweepOverrides& flags);
 // Non-empty lists without repeats, distinct map labels, seeds >= 1, and a valid base scenario.
 void validate_sweep(const Sweep& sweep);
-// The sweep file that defines `sweep` with its base scenario in `scenario_file` (scenario_to_yaml);
+// The sweep file that defines `sweep` with its base scenario in `scenario_file` (scenario_to_yaml;
+// "" for none: then only the base settings a sweep file has keys for are kept);
 // map files are written with absolute paths. Two sweeps are the same sweep when these texts are.
 std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file);
 

@@ -321,5 +321,39 @@ TEST(BenchCommand, ReadySweepFilesRun) {
   for (const auto& row : t.rows) EXPECT_EQ(row.at("robots"), "9");
 }
 
+
+TEST(BenchCommand, AResultsFolderIsResumedOnlyByTheVerySameSweep) {
+  BenchDir b;
+  const std::string sweep = " --strategies uncoordinated --robots 1 --steps 20";
+  // Two maps with the same file stem in different folders are different maps.
+  std::filesystem::create_directories(b / "x");
+  std::filesystem::create_directories(b / "y");
+  std::filesystem::copy_file(b / "hall.png", b / "x" / "r.png");
+  std::filesystem::copy_file(b / "room.png", b / "y" / "r.png");
+  ASSERT_EQ(b.bench("--maps x/r.png --seeds 2" + sweep + " --out out").exit_code, 0);
+  const std::string results = slurp(b / "out" / "results.csv");
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps y/r.png --seeds 2" + sweep + " --out out"),
+                        "--out out: holds the results of another sweep (sweep.yaml there has 'maps: [");
+  // Fewer seeds over a finished sweep: refused, not summarised with the old rows.
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps x/r.png --seeds 1" + sweep + " --out out"),
+                        "(sweep.yaml there has 'seeds: 2', this sweep 'seeds: 1')");
+  EXPECT_EQ(slurp(b / "out" / "results.csv"), results);
+  // The same sweep resumes (nothing left to run).
+  const auto same = b.bench("--maps x/r.png --seeds 2" + sweep + " --out out");
+  ASSERT_EQ(same.exit_code, 0) << same.err;
+  EXPECT_NE(same.out.find("ran 0 runs"), std::string::npos) << same.out;
+  // A row from outside the sweep in results.csv is refused, not counted.
+  auto lines = lines_of(results);
+  std::string foreign = lines[1];
+  foreign.replace(foreign.find(",1,1,"), 5, ",1,9,");  // seed 9 is not in the sweep
+  b.dir.write("out/results.csv", results + foreign + "\n");
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps x/r.png --seeds 2" + sweep + " --out out"),
+                        "holds a run that is not part of this sweep (r, uncoordinated, 1 robots, seed 9)");
+  // A shard's folder is resumed by that shard only.
+  ASSERT_EQ(b.bench("--maps x/r.png --seeds 2" + sweep + " --shard 1/2 --out s1").exit_code, 0);
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps x/r.png --seeds 2" + sweep + " --shard 2/2 --out s1"),
+                        "holds a run that is not part of this sweep (shard)");
+}
+
 }  // namespace
 }  // namespace fleetmap::cli

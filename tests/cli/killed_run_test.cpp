@@ -92,6 +92,20 @@ TEST(KilledRun, LeavesNoTruncatedFile) {
     if (!WIFSIGNALED(status)) break;  // the run finished before the kill: later kills would too
   }
   EXPECT_GT(killed, 0) << "no run was killed while writing";
+  // Whatever a killed run left, the next run takes the folder: it ends well and leaves exactly its
+  // own files (listed in outputs.txt), no temporaries.
+  const pid_t pid = spawn_fleetmap({"explore", "--map", "campus", "--robots", "2", "--steps", "3", "--out", out.string(),
+                                    "--quiet"});
+  ASSERT_GT(pid, 0);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "a run into a killed run's folder failed";
+  const std::string listed = slurp(out / "outputs.txt");
+  for (const auto& entry : fs::directory_iterator(out)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_FALSE(is_temporary(name)) << name;
+    if (name != "outputs.txt") EXPECT_NE(listed.find("\n" + name + "\n"), std::string::npos) << name << " not listed";
+  }
 }
 
 }  // namespace
