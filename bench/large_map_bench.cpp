@@ -16,7 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "maps/builtin_maps.h"
-#include "mapping/map_io.h"
+#include "io/map_io.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"
 
@@ -32,10 +32,10 @@ double peak_rss_mb() {
 mapping::OccupancyGrid scaled(const std::string& name, int factor) {
   const mapping::OccupancyGrid small = maps::load_map_source(name);
   cv::Mat image;
-  cv::resize(mapping::grid_to_image(small), image, {}, factor, factor, cv::INTER_NEAREST);
-  mapping::MapYaml meta;
+  cv::resize(io::grid_to_image(small), image, {}, factor, factor, cv::INTER_NEAREST);
+  io::MapYaml meta;
   meta.resolution = small.resolution() / factor;
-  return mapping::grid_from_image(image, meta);
+  return io::grid_from_image(image, meta);
 }
 
 void run(benchmark::State& state, const mapping::OccupancyGrid& truth, int beams) {

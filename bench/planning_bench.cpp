@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "core/random.h"
 #include "maps/builtin_maps.h"
 #include "planning/grid_astar.h"
@@ -208,6 +208,6 @@ int main(int argc, char** argv) {
   benchmark::Shutdown();
   const std::string tables = fp::markdown(maps, planners, budgets);
   std::fputs(tables.c_str(), stdout);
-  if (!markdown_path.empty()) fleetmap::core::write_file_atomic(markdown_path, tables);
+  if (!markdown_path.empty()) fleetmap::io::write_file_atomic(markdown_path, tables);
   return 0;
 }

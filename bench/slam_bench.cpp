@@ -6,10 +6,10 @@
 
 #include <string>
 
-#include "sim/slam_experiment.h"
-#include "sim/slam_scenario.h"
+#include "experiments/slam_experiment.h"
+#include "experiments/slam_scenario.h"
 
-namespace fleetmap::sim {
+namespace fleetmap::experiments {
 namespace {
 
 const SlamSetup& dalfonso() {
@@ -43,6 +43,6 @@ void BM_PolynomialSlamRun(benchmark::State& state) {
 BENCHMARK(BM_PolynomialSlamRun)->ArgName("exchange")->Arg(1)->Arg(0)->Unit(benchmark::kMillisecond)->Iterations(5);
 
 }  // namespace
-}  // namespace fleetmap::sim
+}  // namespace fleetmap::experiments
 
 BENCHMARK_MAIN();

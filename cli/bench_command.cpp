@@ -16,15 +16,15 @@
 #include "cli/progress.h"
 #include "cli/validators.h"
 #include "core/error.h"
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "exploration/strategy.h"
 #include "localization/localizer.h"
 #include "maps/builtin_maps.h"
 #include "sim/scenario.h"
-#include "sim/sweep.h"
-#include "sim/sweep_report.h"
-#include "sim/sweep_results.h"
-#include "sim/sweep_runner.h"
+#include "sweep/sweep.h"
+#include "sweep/sweep_report.h"
+#include "sweep/sweep_results.h"
+#include "sweep/sweep_runner.h"
 
 namespace fleetmap::cli {
 
@@ -34,7 +34,7 @@ namespace {
 
 struct BenchFlags {
   std::string sweep_file;
-  sim::SweepOverrides sweep;
+  sweep::SweepOverrides sweep;
   int jobs = std::max(1u, std::thread::hardware_concurrency());
   std::string shard;
   std::string out;
@@ -69,20 +69,20 @@ fs::path results_of(const std::string& dir, const std::string& flag) {
 }
 
 // The sweep a results folder was made by (its sweep.yaml), if it has one that still loads.
-std::optional<sim::Sweep> sweep_of(const fs::path& dir) {
+std::optional<sweep::Sweep> sweep_of(const fs::path& dir) {
   if (!fs::is_regular_file(dir / "sweep.yaml")) return std::nullopt;
-  return sim::load_sweep(dir / "sweep.yaml");
+  return sweep::load_sweep(dir / "sweep.yaml");
 }
 
 // The two files that define a sweep in its results folder.
-std::pair<std::string, std::string> sweep_files(const fs::path& out, const sim::Sweep& sweep) {
-  return {sim::sweep_to_yaml(sweep, "scenario.yaml"), sim::scenario_to_yaml(sweep.base, out)};
+std::pair<std::string, std::string> sweep_files(const fs::path& out, const sweep::Sweep& sweep) {
+  return {sweep::sweep_to_yaml(sweep, "scenario.yaml"), sim::scenario_to_yaml(sweep.base, out)};
 }
 
-void write_sweep_files(const fs::path& out, const sim::Sweep& sweep) {
+void write_sweep_files(const fs::path& out, const sweep::Sweep& sweep) {
   const auto [sweep_yaml, scenario_yaml] = sweep_files(out, sweep);
-  core::write_file_atomic(out / "scenario.yaml", scenario_yaml);
-  core::write_file_atomic(out / "sweep.yaml", sweep_yaml);
+  io::write_file_atomic(out / "scenario.yaml", scenario_yaml);
+  io::write_file_atomic(out / "sweep.yaml", sweep_yaml);
 }
 
 // The first line where two texts differ, for messages: "seeds: 6" against "seeds: 4".
@@ -100,27 +100,27 @@ std::pair<std::string, std::string> first_difference(const std::string& a, const
 
 // A results folder is resumed only by the very same sweep (and shard): its sweep.yaml and
 // scenario.yaml must be what this sweep writes, and every row must be a run of this sweep.
-void check_same_sweep(const fs::path& out, const sim::Sweep& sweep, const std::vector<sim::SweepRun>& runs,
-                      const std::vector<sim::RunRecord>& records) {
+void check_same_sweep(const fs::path& out, const sweep::Sweep& sweep, const std::vector<sweep::SweepRun>& runs,
+                      const std::vector<sweep::RunRecord>& records) {
   const std::string where = "--out " + out.string() + ": ";
   const auto [sweep_yaml, scenario_yaml] = sweep_files(out, sweep);
   for (const auto& [name, now] : {std::pair{std::string("sweep.yaml"), sweep_yaml}, std::pair{std::string("scenario.yaml"), scenario_yaml}}) {
     if (!fs::is_regular_file(out / name)) {
       throw InputError(where + "holds results.csv but no " + name + ", so its sweep is unknown; choose another --out");
     }
-    const std::string before = core::read_file(out / name, std::size_t{1} << 20);
+    const std::string before = io::read_file(out / name, std::size_t{1} << 20);
     if (before != now) {
       const auto [was, is] = first_difference(before, now);
-      throw InputError(where + "holds the results of another sweep (" + name + " there has '" + core::printable(was) +
-                       "', this sweep '" + core::printable(is) +
+      throw InputError(where + "holds the results of another sweep (" + name + " there has '" + io::printable(was) +
+                       "', this sweep '" + io::printable(is) +
                        "'); resume only with the same sweep, or choose another --out");
     }
   }
-  std::set<sim::RunKey> ours;
+  std::set<sweep::RunKey> ours;
   for (const auto& r : runs) ours.insert({r.map, r.strategy, r.robots, r.seed});
   for (const auto& r : records) {
     if (ours.count(r.key)) continue;
-    throw InputError(where + "holds a run that is not part of this sweep" + std::string(runs.size() < sim::sweep_runs(sweep).size() ? " (shard)" : "") +
+    throw InputError(where + "holds a run that is not part of this sweep" + std::string(runs.size() < sweep::sweep_runs(sweep).size() ? " (shard)" : "") +
                      " (" + r.key.map + ", " + r.key.strategy + ", " + std::to_string(r.key.robots) + " robots, seed " +
                      std::to_string(r.key.seed) + "); resume only with the same sweep and shard, or choose another --out");
   }
@@ -148,29 +148,29 @@ void print_outputs(const fs::path& out, const std::vector<fs::path>& reports) {
 int run_compare(const BenchFlags& f) {
   if (any_sweep_flag(f) || !f.combine.empty()) throw InputError("--compare A B DIR takes no sweep flags and no --combine");
   const fs::path path = results_of(f.compare[2], "--compare");
-  const auto table = sim::read_results(path);
-  const auto comparison = sim::compare_strategies(table.records, f.compare[0], f.compare[1], f.metric);
-  std::printf("%s", sim::comparison_text(comparison).c_str());
+  const auto table = sweep::read_results(path);
+  const auto comparison = sweep::compare_strategies(table.records, f.compare[0], f.compare[1], f.metric);
+  std::printf("%s", sweep::comparison_text(comparison).c_str());
   return 0;
 }
 
 int run_combine(const BenchFlags& f) {
   if (any_sweep_flag(f)) throw InputError("--combine DIR... takes only folders and --out (no sweep flags)");
   if (f.out.empty()) throw InputError("--combine needs --out DIR: the folder for the combined results");
-  std::vector<sim::RunRecord> records;
-  std::map<sim::RunKey, std::pair<std::size_t, fs::path>> seen;
+  std::vector<sweep::RunRecord> records;
+  std::map<sweep::RunKey, std::pair<std::size_t, fs::path>> seen;
   std::string settings;
   fs::path settings_from;
-  std::optional<sim::Sweep> sweep;
+  std::optional<sweep::Sweep> sweep;
   for (const auto& dir : f.combine) {
     const fs::path path = results_of(dir, "--combine");
-    auto table = sim::read_results(path);
+    auto table = sweep::read_results(path);
     if (settings.empty() && !table.records.empty()) settings = table.records.front().settings, settings_from = path;
-    sim::check_settings(table.records, settings, path);
+    sweep::check_settings(table.records, settings, path);
     if (!sweep) sweep = sweep_of(dir);
     for (auto& r : table.records) {
       if (const auto it = seen.find(r.key); it != seen.end()) {
-        if (sim::record_without_wall_time(records[it->second.first]) != sim::record_without_wall_time(r)) {
+        if (sweep::record_without_wall_time(records[it->second.first]) != sweep::record_without_wall_time(r)) {
           throw InputError("--combine: the run " + r.key.map + "/" + r.key.strategy + "/" + std::to_string(r.key.robots) +
                            " robots/seed " + std::to_string(r.key.seed) + " differs between " + it->second.second.string() +
                            " and " + path.string());
@@ -188,24 +188,24 @@ int run_combine(const BenchFlags& f) {
   for (const auto& r : records) {
     if (std::find(labels.begin(), labels.end(), r.key.map) == labels.end()) labels.push_back(r.key.map);
   }
-  core::OutputFolder folder(out, "bench", bench_files(labels), inputs, "--out " + out.string());
+  io::OutputFolder folder(out, "bench", bench_files(labels), inputs, "--out " + out.string());
   folder.claim();
   std::vector<fs::path> written;
   std::size_t expected = 0;
   if (sweep) {
-    const auto runs = sim::sweep_runs(*sweep);
+    const auto runs = sweep::sweep_runs(*sweep);
     expected = runs.size();
-    sim::sort_records(records, runs);
+    sweep::sort_records(records, runs);
     write_sweep_files(out, *sweep);
     written = {out / "sweep.yaml", out / "scenario.yaml"};
   } else {
-    sim::sort_records(records, {});
+    sweep::sort_records(records, {});
   }
-  sim::write_results(out / "results.csv", records);
+  sweep::write_results(out / "results.csv", records);
   written.push_back(out / "results.csv");
-  const auto reports = sim::write_sweep_reports(out, records);
+  const auto reports = sweep::write_sweep_reports(out, records);
   written.insert(written.end(), reports.begin(), reports.end());
-  folder.finish(core::OutputFolder::names(written));
+  folder.finish(io::OutputFolder::names(written));
   std::printf("combined %zu runs from %zu folders into %s\n", records.size(), f.combine.size(), out.c_str());
   if (expected > records.size()) {
     std::printf("note: %zu of the sweep's %zu runs are missing (shards not finished or not given)\n",
@@ -219,11 +219,11 @@ int run_bench(const BenchFlags& f) {
   if (f.compare.size() == 3) return run_compare(f);
   if (!f.combine.empty()) return run_combine(f);
 
-  sim::Sweep sweep;
-  if (!f.sweep_file.empty()) sweep = sim::load_sweep(f.sweep_file);
-  sim::apply_overrides(sweep, f.sweep);
-  sim::validate_sweep(sweep);
-  const std::optional<sim::Shard> shard = f.shard.empty() ? std::nullopt : std::optional(sim::parse_shard(f.shard));
+  sweep::Sweep sweep;
+  if (!f.sweep_file.empty()) sweep = sweep::load_sweep(f.sweep_file);
+  sweep::apply_overrides(sweep, f.sweep);
+  sweep::validate_sweep(sweep);
+  const std::optional<sweep::Shard> shard = f.shard.empty() ? std::nullopt : std::optional(sweep::parse_shard(f.shard));
 
   // Every output is checked before the maps are read or a run starts.
   const fs::path out = f.out.empty() ? fs::path("out/bench") : fs::path(f.out);
@@ -232,34 +232,34 @@ int run_bench(const BenchFlags& f) {
   if (f.sweep.scenario) inputs.push_back(*f.sweep.scenario);
   std::vector<std::string> labels;
   for (const auto& source : sweep.maps) {
-    labels.push_back(sim::map_label(source));
+    labels.push_back(sweep::map_label(source));
     for (auto& file : maps::map_source_files(source)) inputs.push_back(std::move(file));
   }
-  core::OutputFolder folder(out, "bench", bench_files(labels), inputs, "--out " + out.string());
+  io::OutputFolder folder(out, "bench", bench_files(labels), inputs, "--out " + out.string());
 
-  sim::SweepMaps maps;
+  sweep::SweepMaps maps;
   for (const auto& source : sweep.maps) {
     try {
-      maps.emplace(sim::map_label(source), maps::load_map_source(source));
+      maps.emplace(sweep::map_label(source), maps::load_map_source(source));
     } catch (const InputError& e) {
       throw InputError(std::string(f.sweep.maps || f.sweep_file.empty() ? "--maps" : f.sweep_file + ": maps") + ": " + e.what());
     }
   }
-  sim::check_placements(sweep, maps);
+  sweep::check_placements(sweep, maps);
 
-  const auto all_runs = sim::sweep_runs(sweep);
-  const auto runs = shard ? sim::shard_runs(all_runs, *shard) : all_runs;
+  const auto all_runs = sweep::sweep_runs(sweep);
+  const auto runs = shard ? sweep::shard_runs(all_runs, *shard) : all_runs;
   const fs::path results = out / "results.csv";
-  const std::string settings = sim::settings_id(sweep.base);
+  const std::string settings = sweep::settings_id(sweep.base);
 
-  std::set<sim::RunKey> done;
+  std::set<sweep::RunKey> done;
   if (fs::exists(results)) {
-    const auto table = sim::read_results(results);
+    const auto table = sweep::read_results(results);
     check_same_sweep(out, sweep, runs, table.records);
-    sim::check_settings(table.records, settings, results);
+    sweep::check_settings(table.records, settings, results);
     for (const auto& r : table.records) done.insert(r.key);
   }
-  std::vector<sim::SweepRun> todo;
+  std::vector<sweep::SweepRun> todo;
   for (const auto& r : runs) {
     if (!done.count({r.map, r.strategy, r.robots, r.seed})) todo.push_back(r);
   }
@@ -268,11 +268,11 @@ int run_bench(const BenchFlags& f) {
 
   const auto t0 = std::chrono::steady_clock::now();
   {
-    sim::ResultsAppender appender(results);
+    sweep::ResultsAppender appender(results);
     ProgressBar bar(!f.quiet);
     long finished = 0;
     bar.update(0, long(todo.size()));
-    sim::run_sweep(sweep, todo, maps, {f.jobs}, [&](const sim::RunRecord& r) {
+    sweep::run_sweep(sweep, todo, maps, {f.jobs}, [&](const sweep::RunRecord& r) {
       appender.append(r);
       bar.update(++finished, long(todo.size()),
                  r.key.map + " " + r.key.strategy + " " + std::to_string(r.key.robots) + "r seed " + std::to_string(r.key.seed));
@@ -282,13 +282,13 @@ int run_bench(const BenchFlags& f) {
   const double elapsed = seconds_since(t0);
 
   // The final tables: every row of results.csv, in the sweep's order.
-  auto records = sim::read_results(results).records;
-  sim::sort_records(records, all_runs);
-  sim::write_results(results, records);
-  const auto reports = sim::write_sweep_reports(out, records);
+  auto records = sweep::read_results(results).records;
+  sweep::sort_records(records, all_runs);
+  sweep::write_results(results, records);
+  const auto reports = sweep::write_sweep_reports(out, records);
   std::vector<fs::path> written = {out / "sweep.yaml", out / "scenario.yaml", results};
   written.insert(written.end(), reports.begin(), reports.end());
-  folder.finish(core::OutputFolder::names(written));
+  folder.finish(io::OutputFolder::names(written));
 
   if (f.quiet) {
     std::printf("%s\n", results.c_str());
@@ -332,7 +332,7 @@ Command add_bench_command(CLI::App& root) {
                   "Comma-separated built-in maps or map files [default: empty,unstructured,office,corridor]");
   app->add_option("--strategies", s.strategies, "Comma-separated strategies, or all [default: all]");
   app->add_option("--robots", s.robots, "Team sizes, e.g. 1,2,4,9 or 1-9 [default: 1,2,4,9]");
-  app->add_option("--seeds", s.seeds, "Seeds per combination [default: 20]")->check(in_range(sim::kSeedCountRange));
+  app->add_option("--seeds", s.seeds, "Seeds per combination [default: 20]")->check(in_range(sweep::kSeedCountRange));
   app->add_option("--first-seed", s.first_seed, "The first seed; runs use first-seed, first-seed + 1, ... [default: 1]")
       ->check(seed_number());
   app->add_option("--scenario", s.scenario,
@@ -351,7 +351,7 @@ Command add_bench_command(CLI::App& root) {
   app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]")
       ->check(in_range(sim::limits::kSensorRange));
   app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")
-      ->check(in_range(sim::kJobsRange));
+      ->check(in_range(sweep::kJobsRange));
   app->add_option("--shard", f->shard, "Run only the K-th of N slices of the sweep, K/N (for clusters; see bench/slurm/)");
   app->add_option("--out", f->out,
                   "Output folder: new, empty, or of an earlier run of the very same sweep, which is resumed "

@@ -14,7 +14,7 @@
 #include "core/error.h"
 #include "exploration/strategy.h"
 #include "localization/localizer.h"
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "maps/builtin_maps.h"
 #include "planning/planner.h"
 #include "sim/run_output.h"
@@ -129,9 +129,9 @@ int run_explore(const ExploreFlags& f) {
   std::vector<std::string> files = sim::run_output_files(s);
   if (plan_from) files.push_back("path.json");
   if (f.animate) files.push_back("run.mp4");
-  core::OutputFolder folder(out, "explore", files, inputs, "--out " + out.string());
+  io::OutputFolder folder(out, "explore", files, inputs, "--out " + out.string());
 
-  mapping::MapLoadOptions load;
+  io::MapLoadOptions load;
   load.max_cells = f.max_cells;
   auto truth = maps::load_map_source(s.map, load);
   bool any_free = false;
@@ -159,7 +159,7 @@ int run_explore(const ExploreFlags& f) {
 
   // The plan on the merged map, drawn on merged.png and written to path.json.
   std::optional<planning::PlanResult> plan;
-  mapping::Overlays extra;
+  viz::Overlays extra;
   if (plan_from) {
     planning::PlanPathOptions o;
     o.planner = f.planner;
@@ -176,7 +176,7 @@ int run_explore(const ExploreFlags& f) {
   }
   auto written = sim::write_run_outputs(result, label, out, extra);
   if (plan) {
-    core::write_file_atomic(out / "path.json",
+    io::write_file_atomic(out / "path.json",
                             plan_json(*plan, {label, *plan_from, *plan_to, s.robot.radius_m, "obstacle", f.plan_time, s.seed})
                                     .dump(2) +
                                 "\n");
@@ -186,7 +186,7 @@ int run_explore(const ExploreFlags& f) {
     video->finish();
     written.push_back(out / "run.mp4");
   }
-  folder.finish(core::OutputFolder::names(written));
+  folder.finish(io::OutputFolder::names(written));
   // A plan that failed: the run's outputs are written; the plan's problem gets one line.
   const auto plan_exit = [&]() {
     if (!plan || plan->success()) return 0;

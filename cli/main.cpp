@@ -14,7 +14,7 @@
 
 #include "cli/command.h"
 #include "core/error.h"
-#include "core/file_io.h"
+#include "io/file_io.h"
 
 namespace {
 
@@ -98,10 +98,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const UnknownCommand& e) {
-    fmt::print(stderr, "{}: {}\n", e.where, fm::core::printable(e.what()));
+    fmt::print(stderr, "{}: {}\n", e.where, fm::io::printable(e.what()));
     return kExitBadInput;
   } catch (const CLI::ParseError& e) {
-    fmt::print(stderr, "{}: {} (see --help)\n", command_path(deepest_parsed(&app)), fm::core::printable(e.what()));
+    fmt::print(stderr, "{}: {} (see --help)\n", command_path(deepest_parsed(&app)), fm::io::printable(e.what()));
     return kExitBadInput;
   }
 
@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
       if (c.app->parsed()) return c.run();
     }
   } catch (const fm::InputError& e) {
-    fmt::print(stderr, "fleetmap: {}\n", fm::core::printable(e.what()));
+    fmt::print(stderr, "fleetmap: {}\n", fm::io::printable(e.what()));
     return kExitBadInput;
   } catch (const std::bad_alloc&) {
     fmt::print(stderr, "fleetmap: {}\n", kOutOfMemory);
@@ -120,15 +120,15 @@ int main(int argc, char** argv) {
     if (e.code == cv::Error::StsNoMem) {
       fmt::print(stderr, "fleetmap: {}\n", kOutOfMemory);
     } else {
-      fmt::print(stderr, "fleetmap: error: {}\n", fm::core::printable(e.err));
+      fmt::print(stderr, "fleetmap: error: {}\n", fm::io::printable(e.err));
     }
     return kExitFailure;
   } catch (const std::filesystem::filesystem_error& e) {
     const std::string path = e.path1().empty() ? std::string() : e.path1().string() + ": ";
-    fmt::print(stderr, "fleetmap: {}{}\n", fm::core::printable(path), e.code().message());
+    fmt::print(stderr, "fleetmap: {}{}\n", fm::io::printable(path), e.code().message());
     return kExitFailure;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "fleetmap: error: {}\n", fm::core::printable(e.what()));
+    fmt::print(stderr, "fleetmap: error: {}\n", fm::io::printable(e.what()));
     return kExitFailure;
   }
   return kExitFailure;

@@ -9,10 +9,10 @@
 #include "cli/outputs.h"
 #include "cli/validators.h"
 #include "core/error.h"
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "maps/builtin_maps.h"
-#include "mapping/map_io.h"
-#include "mapping/render.h"
+#include "io/map_io.h"
+#include "viz/render.h"
 
 namespace fleetmap::cli {
 
@@ -45,21 +45,21 @@ int run_list() {
 
 int run_show(const ShowOptions& o) {
   const fs::path out = o.out.empty() ? fs::path(fs::path(o.map).stem().string() + "_map.png") : fs::path(o.out);
-  mapping::check_picture_path(out, "--out");
+  io::check_picture_path(out, "--out");
   const std::vector<OutputFile> outputs = {{"--out", out}};
   check_outputs(outputs, maps::map_source_files(o.map));
-  mapping::MapLoadOptions load;
+  io::MapLoadOptions load;
   load.default_resolution = o.resolution;
   load.max_cells = o.max_cells;
   const auto grid = maps::load_map_source(o.map, load);
-  mapping::RenderOptions render;
+  viz::RenderOptions render;
   render.title = o.title.empty() ? fs::path(o.map).stem().string() : o.title;
-  write_picture(out, mapping::render_map(grid, {}, render));
+  write_picture(out, viz::render_map(grid, {}, render));
   const double free_m2 = double(grid.count(mapping::CellState::Free)) * grid.resolution() * grid.resolution();
   std::FILE* report = report_stream(outputs);
   fmt::print(report, "{}: {}x{} cells, {} m/cell, {:.1f} x {:.1f} m, free {:.1f} m^2\n", o.map, grid.width(),
              grid.height(), grid.resolution(), grid.geometry().width_m(), grid.geometry().height_m(), free_m2);
-  if (!core::is_standard_output(out)) fmt::print(report, "wrote {}\n", out.string());
+  if (!io::is_standard_output(out)) fmt::print(report, "wrote {}\n", out.string());
   return 0;
 }
 
@@ -76,7 +76,7 @@ Command add_maps_command(CLI::App& root) {
   show->add_option("--title", o->title, "Title in the legend panel (default: the map name)");
   show->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
       ->capture_default_str()
-      ->check(in_range(mapping::kResolutionRange));
+      ->check(in_range(io::kResolutionRange));
   show->add_option("--max-cells", o->max_cells, "Refuse maps with more cells than this")
       ->capture_default_str()
       ->check(in_range(kMaxCellsRange));

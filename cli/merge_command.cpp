@@ -16,10 +16,10 @@
 #include "cli/validators.h"
 #include "core/angle.h"
 #include "core/error.h"
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "maps/builtin_maps.h"
-#include "mapping/map_io.h"
-#include "mapping/render.h"
+#include "io/map_io.h"
+#include "viz/render.h"
 #include "merging/fusion.h"
 #include "merging/merge.h"
 #include "merging/multi_merge.h"
@@ -84,7 +84,7 @@ cv::Mat tinted(const merging::FusedMap& fused) {
       int n = 0;
       for (std::size_t k = 0; k < fused.inputs.size() && k < 32; ++k) {
         if (!(fused.sources[i] & (1u << k))) continue;
-        const mapping::Color c = mapping::palette_color(fused.inputs[k]);
+        const viz::Color c = viz::palette_color(fused.inputs[k]);
         tint += cv::Vec3d(c.b, c.g, c.r);
         ++n;
       }
@@ -104,22 +104,22 @@ cv::Mat tinted(const merging::FusedMap& fused) {
 }
 
 cv::Mat picture(const merging::FusedMap& fused, const std::vector<std::string>& names) {
-  mapping::Overlays overlays;
+  viz::Overlays overlays;
   for (int input : fused.inputs) {
-    mapping::CellsOverlay legend_only;
-    legend_only.color = mapping::palette_color(input);
+    viz::CellsOverlay legend_only;
+    legend_only.color = viz::palette_color(input);
     legend_only.label = std::to_string(input + 1) + ": " + fs::path(names[std::size_t(input)]).filename().string();
     overlays.cells.push_back(legend_only);
   }
   if (fused.conflict_cells > 0) {
-    mapping::CellsOverlay conflicts;
+    viz::CellsOverlay conflicts;
     conflicts.color = {214, 39, 40};
     conflicts.label = "free vs occupied";
     overlays.cells.push_back(conflicts);
   }
-  mapping::RenderOptions render;
+  viz::RenderOptions render;
   render.title = "merged: " + std::to_string(fused.inputs.size()) + " of " + std::to_string(names.size()) + " maps";
-  return mapping::decorate(tinted(fused), fused.grid.geometry(), overlays, render);
+  return viz::decorate(tinted(fused), fused.grid.geometry(), overlays, render);
 }
 
 int run_merge(const MergeCommandOptions& o) {
@@ -128,14 +128,14 @@ int run_merge(const MergeCommandOptions& o) {
   }
   merging::check_merge_method(o.method);
   const std::vector<OutputFile> outputs = {{"--out", o.out}, {"--json", o.json}};
-  if (!o.out.empty()) mapping::check_picture_path(o.out, "--out");
+  if (!o.out.empty()) io::check_picture_path(o.out, "--out");
   std::vector<fs::path> inputs;
   for (const auto& m : o.maps) {
     for (auto& f : maps::map_source_files(m)) inputs.push_back(std::move(f));
   }
   check_outputs(outputs, inputs);
   std::FILE* report = report_stream(outputs);
-  mapping::MapLoadOptions load;
+  io::MapLoadOptions load;
   load.default_resolution = o.resolution;
   std::vector<mapping::OccupancyGrid> grids;
   for (const auto& m : o.maps) {
@@ -200,7 +200,7 @@ int run_merge(const MergeCommandOptions& o) {
   if (!o.json.empty()) write_output(o.json, j.dump(2) + "\n");
   if (!o.out.empty()) write_picture(o.out, picture(fused, o.maps));
   for (const auto& out : outputs) {
-    if (!out.path.empty() && !core::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
+    if (!out.path.empty() && !io::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
   }
   if (placed < int(grids.size())) {
     fmt::print(stderr, "fleetmap merge: {} of {} maps merged; the others have no reliable overlap\n", placed,
@@ -237,7 +237,7 @@ Command add_merge_command(CLI::App& root) {
   merge->add_option("--seed", o->seed, "Seed of the RANSAC sampling (features)")->capture_default_str()->check(seed_number());
   merge->add_option("--resolution", o->resolution, "Metres per cell for bare images without YAML")
       ->capture_default_str()
-      ->check(in_range(mapping::kResolutionRange));
+      ->check(in_range(io::kResolutionRange));
   return {merge, [o]() { return run_merge(*o); }};
 }
 

@@ -1,8 +1,8 @@
 #include "cli/outputs.h"
 
 #include "core/error.h"
-#include "core/file_io.h"
-#include "mapping/map_io.h"
+#include "io/file_io.h"
+#include "io/map_io.h"
 
 namespace fleetmap::cli {
 
@@ -12,39 +12,39 @@ void check_outputs(const std::vector<OutputFile>& outputs, const std::vector<fs:
   const OutputFile* to_stdout = nullptr;
   for (const auto& o : outputs) {
     if (o.path.empty()) continue;
-    if (core::is_standard_output(o.path)) {
+    if (io::is_standard_output(o.path)) {
       if (to_stdout) throw InputError(to_stdout->flag + " and " + o.flag + ": only one output can go to the standard output");
       to_stdout = &o;
       continue;
     }
     for (const auto& other : outputs) {
       if (&other == &o || other.path.empty()) continue;
-      if (&other < &o && (other.path == o.path || core::same_file(other.path, o.path))) {
-        throw InputError(other.flag + " and " + o.flag + ": both name " + core::printable(o.path.string()) +
+      if (&other < &o && (other.path == o.path || io::same_file(other.path, o.path))) {
+        throw InputError(other.flag + " and " + o.flag + ": both name " + io::printable(o.path.string()) +
                          "; give each output its own file");
       }
     }
-    core::check_output_file(o.path, inputs, o.flag);
+    io::check_output_file(o.path, inputs, o.flag);
   }
 }
 
 std::FILE* report_stream(const std::vector<OutputFile>& outputs) {
   for (const auto& o : outputs) {
-    if (!o.path.empty() && core::is_standard_output(o.path)) return stderr;
+    if (!o.path.empty() && io::is_standard_output(o.path)) return stderr;
   }
   return stdout;
 }
 
 void write_output(const fs::path& path, std::string_view bytes) {
-  if (!core::is_standard_output(path)) return core::write_file_atomic(path, bytes);
+  if (!io::is_standard_output(path)) return io::write_file_atomic(path, bytes);
   if (std::fwrite(bytes.data(), 1, bytes.size(), stdout) != bytes.size() || std::fflush(stdout) != 0) {
     throw Error("cannot write to the standard output");
   }
 }
 
 void write_picture(const fs::path& path, const cv::Mat& image) {
-  const std::string ext = core::is_standard_output(path) ? ".png" : path.extension().string();
-  write_output(path, mapping::encode_image(ext, image, path.string()));
+  const std::string ext = io::is_standard_output(path) ? ".png" : path.extension().string();
+  write_output(path, io::encode_image(ext, image, path.string()));
 }
 
 }  // namespace fleetmap::cli

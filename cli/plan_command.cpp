@@ -14,10 +14,10 @@
 #include "cli/plan_output.h"
 #include "cli/validators.h"
 #include "core/error.h"
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "maps/builtin_maps.h"
-#include "mapping/map_io.h"
-#include "mapping/render.h"
+#include "io/map_io.h"
+#include "viz/render.h"
 #include "planning/planner.h"
 
 namespace fleetmap::cli {
@@ -80,9 +80,9 @@ nlohmann::json result_json(const PlanCommandOptions& o, const planning::PlanResu
 
 cv::Mat picture(const PlanCommandOptions& o, const mapping::OccupancyGrid& grid, const planning::FreeSpace& space,
                 const planning::PlanResult& r, const Endpoint& start, const Endpoint& goal) {
-  mapping::Overlays overlays;
+  viz::Overlays overlays;
   // Where the robot's centre may not go although the map says free: the inflation by its radius.
-  mapping::CellsOverlay inflated{{}, {255, 200, 120}, "within the robot radius of an obstacle", 0.5};
+  viz::CellsOverlay inflated{{}, {255, 200, 120}, "within the robot radius of an obstacle", 0.5};
   for (int y = 0; y < grid.height(); ++y)
     for (int x = 0; x < grid.width(); ++x)
       if (!space.is_obstacle({x, y}) && !space.valid(core::Cell{x, y})) inflated.cells.push_back({x, y});
@@ -90,7 +90,7 @@ cv::Mat picture(const PlanCommandOptions& o, const mapping::OccupancyGrid& grid,
   char label[96];
   if (r.success()) {
     std::snprintf(label, sizeof label, "%s path, %.2f m", r.planner.c_str(), r.length_m);
-    overlays.paths.push_back({r.path, mapping::palette_color(0), label, 2, false});
+    overlays.paths.push_back({r.path, viz::palette_color(0), label, 2, false});
   }
   // The robot at both ends, heading along the path (or straight at the goal when there is none).
   const auto heading = [](const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
@@ -102,17 +102,17 @@ cv::Mat picture(const PlanCommandOptions& o, const mapping::OccupancyGrid& grid,
   const double at_goal = n >= 2 ? heading(r.path[n - 2], r.path[n - 1]) : at_start;
   overlays.poses.push_back({{start.point.x(), start.point.y(), at_start}, o.radius_m, {44, 160, 44}, "start"});
   overlays.poses.push_back({{goal.point.x(), goal.point.y(), at_goal}, o.radius_m, {214, 39, 40}, "goal"});
-  mapping::RenderOptions render;
+  viz::RenderOptions render;
   render.title = fs::path(o.map).stem().string() + ": " + r.planner + (r.success() ? "" : " (no path)");
-  return mapping::render_map(grid, overlays, render);
+  return viz::render_map(grid, overlays, render);
 }
 
 int run_plan(const PlanCommandOptions& o) {
   const std::vector<OutputFile> outputs = {{"--out", o.out}, {"--json", o.json}};
-  if (!o.out.empty()) mapping::check_picture_path(o.out, "--out");
+  if (!o.out.empty()) io::check_picture_path(o.out, "--out");
   check_outputs(outputs, maps::map_source_files(o.map));
   std::FILE* report = report_stream(outputs);
-  mapping::MapLoadOptions load;
+  io::MapLoadOptions load;
   load.default_resolution = o.resolution;
   const mapping::OccupancyGrid grid = maps::load_map_source(o.map, load);
   const Endpoint start = endpoint("from", o.from, o.from_cell, grid);
@@ -144,7 +144,7 @@ int run_plan(const PlanCommandOptions& o) {
   fmt::print(report, "{}: {:.2f} m in {} waypoints; first path after {:.3f} s, {:.3f} s in all\n", r.planner, r.length_m,
              r.path.size(), r.first_solution_s.value_or(r.time_s), r.time_s);
   for (const auto& out : outputs) {
-    if (!out.path.empty() && !core::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
+    if (!out.path.empty() && !io::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
   }
   return 0;
 }
@@ -178,7 +178,7 @@ Command add_plan_command(CLI::App& root) {
                    "Write planner, success, time, length and waypoints to this JSON; - for the standard output (default: none)");
   plan->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
       ->capture_default_str()
-      ->check(in_range(mapping::kResolutionRange));
+      ->check(in_range(io::kResolutionRange));
   return {plan, [o]() { return run_plan(*o); }};
 }
 

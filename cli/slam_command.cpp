@@ -18,12 +18,12 @@
 #include "cli/corridor_command.h"
 #include "cli/progress.h"
 #include "cli/validators.h"
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "core/error.h"
-#include "sim/slam_experiment.h"
-#include "sim/slam_output.h"
-#include "sim/slam_scenario.h"
-#include "sim/sweep.h"
+#include "experiments/slam_experiment.h"
+#include "experiments/slam_output.h"
+#include "experiments/slam_scenario.h"
+#include "sweep/sweep.h"
 
 namespace fleetmap::cli {
 
@@ -42,7 +42,7 @@ struct SlamFlags {
 
 std::string method_names() {
   std::string names;
-  for (const auto& n : sim::slam_method_names()) names += (names.empty() ? "" : ", ") + n;
+  for (const auto& n : experiments::slam_method_names()) names += (names.empty() ? "" : ", ") + n;
   return names;
 }
 
@@ -50,11 +50,11 @@ int run_slam(const SlamFlags& f) {
   const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
   // The corridor loop of León et al. (experiment: leon_corridor) has its own runner.
   if (is_corridor_scenario_file(f.scenario)) return run_corridor_scenario(f.scenario, out, f.seed, f.quiet);
-  sim::SlamScenario s = sim::load_slam_scenario(f.scenario);
+  experiments::SlamScenario s = experiments::load_slam_scenario(f.scenario);
   if (f.runs) s.runs = *f.runs;
   if (f.seed) s.seed = *f.seed;
-  core::OutputFolder folder(out, "slam", sim::slam_output_files(s), {f.scenario}, "--out " + out.string());
-  const sim::SlamSetup setup = sim::prepare_slam(s);
+  io::OutputFolder folder(out, "slam", experiments::slam_output_files(s), {f.scenario}, "--out " + out.string());
+  const experiments::SlamSetup setup = experiments::prepare_slam(s);
   folder.claim();
 
   int single = -1;
@@ -63,7 +63,7 @@ int run_slam(const SlamFlags& f) {
   }
   // Jobs 0 .. runs-1 are the team runs; runs .. 2 runs-1 the single-robot runs (when asked for).
   const int total = s.runs * (single >= 0 ? 2 : 1);
-  sim::SlamCampaign campaign;
+  experiments::SlamCampaign campaign;
   campaign.team.resize(std::size_t(s.runs));
   if (single >= 0) campaign.alone.resize(std::size_t(s.runs));
   std::atomic<int> next{0}, done{0};
@@ -75,9 +75,9 @@ int run_slam(const SlamFlags& f) {
       if (job >= total) return;
       try {
         if (job < s.runs) {
-          campaign.team[std::size_t(job)] = sim::run_slam(setup, job, s.exchange);
+          campaign.team[std::size_t(job)] = experiments::run_slam(setup, job, s.exchange);
         } else {
-          campaign.alone[std::size_t(job - s.runs)] = sim::run_slam(setup, job - s.runs, false, single);
+          campaign.alone[std::size_t(job - s.runs)] = experiments::run_slam(setup, job - s.runs, false, single);
         }
       } catch (...) {
         const std::lock_guard<std::mutex> lock(failure_mutex);
@@ -100,13 +100,13 @@ int run_slam(const SlamFlags& f) {
   bar.finish();
   if (failure) std::rethrow_exception(failure);
 
-  const auto written = sim::write_slam_outputs(setup, campaign, out, s.paper_table);
-  folder.finish(core::OutputFolder::names(written));
+  const auto written = experiments::write_slam_outputs(setup, campaign, out, s.paper_table);
+  folder.finish(io::OutputFolder::names(written));
   if (f.quiet) {
     fmt::print("{}\n", (out / "table1.md").string());
     return 0;
   }
-  fmt::print("{}", sim::slam_table_markdown(setup, campaign, s.paper_table));
+  fmt::print("{}", experiments::slam_table_markdown(setup, campaign, s.paper_table));
   std::string names;
   for (const auto& p : written) names += " " + p.filename().string();
   fmt::print("\nall outputs in {}/:{}\n", out.string(), names);
@@ -132,11 +132,11 @@ Command add_slam_command(CLI::App& root) {
       ->required()
       ->check(CLI::ExistingFile);
   app->add_option("--runs", f->runs, "Number of runs [default: the scenario's runs, 100 if it has none]")
-      ->check(in_range(sim::kSlamRunsRange));
+      ->check(in_range(experiments::kSlamRunsRange));
   app->add_option("--seed", f->seed, "Random seed; run k uses its own streams derived from it [default: the scenario's, 1]")
       ->check(seed_number());
   app->add_option("--jobs", f->jobs, "Runs computed in parallel, one thread each; results do not depend on it [default: 1]")
-      ->check(in_range(sim::kJobsRange));
+      ->check(in_range(sweep::kJobsRange));
   app->add_option("--out", f->out,
                   "Output folder: new, empty, or of an earlier slam run (its files are replaced) "
                   "[default: out/slam_<scenario name>]");

@@ -5,16 +5,16 @@
 #include <string>
 
 #include "core/error.h"
-#include "mapping/map_io.h"
+#include "io/map_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace mapping = fleetmap::mapping;
-  mapping::MapLoadOptions options;
+  io::MapLoadOptions options;
   options.max_cells = 1 << 22;  // keeps every input quick; the limit itself is part of what is tested
   try {
     const cv::Mat image =
-        mapping::decode_map_image(std::string(reinterpret_cast<const char*>(data), size), "fuzz.png", options);
-    const mapping::OccupancyGrid grid = mapping::grid_from_image(image, mapping::MapYaml{}, options.grid);
+        io::decode_map_image(std::string(reinterpret_cast<const char*>(data), size), "fuzz.png", options);
+    const mapping::OccupancyGrid grid = io::grid_from_image(image, io::MapYaml{}, options.grid);
     if (grid.geometry().width() != image.cols || grid.geometry().height() != image.rows) __builtin_trap();
   } catch (const fleetmap::InputError&) {
   }

@@ -7,7 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "core/error.h"
-#include "mapping/map_io.h"
+#include "io/map_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace mapping = fleetmap::mapping;
@@ -17,11 +17,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return m;
   }();
   try {
-    const mapping::MapYaml meta =
-        mapping::parse_map_yaml(std::string(reinterpret_cast<const char*>(data), size), "fuzz.yaml");
-    const mapping::OccupancyGrid grid = mapping::grid_from_image(image, meta);
+    const io::MapYaml meta =
+        io::parse_map_yaml(std::string(reinterpret_cast<const char*>(data), size), "fuzz.yaml");
+    const mapping::OccupancyGrid grid = io::grid_from_image(image, meta);
     // What map_saver would write loads back to the same settings.
-    const mapping::MapYaml back = mapping::parse_map_yaml(mapping::format_map_yaml(meta), "round-trip.yaml");
+    const io::MapYaml back = io::parse_map_yaml(io::format_map_yaml(meta), "round-trip.yaml");
     if (back.image != meta.image || back.resolution != meta.resolution || !(back.origin == meta.origin) ||
         back.negate != meta.negate || back.mode != meta.mode || back.occupied_thresh != meta.occupied_thresh ||
         back.free_thresh != meta.free_thresh) {

@@ -6,20 +6,20 @@
 #include <string>
 
 #include "core/error.h"
-#include "sim/corridor_experiment.h"
-#include "sim/slam_experiment.h"
-#include "sim/slam_scenario.h"
+#include "experiments/corridor_experiment.h"
+#include "experiments/slam_experiment.h"
+#include "experiments/slam_scenario.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace sim = fleetmap::sim;
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    if (sim::is_corridor_scenario(text, "fuzz.yaml")) {
-      sim::parse_corridor_options(text, "fuzz.yaml");
+    if (experiments::is_corridor_scenario(text, "fuzz.yaml")) {
+      experiments::parse_corridor_options(text, "fuzz.yaml");
       return 0;
     }
-    const sim::SlamScenario s = sim::parse_slam_scenario(text, "fuzz.yaml");
-    sim::validate_slam_scenario(s);
+    const experiments::SlamScenario s = experiments::parse_slam_scenario(text, "fuzz.yaml");
+    experiments::validate_slam_scenario(s);
     // The set-up rasterizes the room: worth it only for rooms of modest size and paths of few steps.
     double lo_x = 1e300, lo_y = 1e300, hi_x = -1e300, hi_y = -1e300;
     for (const auto& p : s.room.boundary) {
@@ -27,7 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       hi_x = std::max(hi_x, p.x()), hi_y = std::max(hi_y, p.y());
     }
     const double cells = (hi_x - lo_x) * (hi_y - lo_y) / (s.room.resolution_m * s.room.resolution_m);
-    if (cells < 1e5 && s.steps <= 2000) sim::prepare_slam(s);
+    if (cells < 1e5 && s.steps <= 2000) experiments::prepare_slam(s);
   } catch (const fleetmap::InputError&) {
   }
   return 0;

@@ -5,18 +5,18 @@
 #include <string>
 
 #include "core/error.h"
-#include "sim/sweep.h"
+#include "sweep/sweep.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   namespace sim = fleetmap::sim;
   try {
-    const sim::Sweep s = sim::parse_sweep(std::string(reinterpret_cast<const char*>(data), size), "fuzz.yaml", "/nonexistent");
+    const sweep::Sweep s = sweep::parse_sweep(std::string(reinterpret_cast<const char*>(data), size), "fuzz.yaml", "/nonexistent");
     // Without a scenario file (none exists under /nonexistent) the sweep file holds every setting.
-    const std::string yaml = sim::sweep_to_yaml(s, "");
-    const sim::Sweep back = sim::parse_sweep(yaml, "round-trip.yaml", "/nonexistent");
-    if (sim::sweep_to_yaml(back, "") != yaml) __builtin_trap();
+    const std::string yaml = sweep::sweep_to_yaml(s, "");
+    const sweep::Sweep back = sweep::parse_sweep(yaml, "round-trip.yaml", "/nonexistent");
+    if (sweep::sweep_to_yaml(back, "") != yaml) __builtin_trap();
     if (s.maps.size() * s.strategies.size() * s.robots.size() * std::size_t(s.seeds) <= 100'000 &&
-        sim::sweep_runs(s).size() != s.maps.size() * s.strategies.size() * s.robots.size() * std::size_t(s.seeds)) {
+        sweep::sweep_runs(s).size() != s.maps.size() * s.strategies.size() * s.robots.size() * std::size_t(s.seeds)) {
       __builtin_trap();
     }
   } catch (const fleetmap::InputError&) {

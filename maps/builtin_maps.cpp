@@ -440,17 +440,17 @@ std::optional<fs::path> map_file(const std::string& name_or_path) {
 
 std::vector<fs::path> map_source_files(const std::string& name_or_path) {
   const auto file = map_file(name_or_path);
-  return file ? mapping::map_files(*file) : std::vector<fs::path>{};
+  return file ? io::map_files(*file) : std::vector<fs::path>{};
 }
 
-mapping::OccupancyGrid load_map_source(const std::string& name_or_path, const mapping::MapLoadOptions& options) {
+mapping::OccupancyGrid load_map_source(const std::string& name_or_path, const io::MapLoadOptions& options) {
   if (name_or_path.empty()) throw InputError("map: empty name (built-in maps: " + builtin_map_names() + ")");
   if (const auto file = map_file(name_or_path)) {
     if (is_builtin_map(name_or_path) && *file != fs::path(name_or_path) && !fs::exists(*file)) {
       throw InputError("map '" + name_or_path + "': built-in map file " + file->string() +
                        " is missing (set FLEETMAP_MAPS_DIR to the maps/ folder)");
     }
-    return mapping::load_map(*file, options);
+    return io::load_map(*file, options);
   }
   const bool looks_like_path = name_or_path.find_first_of("/.") != std::string::npos;
   if (looks_like_path) throw InputError(name_or_path + ": no such file");

@@ -9,7 +9,7 @@
 #include <string_view>
 #include <vector>
 
-#include "mapping/map_io.h"
+#include "io/map_io.h"
 #include "mapping/occupancy_grid.h"
 
 namespace fleetmap::maps {
@@ -27,7 +27,7 @@ std::string builtin_map_names();
 
 struct GeneratedMap {
   cv::Mat image;          // 8-bit grey, 254 free, 0 occupied, top row first
-  mapping::MapYaml yaml;  // image: <name>.png
+  io::MapYaml yaml;  // image: <name>.png
 };
 
 // Deterministic: the same image and YAML on every call. Throws InputError for unknown names.
@@ -42,7 +42,7 @@ std::filesystem::path builtin_maps_dir();
 // Loads a map named by the user: an existing PNG/PGM/YAML file, or a built-in map name.
 // Throws InputError that names the input, listing the built-in names when it is neither.
 mapping::OccupancyGrid load_map_source(const std::string& name_or_path,
-                                       const mapping::MapLoadOptions& options = {});
+                                       const io::MapLoadOptions& options = {});
 // The files load_map_source reads for `name_or_path` (a built-in map's PNG and YAML too), so that
 // no output is ever written over them.
 std::vector<std::filesystem::path> map_source_files(const std::string& name_or_path);

@@ -5,7 +5,7 @@
 #include <exception>
 #include <filesystem>
 
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "maps/builtin_maps.h"
 
 int main(int argc, char** argv) {
@@ -14,8 +14,8 @@ int main(int argc, char** argv) {
     const std::filesystem::path out = argc > 1 ? std::filesystem::path(argv[1]) : fm::maps::builtin_maps_dir();
     for (const auto& info : fm::maps::builtin_maps()) {
       const auto m = fm::maps::generate_builtin_map(info.name);
-      fm::core::write_file_atomic(out / (info.name + ".png"), fm::maps::encode_png(m.image));
-      fm::core::write_file_atomic(out / (info.name + ".yaml"), fm::mapping::format_map_yaml(m.yaml));
+      fm::io::write_file_atomic(out / (info.name + ".png"), fm::maps::encode_png(m.image));
+      fm::io::write_file_atomic(out / (info.name + ".yaml"), fm::io::format_map_yaml(m.yaml));
       std::printf("%-13s %4dx%-4d -> %s\n", info.name.c_str(), m.image.cols, m.image.rows,
                   (out / (info.name + ".png")).c_str());
     }

@@ -9,11 +9,11 @@
 
 #include "core/angle.h"
 #include "core/error.h"
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "localization/metrics.h"
-#include "mapping/map_io.h"
-#include "mapping/octomap_io.h"
-#include "mapping/render.h"
+#include "io/map_io.h"
+#include "io/octomap_io.h"
+#include "viz/render.h"
 
 namespace fleetmap::sim {
 
@@ -40,8 +40,8 @@ std::vector<Eigen::Vector2d> positions(const std::vector<core::Pose2>& poses) {
   return out;
 }
 
-mapping::RenderOptions render_options(const std::string& t) {
-  mapping::RenderOptions o;
+viz::RenderOptions render_options(const std::string& t) {
+  viz::RenderOptions o;
   o.title = t;
   return o;
 }
@@ -145,11 +145,11 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   return j;
 }
 
-cv::Mat render_merged(const RunResult& r, const std::string& map_label, const mapping::Overlays& extra) {
-  mapping::Overlays o;
+cv::Mat render_merged(const RunResult& r, const std::string& map_label, const viz::Overlays& extra) {
+  viz::Overlays o;
   const bool show_estimates = r.scenario.localization != "ideal";
   for (std::size_t i = 0; i < r.robots.size(); ++i) {
-    const auto colour = mapping::palette_color(int(i));
+    const auto colour = viz::palette_color(int(i));
     const auto& t = r.robots[i];
     const std::string name = "robot " + std::to_string(i + 1);
     o.paths.push_back({positions(t.truth), colour, name + (show_estimates ? " (true)" : ""), 2, false});
@@ -163,21 +163,21 @@ cv::Mat render_merged(const RunResult& r, const std::string& map_label, const ma
   o.poses.insert(o.poses.end(), extra.poses.begin(), extra.poses.end());
   char buf[128];
   std::snprintf(buf, sizeof buf, ", %d steps, %.1f%%", r.steps, 100.0 * (r.coverage.empty() ? 0.0 : r.coverage.back()));
-  return mapping::render_map(r.merged, o, render_options(title(r, map_label) + buf));
+  return viz::render_map(r.merged, o, render_options(title(r, map_label) + buf));
 }
 
 cv::Mat render_robot(const RunResult& r, int robot, const std::string& map_label) {
   const auto& t = r.robots[std::size_t(robot)];
-  const auto colour = mapping::palette_color(robot);
+  const auto colour = viz::palette_color(robot);
   // The robot's map is in its own frame; its estimates were recorded in the world's.
   const core::Transform2 to_frame = r.robot_frames[std::size_t(robot)].inverse();
   std::vector<Eigen::Vector2d> trajectory;
   for (const auto& p : t.estimate) trajectory.push_back(to_frame.apply(p.position()));
   const core::Pose2 last = core::Pose2::from_transform(to_frame * t.estimate.back().as_transform());
-  mapping::Overlays o;
+  viz::Overlays o;
   o.paths.push_back({trajectory, colour, "trajectory (estimate)", 2, false});
   o.poses.push_back({last, r.scenario.robot.radius_m, colour, "robot " + std::to_string(robot + 1)});
-  return mapping::render_map(r.robot_maps[std::size_t(robot)], o,
+  return viz::render_map(r.robot_maps[std::size_t(robot)], o,
                              render_options(map_label + ": robot " + std::to_string(robot + 1) + "'s map"));
 }
 
@@ -190,25 +190,25 @@ std::vector<std::string> run_output_files(const Scenario& scenario) {
 }
 
 std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& map_label, const fs::path& dir,
-                                        const mapping::Overlays& extra) {
-  core::ensure_directory(dir);
+                                        const viz::Overlays& extra) {
+  io::ensure_directory(dir);
   std::vector<fs::path> written;
   const auto add = [&](const fs::path& p) { written.push_back(p); };
-  mapping::write_image(dir / "merged.png", render_merged(r, map_label, extra));
+  io::write_image(dir / "merged.png", render_merged(r, map_label, extra));
   add(dir / "merged.png");
   for (std::size_t i = 0; i < r.robot_maps.size(); ++i) {
     const fs::path p = dir / ("robot_" + std::to_string(i + 1) + ".png");
-    mapping::write_image(p, render_robot(r, int(i), map_label));
+    io::write_image(p, render_robot(r, int(i), map_label));
     add(p);
   }
-  core::write_file_atomic(dir / "metrics.json", metrics_json(r, map_label).dump(2) + "\n");
+  io::write_file_atomic(dir / "metrics.json", metrics_json(r, map_label).dump(2) + "\n");
   add(dir / "metrics.json");
-  mapping::save_map_yaml(r.merged, dir / "map.yaml");
+  io::save_map_yaml(r.merged, dir / "map.yaml");
   add(dir / "map.pgm");
   add(dir / "map.yaml");
-  mapping::save_octomap(r.merged, dir / "map.bt");
+  io::save_octomap(r.merged, dir / "map.bt");
   add(dir / "map.bt");
-  core::write_file_atomic(dir / "scenario.yaml", scenario_to_yaml(r.scenario, dir));
+  io::write_file_atomic(dir / "scenario.yaml", scenario_to_yaml(r.scenario, dir));
   add(dir / "scenario.yaml");
   return written;
 }
@@ -237,10 +237,10 @@ RunVideo::~RunVideo() {
 }
 
 void RunVideo::add_frame(const Simulation& sim, const std::string& map_label) {
-  mapping::Overlays o;
+  viz::Overlays o;
   const auto estimates = sim.estimated_poses();
   for (int i = 0; i < sim.scenario().robot_count; ++i) {
-    const auto colour = mapping::palette_color(i);
+    const auto colour = viz::palette_color(i);
     o.paths.push_back({positions(sim.track(i).truth), colour, "robot " + std::to_string(i + 1), 2, false});
     auto plan = sim.path(i);
     if (!plan.empty()) {
@@ -251,14 +251,14 @@ void RunVideo::add_frame(const Simulation& sim, const std::string& map_label) {
   }
   char buf[160];
   std::snprintf(buf, sizeof buf, "%s: step %d, %.1f%%", map_label.c_str(), sim.step_count(), 100.0 * sim.coverage());
-  mapping::RenderOptions ro;
+  viz::RenderOptions ro;
   ro.title = buf;
   ro.max_size_px = 1600;
-  cv::Mat frame = mapping::render_map(sim.merged_map(), o, ro);
+  cv::Mat frame = viz::render_map(sim.merged_map(), o, ro);
   if (!impl_->writer.isOpened()) {
     // Even dimensions keep every codec happy.
     impl_->size = cv::Size(frame.cols + (frame.cols % 2), frame.rows + (frame.rows % 2));
-    core::ensure_directory(impl_->path.parent_path());
+    io::ensure_directory(impl_->path.parent_path());
     if (!impl_->writer.open(impl_->tmp.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), impl_->fps, impl_->size)) {
       throw Error(impl_->path.string() + ": cannot open a video writer (OpenCV without an MP4 encoder?)");
     }

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "mapping/render.h"
+#include "viz/render.h"
 #include "sim/simulation.h"
 
 namespace fleetmap::sim {
@@ -20,7 +20,7 @@ nlohmann::json metrics_json(const RunResult& result, const std::string& map_labe
 // The merged map with every robot's true trajectory (solid), estimated trajectory (dashed, when
 // the localization is not ideal), final pose and landmarks; legend and scale bar.
 // `extra` is drawn on top (e.g. a path planned on the merged map).
-cv::Mat render_merged(const RunResult& result, const std::string& map_label, const mapping::Overlays& extra = {});
+cv::Mat render_merged(const RunResult& result, const std::string& map_label, const viz::Overlays& extra = {});
 // Robot i's own map with its trajectory.
 cv::Mat render_robot(const RunResult& result, int robot, const std::string& map_label);
 
@@ -31,7 +31,7 @@ std::vector<std::string> run_output_files(const Scenario& scenario);
 // scenario.yaml (its map path relative to `dir`) into `dir`. Returns the files written.
 std::vector<std::filesystem::path> write_run_outputs(const RunResult& result, const std::string& map_label,
                                                      const std::filesystem::path& dir,
-                                                     const mapping::Overlays& extra = {});
+                                                     const viz::Overlays& extra = {});
 
 // An MP4 of a run, a frame per step (the merged map, robots, their paths and goals).
 class RunVideo {

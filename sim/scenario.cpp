@@ -8,8 +8,8 @@
 
 #include "core/angle.h"
 #include "core/error.h"
-#include "core/file_io.h"
-#include "core/yaml_reader.h"
+#include "io/file_io.h"
+#include "io/yaml_reader.h"
 #include "exploration/strategy.h"
 #include "maps/builtin_maps.h"
 #include "merging/merge.h"
@@ -23,12 +23,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 using core::deg2rad;
 using core::rad2deg;
 
-std::vector<std::vector<double>> number_rows(core::YamlMap& m, const std::string& key, std::size_t lo, std::size_t hi,
+std::vector<std::vector<double>> number_rows(io::YamlMap& m, const std::string& key, std::size_t lo, std::size_t hi,
                                              const std::string& shape) {
   std::vector<std::vector<double>> rows;
   const auto n = m.node(key);
   if (!n) return rows;
-  if (!n->IsSequence()) throw InputError(m.where(key) + ": expected a list of " + shape + ", got " + core::describe_node(*n));
+  if (!n->IsSequence()) throw InputError(m.where(key) + ": expected a list of " + shape + ", got " + io::describe_node(*n));
   for (const auto& item : *n) {
     std::vector<double> row;
     if (item.IsSequence() && item.size() >= lo && item.size() <= hi) {
@@ -43,7 +43,7 @@ std::vector<std::vector<double>> number_rows(core::YamlMap& m, const std::string
     }
     if (row.size() < lo) {
       throw InputError(m.where_node(item) + ": key '" + m.full_key(key) + "': expected " + shape + ", got " +
-                       core::describe_node(item));
+                       io::describe_node(item));
     }
     rows.push_back(row);
   }
@@ -71,7 +71,7 @@ std::vector<std::string> path_planner_names() {
   return names;
 }
 
-MotionNoise read_motion_noise(core::YamlMap noise, const MotionNoise& fallback) {
+MotionNoise read_motion_noise(io::YamlMap noise, const MotionNoise& fallback) {
   MotionNoise n;
   n.position_m = noise.number("position", fallback.position_m, limits::kNoiseMetres);
   n.heading_rad = deg2rad(noise.number("heading_deg", rad2deg(fallback.heading_rad), limits::kAngleDeg));
@@ -79,7 +79,7 @@ MotionNoise read_motion_noise(core::YamlMap noise, const MotionNoise& fallback) 
   return n;
 }
 
-RobotDetectorOptions read_robot_detector(core::YamlMap det, const RobotDetectorOptions& fallback) {
+RobotDetectorOptions read_robot_detector(io::YamlMap det, const RobotDetectorOptions& fallback) {
   RobotDetectorOptions d = fallback;
   d.max_range_m = det.number("max_range", fallback.max_range_m, limits::kDetectorRange);
   d.fov_rad = deg2rad(det.number("fov_deg", rad2deg(fallback.fov_rad), limits::kAngleDeg));
@@ -90,9 +90,9 @@ RobotDetectorOptions read_robot_detector(core::YamlMap det, const RobotDetectorO
 }
 
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
-  const YAML::Node root = core::parse_yaml(text, source);
+  const YAML::Node root = io::parse_yaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
-  core::YamlMap top(root, source);
+  io::YamlMap top(root, source);
   Scenario s;
   s.base_dir = base_dir;
   s.map = top.text("map", s.map);
@@ -221,7 +221,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
 }
 
 Scenario load_scenario(const std::filesystem::path& path) {
-  return parse_scenario(core::read_file(path, 16 << 20), path.string(), path.parent_path());
+  return parse_scenario(io::read_file(path, 16 << 20), path.string(), path.parent_path());
 }
 
 void validate_scenario(const Scenario& s) {
@@ -316,7 +316,7 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
   }
   std::ostringstream y;
   y << "# fleetmap scenario\n";
-  y << "map: " << core::yaml_quoted(map) << "\n";
+  y << "map: " << io::yaml_quoted(map) << "\n";
   y << "seed: " << s.seed << "\nsteps: " << s.steps << "\nperiod: " << fmt(s.period_s) << "\n";
   y << "robots:\n";
   switch (s.placement) {

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <string>
 
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "tests/cli_run.h"
 
 namespace fleetmap::cli {
@@ -39,7 +39,7 @@ TEST_P(GoldenRuns, MetricsAreTheKeptOnes) {
   metrics.erase("timing");
   const fs::path golden = fs::path(FLEETMAP_SOURCE_DIR) / "tests/data/golden" / (run.name + ".json");
   if (const char* update = std::getenv("FLEETMAP_UPDATE_GOLDEN"); update && std::string(update) == "1") {
-    core::write_file_atomic(golden, metrics.dump(1) + "\n");
+    io::write_file_atomic(golden, metrics.dump(1) + "\n");
   }
   ASSERT_TRUE(fs::exists(golden)) << golden << " is missing: FLEETMAP_UPDATE_GOLDEN=1 writes it";
   const auto kept = nlohmann::json::parse(slurp(golden));

@@ -8,8 +8,8 @@
 
 #include "core/angle.h"
 #include "maps/builtin_maps.h"
-#include "mapping/map_io.h"
-#include "mapping/render.h"
+#include "io/map_io.h"
+#include "viz/render.h"
 #include "merging/evaluation.h"
 #include "merging/rendezvous.h"
 #include "tests/cli_run.h"
@@ -34,8 +34,8 @@ PixelTruth write_pair(const TempDir& dir, const std::string& a_name, const std::
   o.width = o.height = 140;
   o.overlap = 0.5;
   const merging::CropPair pair = merging::make_crop_pair(office, o, random);
-  mapping::save_map_image(pair.a, dir / a_name);
-  mapping::save_map_image(pair.b, dir / b_name);
+  io::save_map_image(pair.a, dir / a_name);
+  io::save_map_image(pair.b, dir / b_name);
   const core::Transform2 px = merging::flip_rows(pair.b_to_a, pair.a.height(), pair.b.height());
   return {px.translation().x(), px.translation().y(), core::rad2deg(px.rotation())};
 }
@@ -66,7 +66,7 @@ TEST(MergeCommand, MergesTwoMapsInThePixelConvention) {
   // The picture tints each input in its own palette colour (legend swatches included).
   const cv::Mat img = cv::imread((dir / "out" / "merged.png").string());
   ASSERT_FALSE(img.empty());
-  const auto has_colour = [&](const mapping::Color& c) {
+  const auto has_colour = [&](const viz::Color& c) {
     for (int y = 0; y < img.rows; ++y) {
       for (int x = 0; x < img.cols; ++x) {
         const auto& p = img.at<cv::Vec3b>(y, x);
@@ -75,8 +75,8 @@ TEST(MergeCommand, MergesTwoMapsInThePixelConvention) {
     }
     return false;
   };
-  EXPECT_TRUE(has_colour(mapping::palette_color(0)));
-  EXPECT_TRUE(has_colour(mapping::palette_color(1)));
+  EXPECT_TRUE(has_colour(viz::palette_color(0)));
+  EXPECT_TRUE(has_colour(viz::palette_color(1)));
 }
 
 TEST(MergeCommand, AMapWithoutOverlapIsReportedNotMerged) {
@@ -84,7 +84,7 @@ TEST(MergeCommand, AMapWithoutOverlapIsReportedNotMerged) {
   write_pair(dir, "a.png", "b.png", 6);
   // A piece of the maze shares nothing with the office.
   const auto maze = maps::load_map_source("maze");
-  mapping::save_map_image(merging::crop_grid(maze, 30, 30, 120, 120), dir / "maze.png");
+  io::save_map_image(merging::crop_grid(maze, 30, 30, 120, 120), dir / "maze.png");
   const auto r = run_fleetmap("merge a.png maze.png b.png --method overlap --json r.json --out m.png", dir);
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("2 of 3 maps merged"), std::string::npos) << r.err;

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "mapping/map_io.h"
+#include "io/map_io.h"
 #include "tests/cli_run.h"
 
 namespace fleetmap::cli {

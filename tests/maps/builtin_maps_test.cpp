@@ -4,8 +4,8 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "core/file_io.h"
-#include "mapping/map_io.h"
+#include "io/file_io.h"
+#include "io/map_io.h"
 #include "tests/test_support.h"
 
 namespace fleetmap::maps {
@@ -17,15 +17,15 @@ class BuiltinMap : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(BuiltinMap, CommittedFilesMatchTheGenerator) {
   const auto generated = generate_builtin_map(GetParam());
-  EXPECT_EQ(core::read_file(kMapsDir / (GetParam() + ".yaml")), mapping::format_map_yaml(generated.yaml));
+  EXPECT_EQ(io::read_file(kMapsDir / (GetParam() + ".yaml")), io::format_map_yaml(generated.yaml));
 #ifdef __clang__
   // The committed images come from the project's compiler, g++ 12; clang's floating point
   // (contraction into FMA, libm calls folded at compile time) moves a few generated obstacles, so
   // under clang only the size is compared and the pixels are checked by the g++ build.
-  const cv::Mat committed = mapping::decode_map_image(core::read_file(kMapsDir / (GetParam() + ".png")), GetParam());
+  const cv::Mat committed = io::decode_map_image(io::read_file(kMapsDir / (GetParam() + ".png")), GetParam());
   EXPECT_EQ(committed.size(), generated.image.size());
 #else
-  EXPECT_EQ(core::read_file(kMapsDir / (GetParam() + ".png")), encode_png(generated.image))
+  EXPECT_EQ(io::read_file(kMapsDir / (GetParam() + ".png")), encode_png(generated.image))
       << "maps/" << GetParam() << ".png differs from the generator: run build/maps/fleetmap_generate_maps";
 #endif
 }

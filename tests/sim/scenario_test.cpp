@@ -5,7 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "core/file_io.h"
+#include "io/file_io.h"
 #include "tests/test_support.h"
 
 namespace fleetmap::sim {
@@ -79,7 +79,7 @@ communication: {range: 12.5}
 exploration: {strategy: market}
 )");
   const std::string text = scenario_to_yaml(a);
-  core::write_file_atomic(dir / "s.yaml", text);
+  io::write_file_atomic(dir / "s.yaml", text);
   const Scenario b = load_scenario(dir / "s.yaml");
   EXPECT_EQ(scenario_to_yaml(b), text);
   EXPECT_EQ(b.starts.size(), 2u);
@@ -129,7 +129,7 @@ namespace {
 // The README documents every scenario key with its default: that block must parse, and give the
 // defaults.
 TEST(Scenario, TheReadmeExampleParsesToTheDefaults) {
-  const std::string readme = core::read_file(std::filesystem::path(FLEETMAP_SOURCE_DIR) / "README.md");
+  const std::string readme = io::read_file(std::filesystem::path(FLEETMAP_SOURCE_DIR) / "README.md");
   const auto section = readme.find("### Scenario files");
   ASSERT_NE(section, std::string::npos);
   const auto begin = readme.find("```yaml\n", section);

@@ -6,7 +6,7 @@
 
 #include "core/angle.h"
 #include "maps/builtin_maps.h"
-#include "mapping/map_io.h"
+#include "io/map_io.h"
 #include "sim/run_output.h"
 #include "tests/sim/sim_test_maps.h"
 #include "tests/test_support.h"
@@ -68,10 +68,10 @@ TEST(Simulation, ExploresASmallMapAndStopsWhenDone) {
 TEST(Simulation, ExploresAFineMapDecidingOnCoarserCells) {
   const mapping::OccupancyGrid office = maps::load_map_source("office");
   cv::Mat image;
-  cv::resize(mapping::grid_to_image(office), image, {}, 2, 2, cv::INTER_NEAREST);
-  mapping::MapYaml meta;
+  cv::resize(io::grid_to_image(office), image, {}, 2, 2, cv::INTER_NEAREST);
+  io::MapYaml meta;
   meta.resolution = office.resolution() / 2;
-  const mapping::OccupancyGrid fine = mapping::grid_from_image(image, meta);
+  const mapping::OccupancyGrid fine = io::grid_from_image(image, meta);
   Scenario s = small("office", 3, 2000);
   s.range.beams = 720;  // beams no farther apart than the cells near the robot
   s.exploration.planning_resolution_m = 0.1;

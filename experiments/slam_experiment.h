@@ -1,0 +1,82 @@
+#pragma once
+// Seed 000 §4's experiment: robots driven along precomputed paths (the commands are computed once,
+// noise-free, from the waypoints), each running its SLAM method from its own origin
+// (x_j,0 = [0 0 0] in R_j,0), exchanging maps when two robots see each other, and measured
+// against the truth: mu (the paper's form and the standard NEES), nu, tau, bytes per rendezvous.
+// `method` picks the SLAM method through a table in slam_experiment.cpp.
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/transform2.h"
+#include "localization/localizer.h"
+#include "localization/metrics.h"
+#include "mapping/occupancy_grid.h"
+#include "mapping/polynomial_map.h"
+#include "experiments/slam_scenario.h"
+#include "sim/world.h"
+
+namespace fleetmap::experiments {
+
+// The room as a grid: free inside the boundary and outside every obstacle (a cell is free when its
+// centre is), with a blocked frame of one cell plus `margin_m` around it.
+mapping::OccupancyGrid rasterize_room(const SlamRoom& room, double margin_m = 0.0);
+
+// The commands that drive a robot from `start` along `path` at `speed`, one per step: heading for
+// the next waypoint (turning at most max_turn_rate, in place when more than 60 degrees off), and
+// (0, 0) once the last waypoint is reached. Noise-free, computed once (seed 000 §4: "angular
+// velocities precomputed").
+std::vector<localization::Odometry> path_commands(const core::Pose2& start, const std::vector<Eigen::Vector2d>& path,
+                                                  double speed, int steps, double period_s, double max_turn_rate);
+
+// What every run of a scenario shares.
+struct SlamSetup {
+  SlamScenario scenario;
+  sim::World world;
+  std::vector<mapping::WallSegment> walls;
+  std::vector<std::vector<localization::Odometry>> commands;  // per robot, per step
+  std::vector<std::vector<core::Pose2>> planned;              // per robot, the noise-free poses, k = 0..steps
+};
+
+// Rasterises the room and precomputes the paths. Throws InputError naming the robot when a start
+// or a step of its noise-free path is within the robot's radius of a wall.
+SlamSetup prepare_slam(const SlamScenario& scenario);
+
+struct SlamRendezvous {
+  int step = 0;
+  int sender = -1;
+  int receiver = -1;
+  int polynomials = 0;            // polynomials sent
+  std::int64_t bytes = 0;         // merging::message_bytes
+  std::int64_t grid_bytes = 0;    // the equivalent occupancy-grid patch
+};
+
+struct SlamRobotResult {
+  std::string name;
+  std::vector<core::Pose2> truth;     // k = 0..steps, room frame
+  std::vector<core::Pose2> estimate;  // the estimate brought into the room frame by the true start
+  localization::LocalizationSummary localization;  // mu (seed000_mu), the standard NEES, RMSE
+  mapping::MappingError mapping;      // nu
+  double boundary_coverage = 0.0;     // share of the true walls within 0.1 m of the map
+  double tau_s = 0.0;                 // mean SLAM time per step (predict, update, received maps)
+  int polynomials = 0;
+  std::vector<std::vector<Eigen::Vector2d>> map_curves;  // the map in the room frame, for pictures
+  std::vector<std::pair<std::string, double>> counters;
+};
+
+struct SlamRunResult {
+  int run = 0;
+  bool exchange = true;
+  std::vector<SlamRobotResult> robots;
+  std::vector<SlamRendezvous> rendezvous;
+};
+
+// One run: the run index picks its random streams (per robot: motion, sensors, camera), so a run
+// without exchange has the same noise as the same run with it. `only` restricts the team to one
+// robot by index (-1: all), for the single-robot runs of seed 000 Fig. 8.
+SlamRunResult run_slam(const SlamSetup& setup, int run, bool exchange, int only = -1);
+
+}  // namespace fleetmap::experiments

@@ -1,0 +1,82 @@
+#pragma once
+// Map files: PNG/PGM images and ROS map_server YAML, with map_server's semantics
+// (image row 0 is the top, cell row 0 the bottom; occ = (255 - mean(RGB)) / 255, inverted by
+// `negate`; Occupied when occ > occupied_thresh, Free when occ < free_thresh).
+#include <opencv2/core/mat.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/range.h"
+#include "core/transform2.h"
+#include "mapping/occupancy_grid.h"
+
+namespace fleetmap::io {
+
+enum class MapMode { Trinary, Scale, Raw };
+
+// Metres per cell a map may have (map YAML files and --resolution alike), and how far its origin
+// may be from zero, in metres: anything beyond is a typing error, not a map.
+inline constexpr core::Range kResolutionRange{1e-4, 1000};
+inline constexpr core::Range kOriginRange{-1e7, 1e7};
+
+// The keys of a map_server YAML file, with map_server's defaults.
+struct MapYaml {
+  std::filesystem::path image;  // as written: relative paths are relative to the YAML's folder
+  double resolution = 0.05;     // metres per cell
+  core::Pose2 origin;           // pose of the lower-left corner of the map
+  bool negate = false;
+  double occupied_thresh = 0.65;
+  double free_thresh = 0.196;
+  MapMode mode = MapMode::Trinary;
+};
+
+struct MapLoadOptions {
+  // Larger images are refused before they are decoded (64 M cells = 8000 x 8000).
+  std::int64_t max_cells = 64'000'000;
+  // A bare image has no YAML: it gets this resolution and origin (0, 0, 0).
+  double default_resolution = 0.05;
+  mapping::OccupancyGridOptions grid;
+};
+
+// Parses a map_server YAML text. `source` names it in errors. Unknown keys, missing `image` or
+// `resolution`, and bad values throw InputError naming the source, the key and its line.
+MapYaml parse_map_yaml(std::string_view text, const std::string& source);
+// The YAML text map_saver writes (the image path as given).
+std::string format_map_yaml(const MapYaml& yaml);
+
+// Decodes the bytes of a PNG or PGM map image, refusing images over `options.max_cells` from their
+// header before decoding. Returns 8-bit 1-4 channel pixels; throws InputError naming `source`.
+cv::Mat decode_map_image(const std::string& bytes, const std::string& source, const MapLoadOptions& options = {});
+// Builds a grid from a decoded image (8-bit, 1 to 4 channels) with map_server's rules.
+mapping::OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta,
+                              const mapping::OccupancyGridOptions& grid_options = {});
+// The map_saver image: 254 free, 0 occupied, 205 unknown, 8-bit single channel, top row first.
+cv::Mat grid_to_image(const mapping::OccupancyGrid& grid);
+
+// Loads a map from a map_server YAML (.yaml / .yml) or an image (PNG, PGM, ...).
+// Throws InputError naming the file for anything missing, unreadable, empty or too large.
+mapping::OccupancyGrid load_map(const std::filesystem::path& path, const MapLoadOptions& options = {});
+
+// The files load_map(path) reads: a map_server YAML and the image it names, or the image alone.
+// For checks that no output replaces an input; a YAML that cannot be read gives just itself.
+std::vector<std::filesystem::path> map_files(const std::filesystem::path& path);
+
+// The bytes of `image` in the format an extension names (".png", ".pgm"). Throws InputError
+// naming `what` when fleetmap cannot write that format for this image.
+std::string encode_image(const std::string& extension, const cv::Mat& image, const std::string& what);
+// Throws InputError (before any work) unless pictures can be written to `path`: a .png name, or
+// the standard output ("-", which gets PNG).
+void check_picture_path(const std::filesystem::path& path, const std::string& what);
+
+// Encodes `image` (extension picks the format) and writes it atomically.
+void write_image(const std::filesystem::path& path, const cv::Mat& image);
+// Saves the map_saver image of the grid as PNG or PGM (by extension).
+void save_map_image(const mapping::OccupancyGrid& grid, const std::filesystem::path& path);
+// Saves `<yaml_path stem>.pgm` beside the YAML and the YAML that map_server loads back.
+void save_map_yaml(const mapping::OccupancyGrid& grid, const std::filesystem::path& yaml_path);
+
+}  // namespace fleetmap::io

@@ -1,0 +1,336 @@
+#include "sweep/sweep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <set>
+
+#include "core/error.h"
+#include "io/file_io.h"
+#include "io/yaml_reader.h"
+
+namespace fleetmap::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+// Comma-separated items, trimmed; an empty item is an error.
+std::vector<std::string> split_list(const std::string& text, const std::string& what) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = text.find(',', start);
+    const std::string item = trim(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (item.empty()) throw InputError(what + ": empty item in the list '" + text + "'");
+    out.push_back(item);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+std::string join(const std::vector<std::string>& items, const char* sep = ", ") {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : sep) + s;
+  return out;
+}
+
+template <typename T>
+void check_unique(const std::vector<T>& items, const std::string& what) {
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (items[i] == items[j]) {
+        if constexpr (std::is_same_v<T, std::string>) throw InputError(what + ": '" + items[i] + "' is listed twice");
+        else throw InputError(what + ": " + std::to_string(items[i]) + " is listed twice");
+      }
+    }
+  }
+}
+
+// A list value of a sweep file: a YAML sequence or a comma-separated scalar, as one string.
+std::optional<std::string> list_text(io::YamlMap& m, const std::string& key) {
+  const auto node = m.node(key);
+  if (!node) return std::nullopt;
+  if (node->IsScalar()) return node->Scalar();
+  if (!node->IsSequence() || node->size() == 0) {
+    throw InputError(m.where(key) + ": expected a list such as [a, b] or 'a,b', got " + io::describe_node(*node));
+  }
+  std::vector<std::string> items;
+  for (const auto& item : *node) {
+    if (!item.IsScalar()) throw InputError(m.where(key) + ": expected a list of names or numbers, got " + io::describe_node(item));
+    items.push_back(item.Scalar());
+  }
+  return join(items, ",");
+}
+
+bool looks_like_file(const std::string& source) {
+  return source.find('/') != std::string::npos || fs::path(source).has_extension();
+}
+
+
+std::string number_text(double v) {
+  if (std::isinf(v)) return "inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+void use_base(Sweep& sweep, sim::Scenario base) {
+  if (base.placement == sim::Placement::List) base.placement = sim::Placement::Cluster, base.starts.clear();
+  sweep.base = std::move(base);
+}
+
+}  // namespace
+
+std::string map_label(const std::string& source) {
+  return looks_like_file(source) ? fs::path(source).stem().string() : source;
+}
+
+std::vector<std::string> parse_map_list(const std::string& text, const std::string& what) {
+  auto maps = split_list(text, what);
+  check_unique(maps, what);
+  return maps;
+}
+
+std::vector<std::string> parse_strategy_list(const std::string& text, const std::string& what) {
+  const auto valid = exploration::strategy_names();
+  if (trim(text) == "all") return valid;
+  auto names = split_list(text, what);
+  for (const auto& n : names) {
+    if (std::find(valid.begin(), valid.end(), n) == valid.end()) {
+      throw InputError(what + ": unknown strategy '" + n + "' (valid: " + join(valid) + ", or all)");
+    }
+  }
+  check_unique(names, what);
+  return names;
+}
+
+std::vector<int> parse_team_sizes(const std::string& text, const std::string& what) {
+  const auto whole = [&](const std::string& item, const std::string& part) {
+    const bool digits = !part.empty() && part.size() <= 3 && std::all_of(part.begin(), part.end(), [](char c) {
+      return c >= '0' && c <= '9';
+    });
+    const int v = digits ? std::stoi(part) : 0;
+    if (v < 1 || v > 64) {
+      throw InputError(what + ": team size '" + item + "': expected whole numbers from 1 to 64, e.g. 1,2,4,9 or 1-9");
+    }
+    return v;
+  };
+  std::vector<int> sizes;
+  for (const auto& item : split_list(text, what)) {
+    const auto dash = item.find('-', 1);
+    if (dash == std::string::npos) {
+      sizes.push_back(whole(item, item));
+      continue;
+    }
+    const int lo = whole(item, trim(item.substr(0, dash))), hi = whole(item, trim(item.substr(dash + 1)));
+    if (hi < lo) throw InputError(what + ": team sizes '" + item + "': the range runs backwards");
+    for (int n = lo; n <= hi; ++n) sizes.push_back(n);
+  }
+  check_unique(sizes, what);
+  return sizes;
+}
+
+double parse_comm_range(const std::string& text, const std::string& what) {
+  if (const auto v = core::parse_in_range(trim(text), sim::limits::kCommRange)) return *v;
+  throw InputError(what + ": expected " + core::expected_text(sim::limits::kCommRange) + ", got '" + text + "'");
+}
+
+Sweep parse_sweep(const std::string& text, const std::string& source, const fs::path& base_dir) {
+  const YAML::Node root = io::parse_yaml(text, source);
+  if (!root || root.IsNull()) throw InputError(source + ": empty sweep file");
+  io::YamlMap top(root, source);
+  Sweep sweep;
+  if (const auto scenario = top.node("scenario")) {
+    if (!scenario->IsScalar() || scenario->Scalar().empty()) {
+      throw InputError(top.where("scenario") + ": expected the path of a scenario file, got " + io::describe_node(*scenario));
+    }
+    fs::path p = scenario->Scalar();
+    if (p.is_relative()) p = base_dir / p;
+    if (!fs::is_regular_file(p)) throw InputError(top.where("scenario") + ": no scenario file '" + p.string() + "'");
+    use_base(sweep, sim::load_scenario(p));
+  }
+  if (const auto maps = list_text(top, "maps")) {
+    sweep.maps = parse_map_list(*maps, top.where("maps"));
+    for (auto& m : sweep.maps) {
+      // A file is relative to the sweep file; a built-in name stays a name unless such a file is there.
+      if (fs::path(m).is_relative() && (looks_like_file(m) || fs::is_regular_file(base_dir / m))) m = (base_dir / m).string();
+    }
+  }
+  if (const auto s = list_text(top, "strategies")) sweep.strategies = parse_strategy_list(*s, top.where("strategies"));
+  if (const auto r = list_text(top, "robots")) sweep.robots = parse_team_sizes(*r, top.where("robots"));
+  sweep.seeds = int(top.number("seeds", sweep.seeds, kSeedCountRange));
+  sweep.first_seed = top.seed("first_seed", sweep.first_seed);
+  sweep.base.steps = int(top.number("steps", sweep.base.steps, sim::limits::kSteps));
+  sweep.base.localization = top.text("localization", sweep.base.localization);
+  sweep.base.merging = top.choice("merging", sweep.base.merging, sim::merging_names());
+  if (const auto c = top.node("comm_range")) {
+    if (!c->IsScalar()) throw InputError(top.where("comm_range") + ": expected metres >= 0 or 'inf'");
+    sweep.base.communication.range_m = parse_comm_range(c->Scalar(), top.where("comm_range"));
+  }
+  sweep.base.range.max_range_m = top.number("sensor_range", sweep.base.range.max_range_m, sim::limits::kSensorRange);
+  top.finish();
+  try {
+    validate_sweep(sweep);
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  return sweep;
+}
+
+Sweep load_sweep(const fs::path& path) {
+  return parse_sweep(io::read_file(path, std::size_t{1} << 20), path.string(), path.parent_path());
+}
+
+void apply_overrides(Sweep& sweep, const SweepOverrides& f) {
+  if (f.scenario) {
+    if (!fs::is_regular_file(*f.scenario)) throw InputError("--scenario: no scenario file '" + *f.scenario + "'");
+    use_base(sweep, sim::load_scenario(*f.scenario));
+  }
+  if (f.maps) sweep.maps = parse_map_list(*f.maps, "--maps");
+  if (f.strategies) sweep.strategies = parse_strategy_list(*f.strategies, "--strategies");
+  if (f.robots) sweep.robots = parse_team_sizes(*f.robots, "--robots");
+  if (f.seeds) sweep.seeds = *f.seeds;
+  if (f.first_seed) sweep.first_seed = *f.first_seed;
+  if (f.steps) sweep.base.steps = *f.steps;
+  if (f.localization) sweep.base.localization = *f.localization;
+  if (f.merging) {
+    const auto names = sim::merging_names();
+    if (std::find(names.begin(), names.end(), *f.merging) == names.end()) {
+      throw InputError("--merging: unknown mode '" + *f.merging + "' (valid: " + join(names) + ")");
+    }
+    sweep.base.merging = *f.merging;
+  }
+  if (f.comm_range) sweep.base.communication.range_m = parse_comm_range(*f.comm_range, "--comm-range");
+  if (f.sensor_range) sweep.base.range.max_range_m = *f.sensor_range;
+}
+
+void validate_sweep(const Sweep& sweep) {
+  if (sweep.maps.empty()) throw InputError("maps: the sweep needs at least one map");
+  if (sweep.strategies.empty()) throw InputError("strategies: the sweep needs at least one strategy");
+  if (sweep.robots.empty()) throw InputError("robots: the sweep needs at least one team size");
+  if (!core::parse_in_range(std::to_string(sweep.seeds), kSeedCountRange)) {
+    throw InputError("seeds: expected " + core::expected_text(kSeedCountRange) + ", got " + std::to_string(sweep.seeds));
+  }
+  if (sweep.first_seed > std::numeric_limits<std::uint64_t>::max() - std::uint64_t(sweep.seeds - 1)) {
+    throw InputError("first_seed: " + std::to_string(sweep.first_seed) + " with " + std::to_string(sweep.seeds) +
+                     " seeds runs past the largest seed, 18446744073709551615");
+  }
+  check_unique(sweep.maps, "maps");
+  check_unique(sweep.strategies, "strategies");
+  check_unique(sweep.robots, "robots");
+  std::set<std::string> labels;
+  for (const auto& m : sweep.maps) {
+    if (!labels.insert(map_label(m)).second) throw InputError("maps: two maps are named '" + map_label(m) + "' (" + join(sweep.maps) + ")");
+    if (map_label(m).find_first_of(",\"\n") != std::string::npos) throw InputError("maps: '" + m + "': map names may not hold , or \"");
+  }
+  const auto valid = exploration::strategy_names();
+  for (const auto& s : sweep.strategies) {
+    if (std::find(valid.begin(), valid.end(), s) == valid.end()) {
+      throw InputError("strategies: unknown strategy '" + s + "' (valid: " + join(valid) + ", or all)");
+    }
+  }
+  for (int n : sweep.robots) {
+    if (n < 1 || n > 64) throw InputError("robots: team size " + std::to_string(n) + ": expected 1 to 64");
+  }
+  sim::Scenario probe = sweep.base;
+  probe.robot_count = sweep.robots.front();
+  probe.exploration.strategy = sweep.strategies.front();
+  sim::validate_scenario(probe);
+}
+
+std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file) {
+  std::string y = "# fleetmap bench sweep: run it again with `fleetmap bench --sweep FILE`\n";
+  std::vector<std::string> maps;
+  for (const auto& m : sweep.maps) maps.push_back(io::yaml_quoted(looks_like_file(m) && fs::exists(m) ? fs::absolute(m).lexically_normal().string() : m));
+  y += "maps: [" + join(maps) + "]\n";
+  y += "strategies: [" + join(sweep.strategies) + "]\n";
+  std::vector<std::string> robots;
+  for (int n : sweep.robots) robots.push_back(std::to_string(n));
+  y += "robots: [" + join(robots) + "]\n";
+  y += "seeds: " + std::to_string(sweep.seeds) + "\nfirst_seed: " + std::to_string(sweep.first_seed) + "\n";
+  if (!scenario_file.empty()) y += "scenario: " + io::yaml_quoted(scenario_file) + "\n";
+  y += "steps: " + std::to_string(sweep.base.steps) + "\n";
+  y += "localization: " + sweep.base.localization + "\n";
+  y += "merging: " + sweep.base.merging + "\n";
+  y += "comm_range: " + number_text(sweep.base.communication.range_m) + "\n";
+  y += "sensor_range: " + number_text(sweep.base.range.max_range_m) + "\n";
+  return y;
+}
+
+std::vector<SweepRun> sweep_runs(const Sweep& sweep) {
+  std::vector<SweepRun> runs;
+  for (const auto& map : sweep.maps) {
+    for (const auto& strategy : sweep.strategies) {
+      for (int robots : sweep.robots) {
+        for (int k = 0; k < sweep.seeds; ++k) {
+          runs.push_back({runs.size(), map_label(map), map, strategy, robots, sweep.first_seed + std::uint64_t(k)});
+        }
+      }
+    }
+  }
+  return runs;
+}
+
+sim::Scenario run_scenario(const Sweep& sweep, const SweepRun& run) {
+  sim::Scenario s = sweep.base;
+  s.map = run.map_source;
+  s.base_dir.clear();
+  s.exploration.strategy = run.strategy;
+  s.robot_count = run.robots;
+  s.seed = run.seed;
+  return s;
+}
+
+Shard parse_shard(const std::string& text) {
+  const auto slash = text.find('/');
+  const auto number = [](const std::string& part) {
+    if (part.empty() || part.size() > 6 || !std::all_of(part.begin(), part.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      return -1;
+    }
+    return std::stoi(part);
+  };
+  const int k = slash == std::string::npos ? -1 : number(text.substr(0, slash));
+  const int n = slash == std::string::npos ? -1 : number(text.substr(slash + 1));
+  if (k < 1 || n < 1 || k > n) {
+    throw InputError("--shard '" + text + "': expected K/N with 1 <= K <= N, e.g. 2/4 (the second of four slices)");
+  }
+  return {k, n};
+}
+
+std::vector<SweepRun> shard_runs(const std::vector<SweepRun>& runs, const Shard& shard) {
+  std::vector<SweepRun> out;
+  for (const auto& r : runs) {
+    if (int(r.index % std::size_t(shard.count)) == shard.index - 1) out.push_back(r);
+  }
+  return out;
+}
+
+std::string settings_id(const sim::Scenario& base) {
+  sim::Scenario s = base;
+  s.map.clear();
+  s.base_dir.clear();
+  s.seed = 0;
+  s.robot_count = 1;
+  s.exploration.strategy.clear();
+  if (s.placement == sim::Placement::List) s.placement = sim::Placement::Cluster, s.starts.clear();
+  const std::string text = sim::scenario_to_yaml(s);
+  std::uint64_t h = 1469598103934665603ull;  // FNV-1a, 64 bits
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+}  // namespace fleetmap::sweep

@@ -1,0 +1,100 @@
+#pragma once
+// A benchmark sweep: every combination of map x strategy x team size x seed, each run from one base
+// scenario with those four replaced. Defined by flags or a YAML sweep file (every key checked,
+// errors name the file, line and key); listed in a fixed order, and cut into shards for clusters.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/range.h"
+#include "exploration/strategy.h"
+#include "sim/scenario.h"
+
+namespace fleetmap::sweep {
+
+// Seeds per combination, and parallel runs, that a sweep accepts (the file and the flags alike).
+inline constexpr core::Range kSeedCountRange{1, 1'000'000, true};
+inline constexpr core::Range kJobsRange{1, 1024, true};
+
+struct Sweep {
+  // Built-in map names or map files (PNG/PGM/map_server YAML); a run's `map` is the label.
+  std::vector<std::string> maps = {"empty", "unstructured", "office", "corridor"};
+  std::vector<std::string> strategies = exploration::strategy_names();
+  std::vector<int> robots = {1, 2, 4, 9};
+  int seeds = 20;                 // seeds first_seed, first_seed + 1, ...
+  std::uint64_t first_seed = 1;
+  // Everything else: steps, sensors, localization, communication, ... Its map, strategy, robot
+  // count and seed are replaced per run; listed starts become a cluster of the run's team size.
+  sim::Scenario base;
+};
+
+// Flags given on the command line; each replaces the sweep file's value. Lists are as typed.
+struct SweepOverrides {
+  std::optional<std::string> maps, strategies, robots;
+  std::optional<int> seeds;
+  std::optional<std::uint64_t> first_seed;
+  std::optional<std::string> scenario;  // a scenario file: the base
+  std::optional<int> steps;
+  std::optional<std::string> localization;
+  std::optional<std::string> merging;     // known, rendezvous or overlap
+  std::optional<std::string> comm_range;  // metres, or "inf"
+  std::optional<double> sensor_range;
+};
+
+// The name a map goes by in results: a built-in name as is, a file by its stem ("maps/lab.png": "lab").
+std::string map_label(const std::string& source);
+
+// "a,b,c" lists; `what` names the input in errors ("--maps", "sweep.yaml:3: key 'maps'").
+std::vector<std::string> parse_map_list(const std::string& text, const std::string& what);
+// Strategy names or "all"; unknown names are errors listing the valid ones.
+std::vector<std::string> parse_strategy_list(const std::string& text, const std::string& what);
+// Team sizes: "1,2,4,9" or ranges "1-9"; each 1..64.
+std::vector<int> parse_team_sizes(const std::string& text, const std::string& what);
+// Metres >= 0, or "inf".
+double parse_comm_range(const std::string& text, const std::string& what);
+
+// Parses a sweep file. Keys: maps, strategies, robots, seeds, first_seed, scenario (a scenario file,
+// relative to the sweep file), steps, localization, merging, comm_range, sensor_range. Relative map
+// files are relative to `base_dir` (the sweep file's folder).
+Sweep parse_sweep(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
+Sweep load_sweep(const std::filesystem::path& path);
+// Applies flags over `sweep` (relative paths in flags are relative to the working directory).
+// Numbers are checked by the flags' own validators (the same ranges as the file's).
+void apply_overrides(Sweep& sweep, const SweepOverrides& flags);
+// Non-empty lists without repeats, distinct map labels, seeds >= 1, and a valid base scenario.
+void validate_sweep(const Sweep& sweep);
+// The sweep file that defines `sweep` with its base scenario in `scenario_file` (scenario_to_yaml;
+// "" for none: then only the base settings a sweep file has keys for are kept);
+// map files are written with absolute paths. Two sweeps are the same sweep when these texts are.
+std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file);
+
+struct SweepRun {
+  std::size_t index = 0;   // place in the sweep's order
+  std::string map;         // label
+  std::string map_source;  // as loaded
+  std::string strategy;
+  int robots = 1;
+  std::uint64_t seed = 1;
+};
+
+// Every run, in the fixed order map, strategy, team size, seed (seed varies fastest).
+std::vector<SweepRun> sweep_runs(const Sweep& sweep);
+// The scenario of one run: the base with map, strategy, robot count and seed replaced.
+sim::Scenario run_scenario(const Sweep& sweep, const SweepRun& run);
+
+// K-th of N slices (1 <= K <= N): runs whose index % N == K - 1, so every shard gets a similar mix.
+struct Shard {
+  int index = 1;
+  int count = 1;
+};
+// "K/N"; throws InputError naming --shard.
+Shard parse_shard(const std::string& text);
+std::vector<SweepRun> shard_runs(const std::vector<SweepRun>& runs, const Shard& shard);
+
+// 16 hex digits identifying every setting of the base but the map, strategy, robot count and seed:
+// runs with equal ids were run alike and may share one results table.
+std::string settings_id(const sim::Scenario& base);
+
+}  // namespace fleetmap::sweep

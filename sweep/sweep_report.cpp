@@ -1,0 +1,446 @@
+#include "sweep/sweep_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include "core/error.h"
+#include "io/file_io.h"
+#include "io/map_io.h"
+#include "viz/plot.h"
+
+namespace fleetmap::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::optional<double> optional_steps(const std::optional<int>& v) {
+  return v ? std::optional<double>(double(*v)) : std::nullopt;
+}
+
+std::string number(double v, int decimals) {
+  if (!std::isfinite(v)) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+// Full precision for CSV: the same records give the same text.
+std::string csv_number(double v) {
+  if (!std::isfinite(v)) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+
+std::string team_text(int robots) { return std::to_string(robots) + (robots == 1 ? " robot" : " robots"); }
+
+// Distinct values in order of first appearance.
+template <typename T, typename F>
+std::vector<T> distinct(const std::vector<RunRecord>& records, F get) {
+  std::vector<T> out;
+  for (const auto& r : records) {
+    const T v = get(r);
+    if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<std::string> maps_of(const std::vector<RunRecord>& r) {
+  return distinct<std::string>(r, [](const RunRecord& x) { return x.key.map; });
+}
+std::vector<std::string> strategies_of(const std::vector<RunRecord>& r) {
+  return distinct<std::string>(r, [](const RunRecord& x) { return x.key.strategy; });
+}
+std::vector<int> teams_of(const std::vector<RunRecord>& r) {
+  auto t = distinct<int>(r, [](const RunRecord& x) { return x.key.robots; });
+  std::sort(t.begin(), t.end());
+  return t;
+}
+
+viz::Color strategy_color(const std::vector<std::string>& strategies, const std::string& s) {
+  return viz::palette_color(int(std::find(strategies.begin(), strategies.end(), s) - strategies.begin()));
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+std::size_t metric_index(const std::string& name) {
+  const auto& m = report_metrics();
+  return std::size_t(std::find_if(m.begin(), m.end(), [&](const ReportMetric& x) { return x.name == name; }) - m.begin());
+}
+
+}  // namespace
+
+const std::vector<ReportMetric>& report_metrics() {
+  static const std::vector<ReportMetric> kMetrics = {
+      {"steps_to_95", "steps to 95%", false, 1, [](const RunRecord& r) { return optional_steps(r.steps_to_95); }},
+      {"steps_to_99", "steps to 99%", false, 1, [](const RunRecord& r) { return optional_steps(r.steps_to_99); }},
+      {"distance_m", "distance (m)", false, 1, [](const RunRecord& r) { return std::optional<double>(r.distance_m); }},
+      {"redundancy", "redundancy", false, 3, [](const RunRecord& r) { return std::optional<double>(r.redundancy); }},
+      {"bytes_sent", "bytes sent", false, 0, [](const RunRecord& r) { return std::optional<double>(double(r.bytes_sent)); }},
+      {"efficiency", "efficiency", true, 3, [](const RunRecord& r) { return r.efficiency; }},
+      {"coverage", "final coverage", true, 4, [](const RunRecord& r) { return std::optional<double>(r.coverage); }},
+  };
+  return kMetrics;
+}
+
+const ReportMetric& find_report_metric(const std::string& name, const std::string& what) {
+  std::vector<std::string> names;
+  for (const auto& m : report_metrics()) {
+    if (m.name == name) return m;
+    names.push_back(m.name);
+  }
+  throw InputError(what + ": unknown metric '" + name + "' (valid: " + join(names) + ")");
+}
+
+std::vector<GroupSummary> summarize_groups(const std::vector<RunRecord>& records) {
+  struct Group {
+    GroupSummary summary;
+    std::vector<std::vector<double>> values;
+  };
+  std::vector<Group> groups;
+  std::map<std::tuple<std::string, std::string, int>, std::size_t> index;
+  const auto& metrics = report_metrics();
+  for (const auto& r : records) {
+    const auto key = std::make_tuple(r.key.map, r.key.strategy, r.key.robots);
+    auto it = index.find(key);
+    if (it == index.end()) {
+      it = index.emplace(key, groups.size()).first;
+      Group g;
+      g.summary.map = r.key.map;
+      g.summary.strategy = r.key.strategy;
+      g.summary.robots = r.key.robots;
+      g.summary.lower_bound_min = g.summary.lower_bound_max = r.lower_bound_steps;
+      g.values.resize(metrics.size());
+      groups.push_back(std::move(g));
+    }
+    Group& g = groups[it->second];
+    ++g.summary.runs;
+    g.summary.lower_bound_min = std::min(g.summary.lower_bound_min, r.lower_bound_steps);
+    g.summary.lower_bound_max = std::max(g.summary.lower_bound_max, r.lower_bound_steps);
+    for (std::size_t m = 0; m < metrics.size(); ++m) {
+      if (const auto v = metrics[m].value(r)) g.values[m].push_back(*v);
+    }
+  }
+  std::vector<GroupSummary> out;
+  for (auto& g : groups) {
+    for (const auto& v : g.values) g.summary.metrics.push_back(summarize(v));
+    out.push_back(std::move(g.summary));
+  }
+  return out;
+}
+
+std::string summary_csv(const std::vector<GroupSummary>& groups) {
+  std::string text = "map,strategy,robots,runs,lower_bound_steps_min,lower_bound_steps_max";
+  for (const auto& m : report_metrics()) {
+    for (const char* part : {"_n", "_mean", "_sd", "_ci95_low", "_ci95_high"}) text += "," + m.name + part;
+  }
+  text += "\n";
+  for (const auto& g : groups) {
+    text += g.map + "," + g.strategy + "," + std::to_string(g.robots) + "," + std::to_string(g.runs) + "," +
+            std::to_string(g.lower_bound_min) + "," + std::to_string(g.lower_bound_max);
+    for (const auto& s : g.metrics) {
+      text += "," + std::to_string(s.n) + "," + csv_number(s.mean) + "," + csv_number(s.sd) + "," + csv_number(s.ci_low) +
+              "," + csv_number(s.ci_high);
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+std::string summary_markdown(const std::vector<RunRecord>& records, const std::vector<GroupSummary>& groups) {
+  const auto& metrics = report_metrics();
+  const auto maps = maps_of(records);
+  const auto strategies = strategies_of(records);
+  const auto teams = teams_of(records);
+  std::string md = "# Strategy sweep\n\n";
+  if (records.empty()) return md + "No runs yet.\n";
+  const auto seeds = distinct<std::uint64_t>(records, [](const RunRecord& r) { return r.key.seed; });
+  std::vector<std::string> team_texts;
+  for (int t : teams) team_texts.push_back(std::to_string(t));
+  const RunRecord& first = records.front();
+  char settings[256];
+  std::snprintf(settings, sizeof settings,
+                "localization %s, merging %s, communication range %s, sensor range %g m, step limit %d (settings %s)",
+                first.localization.c_str(), first.merging.c_str(), std::isinf(first.comm_range_m) ? "unlimited" : (number(first.comm_range_m, 1) + " m").c_str(),
+                first.sensor_range_m, first.step_limit, first.settings.c_str());
+  md += std::to_string(records.size()) + " runs: maps " + join(maps) + "; strategies " + join(strategies) +
+        "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) + (seeds.size() == 1 ? " seed. " : " seeds. ") + settings + ".\n\n";
+  md += "Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
+        "reached the level. **Bold**: the best strategy in the column for that map and team size (lowest; highest for "
+        "efficiency and coverage). Efficiency = lower bound / steps to 99% (README.md, \"Benchmarking strategies\").\n";
+  for (const auto& map : maps) {
+    md += "\n## " + map + "\n";
+    for (int team : teams) {
+      std::vector<const GroupSummary*> rows;
+      for (const auto& g : groups) {
+        if (g.map == map && g.robots == team) rows.push_back(&g);
+      }
+      if (rows.empty()) continue;
+      int lb_lo = rows.front()->lower_bound_min, lb_hi = rows.front()->lower_bound_max;
+      for (const auto* g : rows) lb_lo = std::min(lb_lo, g->lower_bound_min), lb_hi = std::max(lb_hi, g->lower_bound_max);
+      md += "\n### " + team_text(team) + " (lower bound " +
+            (lb_lo == lb_hi ? std::to_string(lb_lo) : std::to_string(lb_lo) + "-" + std::to_string(lb_hi)) +
+            " steps to 99%)\n\n| strategy | runs |";
+      for (const auto& m : metrics) md += " " + m.title + " |";
+      md += "\n|---|---:|";
+      for (std::size_t m = 0; m < metrics.size(); ++m) md += "---:|";
+      md += "\n";
+      // The best mean per column among rows with a value; ties are all marked.
+      std::vector<double> best(metrics.size(), std::nan(""));
+      for (std::size_t m = 0; m < metrics.size(); ++m) {
+        for (const auto* g : rows) {
+          const double v = g->metrics[m].mean;
+          if (!std::isfinite(v)) continue;
+          if (!std::isfinite(best[m]) || (metrics[m].higher_is_better ? v > best[m] : v < best[m])) best[m] = v;
+        }
+      }
+      // A column where every row shows the best value has no best.
+      std::vector<bool> all_tie(metrics.size(), true);
+      for (std::size_t m = 0; m < metrics.size(); ++m) {
+        for (const auto* g : rows) {
+          if (number(g->metrics[m].mean, metrics[m].decimals) != number(best[m], metrics[m].decimals)) all_tie[m] = false;
+        }
+      }
+      for (const auto* g : rows) {
+        md += "| " + g->strategy + " | " + std::to_string(g->runs) + " |";
+        for (std::size_t m = 0; m < metrics.size(); ++m) {
+          const SampleSummary& s = g->metrics[m];
+          std::string cell = "—";
+          if (s.n > 0) {
+            cell = number(s.mean, metrics[m].decimals);
+            if (s.n > 1) cell += " ± " + number(s.half_width(), metrics[m].decimals);
+            const bool is_best = !all_tie[m] && number(s.mean, metrics[m].decimals) == number(best[m], metrics[m].decimals);
+            if (is_best) cell = "**" + cell + "**";
+            if (s.n < g->runs) cell += " (" + std::to_string(s.n) + "/" + std::to_string(g->runs) + ")";
+          }
+          md += " " + cell + " |";
+        }
+        md += "\n";
+      }
+    }
+  }
+  return md;
+}
+
+StrategyComparison compare_strategies(const std::vector<RunRecord>& records, const std::string& a, const std::string& b,
+                                      const std::string& metric_name) {
+  const ReportMetric& metric = find_report_metric(metric_name, "--metric");
+  const auto strategies = strategies_of(records);
+  for (const auto& s : {a, b}) {
+    if (std::find(strategies.begin(), strategies.end(), s) == strategies.end()) {
+      throw InputError("--compare: no runs of strategy '" + s + "' in the results (strategies there: " +
+                       (strategies.empty() ? std::string("none") : join(strategies)) + ")");
+    }
+  }
+  if (a == b) throw InputError("--compare: give two different strategies, got '" + a + "' twice");
+  StrategyComparison c;
+  c.a = a;
+  c.b = b;
+  c.metric = metric.name;
+  c.higher_is_better = metric.higher_is_better;
+  // (map, robots, seed) -> values of a and b.
+  std::map<std::tuple<std::string, int, std::uint64_t>, std::pair<std::optional<double>, std::optional<double>>> pairs;
+  int runs = 0;
+  for (const auto& r : records) {
+    if (r.key.strategy != a && r.key.strategy != b) continue;
+    ++runs;
+    auto& p = pairs[{r.key.map, r.key.robots, r.key.seed}];
+    (r.key.strategy == a ? p.first : p.second) = metric.value(r);
+  }
+  struct Sample {
+    std::vector<double> a, b;
+  };
+  std::map<std::pair<std::string, int>, Sample> by_group;
+  std::map<std::string, Sample> by_map;
+  Sample all;
+  int paired = 0;
+  for (const auto& [key, p] : pairs) {
+    if (!p.first || !p.second) continue;
+    paired += 2;
+    for (Sample* s : {&by_group[{std::get<0>(key), std::get<1>(key)}], &by_map[std::get<0>(key)], &all}) {
+      s->a.push_back(*p.first);
+      s->b.push_back(*p.second);
+    }
+  }
+  c.unpaired = runs - paired;
+  for (const auto& map : maps_of(records)) {
+    for (int team : teams_of(records)) {
+      if (const auto it = by_group.find({map, team}); it != by_group.end()) {
+        c.rows.push_back({map, team, compare_paired(it->second.a, it->second.b)});
+      }
+    }
+  }
+  for (const auto& map : maps_of(records)) {
+    if (const auto it = by_map.find(map); it != by_map.end()) c.rows.push_back({map, 0, compare_paired(it->second.a, it->second.b)});
+  }
+  c.rows.push_back({"all", 0, compare_paired(all.a, all.b)});
+  return c;
+}
+
+std::string comparison_text(const StrategyComparison& c) {
+  const ReportMetric& metric = find_report_metric(c.metric, "metric");
+  const int d = std::max(metric.decimals, 2);
+  std::string t = "Paired comparison of " + c.metric + ": " + c.a + " - " + c.b + " over runs with the same map, team size and seed\n";
+  t += "(negative: " + c.a + "'s value is lower; " + (c.higher_is_better ? "higher" : "lower") +
+       " is better. The interval is the 95% confidence interval of the mean difference, p the two-sided paired t test)\n\n";
+  t += "| map | robots | pairs | mean difference | 95% CI | p | " + c.a + " better | " + c.b + " better | ties |\n";
+  t += "|---|---|---:|---:|---|---:|---:|---:|---:|\n";
+  for (const auto& row : c.rows) {
+    const auto& x = row.comparison;
+    const int a_better = c.higher_is_better ? x.b_lower : x.a_lower;
+    const int b_better = c.higher_is_better ? x.a_lower : x.b_lower;
+    char p[32] = "";
+    if (std::isfinite(x.p_value)) std::snprintf(p, sizeof p, x.p_value < 0.001 ? "%.1e" : "%.3f", x.p_value);
+    const std::string ci = x.difference.n > 1 ? "[" + number(x.difference.ci_low, d) + ", " + number(x.difference.ci_high, d) + "]" : "";
+    t += "| " + row.map + " | " + (row.robots > 0 ? std::to_string(row.robots) : std::string("all")) + " | " +
+         std::to_string(x.difference.n) + " | " + number(x.difference.mean, d) + " | " + ci + " | " + p + " | " +
+         std::to_string(a_better) + " | " + std::to_string(b_better) + " | " + std::to_string(x.ties) + " |\n";
+  }
+  if (c.unpaired > 0) {
+    t += "\n" + std::to_string(c.unpaired) + " runs had no partner with a value of " + c.metric +
+         " (the other strategy's run is missing, or a level was never reached) and were left out.\n";
+  }
+  return t;
+}
+
+std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records) {
+  std::vector<SweepPlot> plots;
+  if (records.empty()) return plots;
+  const auto maps = maps_of(records);
+  const auto strategies = strategies_of(records);
+  const auto teams = teams_of(records);
+  const auto groups = summarize_groups(records);
+  const std::size_t steps99 = metric_index("steps_to_99");
+
+  for (const auto& map : maps) {
+    // Coverage against step: one panel per team size.
+    std::vector<cv::Mat> panels;
+    for (int team : teams) {
+      std::vector<const RunRecord*> runs;
+      int last = 1;
+      for (const auto& r : records) {
+        if (r.key.map != map || r.key.robots != team) continue;
+        runs.push_back(&r);
+        last = std::max(last, r.steps_to_99 ? *r.steps_to_99 : r.steps);
+      }
+      if (runs.empty()) continue;
+      last = int(std::ceil(last * 1.05));
+      viz::LinePlot plot;
+      plot.title = map + ", " + team_text(team);
+      plot.x = {"step", 0.0, double(last), {}};
+      plot.y = {"coverage of the reachable free space (%)", 0.0, 100.0, {}};
+      for (const auto& strategy : strategies) {
+        std::vector<const RunRecord*> mine;
+        for (const auto* r : runs) {
+          if (r->key.strategy == strategy) mine.push_back(r);
+        }
+        if (mine.empty()) continue;
+        viz::PlotSeries s;
+        s.label = strategy;
+        s.color = strategy_color(strategies, strategy);
+        for (int step = 0; step <= last; ++step) {
+          std::vector<double> v;
+          for (const auto* r : mine) v.push_back(100.0 * coverage_at(*r, step));
+          const SampleSummary sum = summarize(v);
+          s.x.push_back(step);
+          s.y.push_back(sum.mean);
+          s.y_low.push_back(sum.n > 1 ? sum.ci_low : sum.mean);
+          s.y_high.push_back(sum.n > 1 ? sum.ci_high : sum.mean);
+        }
+        plot.series.push_back(std::move(s));
+      }
+      panels.push_back(viz::draw_line_plot(plot, {760, 500}));
+    }
+    plots.push_back({"coverage_" + map + ".png", viz::tile_images(panels, 2)});
+
+    // Steps to 99% against team size, with the lower bound.
+    viz::LinePlot time;
+    time.title = map + ": steps to 99% coverage (mean, 95% CI)";
+    time.x = {"robots", std::nullopt, std::nullopt, {}};
+    for (int team : teams) time.x.ticks.push_back(team);
+    time.y = {"steps", 0.0, std::nullopt, {}};
+    time.bands = false;
+    for (const auto& strategy : strategies) {
+      viz::PlotSeries s;
+      s.label = strategy;
+      s.color = strategy_color(strategies, strategy);
+      s.markers = true;
+      for (const auto& g : groups) {
+        if (g.map != map || g.strategy != strategy || g.metrics[steps99].n == 0) continue;
+        const SampleSummary& m = g.metrics[steps99];
+        s.x.push_back(g.robots);
+        s.y.push_back(m.mean);
+        s.y_low.push_back(m.n > 1 ? m.ci_low : m.mean);
+        s.y_high.push_back(m.n > 1 ? m.ci_high : m.mean);
+      }
+      if (!s.x.empty()) time.series.push_back(std::move(s));
+    }
+    viz::PlotSeries bound;
+    bound.label = "lower bound";
+    bound.color = {90, 90, 90};
+    for (int team : teams) {
+      int lb = -1;
+      for (const auto& g : groups) {
+        if (g.map == map && g.robots == team) lb = std::max(lb, g.lower_bound_max);
+      }
+      if (lb < 0) continue;
+      bound.x.push_back(team);
+      bound.y.push_back(lb);
+    }
+    time.series.push_back(std::move(bound));
+    plots.push_back({"time_" + map + ".png", viz::draw_line_plot(time)});
+  }
+
+  // Efficiency per strategy, on each map and on all maps.
+  viz::BarChart bars;
+  bars.title = "efficiency = lower bound / steps to 99% (mean over team sizes and seeds, 95% CI)";
+  bars.y_label = "efficiency";
+  bars.groups = maps;
+  bars.groups.push_back("all maps");
+  for (const auto& strategy : strategies) {
+    bars.series_labels.push_back(strategy);
+    bars.colors.push_back(strategy_color(strategies, strategy));
+    std::vector<double> mean, low, high;
+    for (std::size_t g = 0; g < bars.groups.size(); ++g) {
+      std::vector<double> v;
+      for (const auto& r : records) {
+        if (r.key.strategy == strategy && (g == maps.size() || r.key.map == maps[g]) && r.efficiency) v.push_back(*r.efficiency);
+      }
+      const SampleSummary s = summarize(v);
+      mean.push_back(s.mean);
+      low.push_back(s.ci_low);
+      high.push_back(s.ci_high);
+    }
+    bars.values.push_back(mean);
+    bars.low.push_back(low);
+    bars.high.push_back(high);
+  }
+  plots.push_back({"efficiency.png", viz::draw_bar_chart(bars, {std::max(900, 160 * int(bars.groups.size()) + 300), 560})});
+  return plots;
+}
+
+std::vector<fs::path> write_sweep_reports(const fs::path& dir, const std::vector<RunRecord>& records) {
+  io::ensure_directory(dir);
+  std::vector<fs::path> written;
+  const auto groups = summarize_groups(records);
+  io::write_file_atomic(dir / "summary.csv", summary_csv(groups));
+  written.push_back(dir / "summary.csv");
+  io::write_file_atomic(dir / "summary.md", summary_markdown(records, groups));
+  written.push_back(dir / "summary.md");
+  for (const auto& plot : sweep_plots(records)) {
+    if (plot.image.empty()) continue;
+    io::write_image(dir / plot.file, plot.image);
+    written.push_back(dir / plot.file);
+  }
+  return written;
+}
+
+}  // namespace fleetmap::sweep

@@ -1,0 +1,81 @@
+#pragma once
+// What a sweep's results.csv becomes: per map x strategy x team size the mean, standard deviation
+// and 95% confidence interval of each metric (summary.csv, summary.md with the best per column
+// marked), plots, and the paired comparison of two strategies. Everything is computed from the
+// records alone, so a combined set of shards gives the same reports as one run of the sweep.
+#include <opencv2/core/mat.hpp>
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sweep/statistics.h"
+#include "sweep/sweep_results.h"
+
+namespace fleetmap::sweep {
+
+struct ReportMetric {
+  std::string name;   // column in results.csv
+  std::string title;  // in tables
+  bool higher_is_better = false;
+  int decimals = 1;   // in summary.md
+  // nullopt leaves the run out of this metric (e.g. steps_to_99 of a run that never reached 99%).
+  std::function<std::optional<double>(const RunRecord&)> value;
+};
+
+// steps_to_95, steps_to_99, distance_m, redundancy, bytes_sent, efficiency, coverage.
+const std::vector<ReportMetric>& report_metrics();
+// Throws InputError naming `what` and listing the metric names.
+const ReportMetric& find_report_metric(const std::string& name, const std::string& what);
+
+struct GroupSummary {
+  std::string map, strategy;
+  int robots = 0;
+  int runs = 0;
+  std::vector<SampleSummary> metrics;  // in the order of report_metrics()
+  int lower_bound_min = 0, lower_bound_max = 0;  // lower_bound_steps over the group's runs
+};
+
+// Groups in the order their first record appears (records in sweep order give the sweep's order).
+std::vector<GroupSummary> summarize_groups(const std::vector<RunRecord>& records);
+
+std::string summary_csv(const std::vector<GroupSummary>& groups);
+std::string summary_markdown(const std::vector<RunRecord>& records, const std::vector<GroupSummary>& groups);
+
+struct PairedRow {
+  std::string map;  // "all" for every map
+  int robots = 0;   // 0 for every team size
+  PairedComparison comparison;
+};
+
+struct StrategyComparison {
+  std::string a, b, metric;
+  bool higher_is_better = false;
+  std::vector<PairedRow> rows;  // per map x team size, then per map, then overall
+  int unpaired = 0;             // runs of a or b without a partner holding the metric
+};
+
+// Pairs runs of strategies a and b with the same map, team size and seed; differences are a - b.
+// Throws InputError when a strategy has no runs (naming the strategies present) or a == b.
+StrategyComparison compare_strategies(const std::vector<RunRecord>& records, const std::string& a, const std::string& b,
+                                      const std::string& metric);
+// A readable table of the comparison.
+std::string comparison_text(const StrategyComparison& comparison);
+
+struct SweepPlot {
+  std::string file;  // e.g. "coverage_office.png"
+  cv::Mat image;
+};
+
+// coverage_<map>.png (coverage against step, a panel per team size, a curve per strategy: the mean
+// over seeds with its 95% confidence band), time_<map>.png (steps to 99% against team size, with
+// the lower bound) and efficiency.png (mean efficiency per strategy on each map and on all).
+std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records);
+
+// Writes summary.csv, summary.md and the plots into `dir` (each atomically); returns the files.
+std::vector<std::filesystem::path> write_sweep_reports(const std::filesystem::path& dir,
+                                                       const std::vector<RunRecord>& records);
+
+}  // namespace fleetmap::sweep

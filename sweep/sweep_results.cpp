@@ -1,0 +1,412 @@
+#include "sweep/sweep_results.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <sstream>
+
+#include "core/error.h"
+#include "io/file_io.h"
+#include "sweep/lower_bound.h"
+#include "sim/run_output.h"
+
+namespace fleetmap::sweep {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::vector<std::string>& columns() {
+  static const std::vector<std::string> kColumns = {
+      "map", "strategy", "robots", "seed", "localization", "merging", "comm_range_m", "sensor_range_m", "step_limit", "settings",
+      "steps", "finished", "coverage", "steps_to_95", "steps_to_99", "distance_m", "redundancy", "bytes_sent",
+      "meetings", "merges_made", "blocked_moves", "position_rmse_m", "lower_bound_steps", "lower_bound_travel_steps",
+      "lower_bound_area_steps", "efficiency", "wall_time_s", "steps_to_percent"};
+  return kColumns;
+}
+
+std::string fixed(double v, int decimals) {
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+std::string optional_int(const std::optional<int>& v) { return v ? std::to_string(*v) : ""; }
+
+std::string levels_text(const std::vector<std::optional<int>>& levels) {
+  std::string out;
+  for (std::size_t k = 0; k < levels.size(); ++k) {
+    if (k) out += ' ';
+    out += levels[k] ? std::to_string(*levels[k]) : std::string("-");
+  }
+  return out;
+}
+
+std::vector<std::string> split_fields(const std::string& line) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = line.find(',', start);
+    out.push_back(line.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
+  }
+}
+
+// Parses the fields of one row; every error names the line and the column.
+struct FieldReader {
+  const std::vector<std::string>& fields;
+  const std::string& where;
+  std::size_t next = 0;
+
+  [[noreturn]] void fail(const std::string& expected) const {
+    throw InputError(where + ": column '" + columns()[next - 1] + "': expected " + expected + ", got '" + fields[next - 1] + "'");
+  }
+  const std::string& text() { return fields[next++]; }
+  long long integer(long long lo = std::numeric_limits<long long>::min()) {
+    const std::string& t = text();
+    try {
+      std::size_t used = 0;
+      const long long v = std::stoll(t, &used);
+      if (used == t.size() && v >= lo) return v;
+    } catch (const std::exception&) {
+    }
+    fail("a whole number");
+  }
+  std::uint64_t unsigned_integer() {
+    const std::string& t = text();
+    if (!t.empty() && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+      try {
+        return std::stoull(t);
+      } catch (const std::exception&) {
+      }
+    }
+    fail("a whole number >= 0");
+  }
+  std::optional<int> optional_integer() {
+    if (fields[next].empty()) return ++next, std::nullopt;
+    return int(integer(0));
+  }
+  double number() {
+    const std::string& t = text();
+    if (t == "inf") return std::numeric_limits<double>::infinity();
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(t, &used);
+      if (used == t.size() && std::isfinite(v)) return v;
+    } catch (const std::exception&) {
+    }
+    fail("a number");
+  }
+  std::optional<double> optional_number() {
+    if (fields[next].empty()) return ++next, std::nullopt;
+    return number();
+  }
+  bool boolean() {
+    const std::string& t = text();
+    if (t == "true" || t == "false") return t == "true";
+    fail("true or false");
+  }
+  std::vector<std::optional<int>> levels() {
+    const std::string& t = text();
+    std::vector<std::optional<int>> out;
+    std::istringstream in(t);
+    std::string item;
+    while (in >> item) {
+      if (item == "-") {
+        out.emplace_back();
+        continue;
+      }
+      try {
+        std::size_t used = 0;
+        const int v = std::stoi(item, &used);
+        if (used != item.size() || v < 0) fail(std::to_string(kCoverageLevels) + " steps or '-' separated by spaces");
+        out.push_back(v);
+      } catch (const InputError&) {
+        throw;
+      } catch (const std::exception&) {
+        fail(std::to_string(kCoverageLevels) + " steps or '-' separated by spaces");
+      }
+    }
+    if (out.size() != std::size_t(kCoverageLevels)) fail(std::to_string(kCoverageLevels) + " steps or '-' separated by spaces");
+    return out;
+  }
+};
+
+std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+std::string errno_text() { return std::strerror(errno); }
+
+}  // namespace
+
+RunRecord make_record(const sim::RunResult& result, const sim::World& world, const std::string& map_label,
+                      const std::string& settings, double wall_time_s) {
+  const sim::Scenario& s = result.scenario;
+  const nlohmann::json m = sim::metrics_json(result, map_label);
+  RunRecord r;
+  r.key = {map_label, s.exploration.strategy, s.robot_count, s.seed};
+  r.localization = s.localization;
+  r.merging = s.merging;
+  r.comm_range_m = s.communication.range_m;
+  r.sensor_range_m = s.range.max_range_m;
+  r.step_limit = s.steps;
+  r.settings = settings;
+  r.steps = m["steps"].get<int>();
+  r.finished = m["finished"].get<bool>();
+  r.coverage = m["coverage"].get<double>();
+  if (!m["steps_to_95"].is_null()) r.steps_to_95 = m["steps_to_95"].get<int>();
+  if (!m["steps_to_99"].is_null()) r.steps_to_99 = m["steps_to_99"].get<int>();
+  r.distance_m = m["distance_m"].get<double>();
+  r.redundancy = m["redundancy"].get<double>();
+  r.bytes_sent = m["bytes_sent"].get<std::int64_t>();
+  r.meetings = m["meetings"].get<int>();
+  r.merges_made = m["merges_made"].get<int>();
+  r.blocked_moves = m["blocked_moves"].get<int>();
+  r.position_rmse_m = m["position_rmse_m"].get<double>();
+
+  std::vector<Eigen::Vector2d> starts;
+  for (const auto& t : result.robots) starts.push_back(t.truth.front().position());
+  LowerBoundOptions lb_options;
+  lb_options.coverage = 0.99;
+  lb_options.sensor_range_m = s.range.max_range_m;
+  lb_options.step_length_m = s.robot.max_speed_mps * s.period_s;
+  const ExplorationLowerBound lb = exploration_lower_bound(world, starts, lb_options);
+  r.lower_bound_steps = lb.steps();
+  r.lower_bound_travel_steps = lb.travel_steps;
+  r.lower_bound_area_steps = lb.area_steps;
+  r.efficiency = exploration_efficiency(lb.steps(), r.steps_to_99);
+
+  // The same rule as steps_to_95 / steps_to_99: the first step whose coverage reaches the level.
+  r.steps_to_percent.assign(std::size_t(kCoverageLevels), std::nullopt);
+  const auto& curve = m["coverage_curve"];
+  std::size_t level = 0;
+  for (std::size_t step = 0; step < curve.size() && level < r.steps_to_percent.size(); ++step) {
+    const double c = curve[step].get<double>();
+    while (level < r.steps_to_percent.size() && c >= double(level + 1) / 100.0) r.steps_to_percent[level++] = int(step);
+  }
+  r.wall_time_s = wall_time_s;
+  return r;
+}
+
+double coverage_at(const RunRecord& r, int step) {
+  if (step >= r.steps) return r.coverage;
+  int level = 0;
+  while (level < int(r.steps_to_percent.size()) && r.steps_to_percent[std::size_t(level)] &&
+         *r.steps_to_percent[std::size_t(level)] <= step) {
+    ++level;
+  }
+  return level / 100.0;
+}
+
+std::string results_header() {
+  std::string h;
+  for (const auto& c : columns()) h += (h.empty() ? "" : ",") + c;
+  return h;
+}
+
+std::string format_record(const RunRecord& r) {
+  std::string line = record_without_wall_time(r);
+  const auto cut = line.rfind(',');  // before steps_to_percent
+  return line.substr(0, cut) + "," + fixed(r.wall_time_s, 3) + line.substr(cut);
+}
+
+std::string record_without_wall_time(const RunRecord& r) {
+  const std::vector<std::string> f = {r.key.map,
+                                      r.key.strategy,
+                                      std::to_string(r.key.robots),
+                                      std::to_string(r.key.seed),
+                                      r.localization,
+                                      r.merging,
+                                      std::isinf(r.comm_range_m) ? "inf" : fixed(r.comm_range_m, 3),
+                                      fixed(r.sensor_range_m, 3),
+                                      std::to_string(r.step_limit),
+                                      r.settings,
+                                      std::to_string(r.steps),
+                                      r.finished ? "true" : "false",
+                                      fixed(r.coverage, 6),
+                                      optional_int(r.steps_to_95),
+                                      optional_int(r.steps_to_99),
+                                      fixed(r.distance_m, 3),
+                                      fixed(r.redundancy, 6),
+                                      std::to_string(r.bytes_sent),
+                                      std::to_string(r.meetings),
+                                      std::to_string(r.merges_made),
+                                      std::to_string(r.blocked_moves),
+                                      fixed(r.position_rmse_m, 6),
+                                      std::to_string(r.lower_bound_steps),
+                                      std::to_string(r.lower_bound_travel_steps),
+                                      std::to_string(r.lower_bound_area_steps),
+                                      r.efficiency ? fixed(*r.efficiency, 6) : "",
+                                      levels_text(r.steps_to_percent)};
+  std::string line;
+  for (const auto& s : f) line += (line.empty() ? "" : ",") + s;
+  return line;
+}
+
+RunRecord parse_record(const std::string& line, const std::string& where) {
+  const auto fields = split_fields(line);
+  if (fields.size() != columns().size()) {
+    throw InputError(where + ": expected " + std::to_string(columns().size()) + " columns, found " + std::to_string(fields.size()));
+  }
+  FieldReader in{fields, where};
+  RunRecord r;
+  r.key.map = in.text();
+  r.key.strategy = in.text();
+  r.key.robots = int(in.integer(1));
+  r.key.seed = in.unsigned_integer();
+  r.localization = in.text();
+  r.merging = in.text();
+  r.comm_range_m = in.number();
+  r.sensor_range_m = in.number();
+  r.step_limit = int(in.integer(1));
+  r.settings = in.text();
+  r.steps = int(in.integer(0));
+  r.finished = in.boolean();
+  r.coverage = in.number();
+  r.steps_to_95 = in.optional_integer();
+  r.steps_to_99 = in.optional_integer();
+  r.distance_m = in.number();
+  r.redundancy = in.number();
+  r.bytes_sent = in.integer(0);
+  r.meetings = int(in.integer(0));
+  r.merges_made = int(in.integer(0));
+  r.blocked_moves = int(in.integer(0));
+  r.position_rmse_m = in.number();
+  r.lower_bound_steps = int(in.integer(0));
+  r.lower_bound_travel_steps = int(in.integer(0));
+  r.lower_bound_area_steps = int(in.integer(0));
+  r.efficiency = in.optional_number();
+  r.wall_time_s = in.number();
+  r.steps_to_percent = in.levels();
+  if (r.key.map.empty() || r.key.strategy.empty()) throw InputError(where + ": empty map or strategy");
+  return r;
+}
+
+ResultsTable read_results(const fs::path& path) {
+  const std::string text = io::read_file(path);
+  ResultsTable table;
+  const std::string name = path.string();
+  if (first_line(text) != results_header()) {
+    throw InputError(name + ":1: not a results table of this fleetmap bench (its columns differ: written by another "
+                            "version or another program); use another --out");
+  }
+  std::map<RunKey, std::pair<std::size_t, int>> seen;  // key -> (record index, line)
+  std::size_t pos = text.find('\n');
+  int line_no = 1;
+  while (pos != std::string::npos && pos + 1 < text.size()) {
+    const std::size_t begin = pos + 1;
+    pos = text.find('\n', begin);
+    ++line_no;
+    if (pos == std::string::npos) {
+      table.partial_last_line = true;  // a row cut short: not a row
+      break;
+    }
+    const std::string line = text.substr(begin, pos - begin);
+    if (line.empty()) continue;
+    const std::string where = name + ":" + std::to_string(line_no);
+    RunRecord r = parse_record(line, where);
+    if (const auto it = seen.find(r.key); it != seen.end()) {
+      if (record_without_wall_time(table.records[it->second.first]) != record_without_wall_time(r)) {
+        throw InputError(where + ": the run of line " + std::to_string(it->second.second) + " again, with other results");
+      }
+      continue;
+    }
+    seen.emplace(r.key, std::make_pair(table.records.size(), line_no));
+    table.records.push_back(std::move(r));
+  }
+  return table;
+}
+
+void check_settings(const std::vector<RunRecord>& records, const std::string& settings, const fs::path& path) {
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const auto& r = records[i];
+    if (r.settings == settings) continue;
+    throw InputError(path.string() + ": the run " + r.key.map + "/" + r.key.strategy + "/" + std::to_string(r.key.robots) +
+                     " robots/seed " + std::to_string(r.key.seed) + " is from a sweep with other settings (settings " +
+                     r.settings + ", this sweep " + settings + "; its localization " + r.localization + ", step limit " +
+                     std::to_string(r.step_limit) + "): use another --out, or the same settings");
+  }
+}
+
+ResultsAppender::ResultsAppender(const fs::path& path) : path_(path) {
+  if (!path.parent_path().empty()) io::ensure_directory(path.parent_path());
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw Error(path.string() + ": cannot open for appending: " + errno_text());
+  try {
+    prepare();
+  } catch (...) {
+    ::close(fd_);
+    fd_ = -1;
+    throw;
+  }
+}
+
+void ResultsAppender::prepare() {
+  const fs::path& path = path_;
+  struct stat st {};
+  if (::fstat(fd_, &st) != 0) throw Error(path.string() + ": cannot read its size: " + errno_text());
+  std::string text;
+  if (st.st_size > 0) {
+    text = io::read_file(path);
+    if (first_line(text) != results_header()) {
+      throw InputError(path.string() + ":1: not a results table of this fleetmap bench; use another --out");
+    }
+    // A row cut short (the machine stopped inside a write) is dropped, so appends start on a new line.
+    const auto last_newline = text.rfind('\n');
+    if (last_newline + 1 != text.size() && ::ftruncate(fd_, off_t(last_newline + 1)) != 0) {
+      throw Error(path.string() + ": cannot cut off a partial row: " + errno_text());
+    }
+  }
+  if (::lseek(fd_, 0, SEEK_END) < 0) throw Error(path.string() + ": cannot seek: " + errno_text());
+  if (st.st_size == 0) {
+    const std::string header = results_header() + "\n";
+    if (::write(fd_, header.data(), header.size()) != ssize_t(header.size()) || ::fsync(fd_) != 0) {
+      throw Error(path.string() + ": cannot write the header: " + errno_text());
+    }
+  }
+}
+
+ResultsAppender::~ResultsAppender() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void ResultsAppender::append(const RunRecord& record) {
+  const std::string line = format_record(record) + "\n";
+  // One write of the whole line: a reader (or a rerun after a kill) sees the row whole or not at all.
+  const ssize_t n = ::write(fd_, line.data(), line.size());
+  if (n != ssize_t(line.size())) {
+    const std::string why = n < 0 ? errno_text() : "short write";
+    if (n > 0) (void)::ftruncate(fd_, ::lseek(fd_, 0, SEEK_END) - n);  // take the partial row back
+    throw Error(path_.string() + ": cannot append a row: " + why);
+  }
+  if (::fsync(fd_) != 0) throw Error(path_.string() + ": cannot flush a row to disk: " + errno_text());
+}
+
+void sort_records(std::vector<RunRecord>& records, const std::vector<SweepRun>& runs) {
+  std::map<RunKey, std::size_t> order;
+  for (const auto& r : runs) order.emplace(RunKey{r.map, r.strategy, r.robots, r.seed}, r.index);
+  const auto rank = [&](const RunRecord& r) {
+    const auto it = order.find(r.key);
+    return it == order.end() ? std::numeric_limits<std::size_t>::max() : it->second;
+  };
+  std::stable_sort(records.begin(), records.end(), [&](const RunRecord& a, const RunRecord& b) {
+    const auto ra = rank(a), rb = rank(b);
+    return ra != rb ? ra < rb : a.key < b.key;
+  });
+}
+
+void write_results(const fs::path& path, const std::vector<RunRecord>& records) {
+  std::string text = results_header() + "\n";
+  for (const auto& r : records) text += format_record(r) + "\n";
+  io::write_file_atomic(path, text);
+}
+
+}  // namespace fleetmap::sweep

@@ -1,0 +1,139 @@
+#include "experiments/slam_experiment.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "experiments/slam_output.h"
+#include "tests/test_support.h"
+
+namespace fleetmap::experiments {
+namespace {
+
+using fleetmap::testing::expect_input_error;
+
+// One robot driving a loop in a 6 x 4 m room; everything exact (no process, sensor or camera
+// noise; walls on cell boundaries, so the ray casts are exact too).
+SlamScenario noise_free_rectangle() {
+  SlamScenario s;
+  s.room.boundary = {{0.0, 0.0}, {6.0, 0.0}, {6.0, 4.0}, {0.0, 4.0}};
+  s.robots.push_back({"a", core::Pose2(1.0, 1.0, 0.0), {{5.0, 1.0}, {5.0, 3.0}, {1.0, 3.0}, {1.0, 1.2}}, 0.1});
+  s.steps = 150;
+  s.runs = 1;
+  s.noise = {0.0, 0.0};
+  s.range.angles_rad = {-1.5707963267948966, -0.7853981633974483, 0.0, 0.7853981633974483, 1.5707963267948966};
+  s.range.max_range_m = 3.0;
+  s.range.noise_m = 0.0;
+  s.camera.range_noise_m = 0.0;
+  s.camera.bearing_noise_rad = 0.0;
+  s.polynomial.range_noise = 0.005;       // the filter's V
+  s.polynomial.cluster_tolerance = 0.001;  // 3 sigma of exact readings
+  return s;
+}
+
+SlamScenario dalfonso() {
+  return load_slam_scenario(std::string(FLEETMAP_SOURCE_DIR) + "/scenarios/dalfonso_3robots.yaml");
+}
+
+int index_of(const SlamScenario& s, const std::string& name) {
+  for (std::size_t i = 0; i < s.robots.size(); ++i) {
+    if (s.robots[i].name == name) return int(i);
+  }
+  return -1;
+}
+
+TEST(SlamExperiment, NoiseFreeRunMapsARectangularRoom) {
+  const SlamSetup setup = prepare_slam(noise_free_rectangle());
+  const SlamRunResult run = run_slam(setup, 0, true);
+  ASSERT_EQ(run.robots.size(), 1u);
+  const SlamRobotResult& r = run.robots[0];
+  EXPECT_EQ(r.truth.size(), 151u);
+  // nu as seed 000 defines it (each polynomial's distances summed), and its per-point mean.
+  EXPECT_LT(r.mapping.nu, 0.05);
+  EXPECT_LT(r.mapping.mean_distance, 0.001);
+  EXPECT_GE(r.polynomials, 4);
+  EXPECT_GT(r.boundary_coverage, 0.6);
+  EXPECT_LT(r.localization.position_rmse, 0.001);
+}
+
+TEST(SlamExperiment, RendezvousMapsMoreOfTheRoomForR3ThanItsSingleRobotRun) {
+  const SlamScenario s = dalfonso();
+  const SlamSetup setup = prepare_slam(s);
+  const int r3 = index_of(s, "r3"), r2 = index_of(s, "r2");
+  const SlamRunResult team = run_slam(setup, 0, true);
+  const SlamRunResult alone = run_slam(setup, 0, false, r3);
+  ASSERT_EQ(alone.robots.size(), 1u);
+  EXPECT_EQ(alone.robots[0].name, "r3");
+  EXPECT_GT(team.robots[std::size_t(r3)].boundary_coverage, alone.robots[0].boundary_coverage + 0.05);
+  EXPECT_GT(team.robots[std::size_t(r3)].polynomials, alone.robots[0].polynomials);
+  // Only r2 and r3 meet; each sends the other its polynomials, far fewer bytes than the grid patch.
+  ASSERT_FALSE(team.rendezvous.empty());
+  for (const auto& m : team.rendezvous) {
+    EXPECT_TRUE((m.sender == r2 && m.receiver == r3) || (m.sender == r3 && m.receiver == r2));
+    if (m.polynomials > 0) {
+      EXPECT_LT(m.bytes, m.grid_bytes);
+    }
+  }
+  EXPECT_TRUE(alone.rendezvous.empty());
+}
+
+TEST(SlamExperiment, RunsAreReproducibleAndShareTheirNoiseWithTheSingleRobotRun) {
+  const SlamScenario s = dalfonso();
+  const SlamSetup setup = prepare_slam(s);
+  const int r3 = index_of(s, "r3");
+  const SlamRunResult a = run_slam(setup, 3, true);
+  const SlamRunResult b = run_slam(setup, 3, true);
+  const SlamRunResult other = run_slam(setup, 4, true);
+  const SlamRunResult alone = run_slam(setup, 3, false, r3);
+  for (std::size_t i = 0; i < a.robots.size(); ++i) {
+    EXPECT_EQ(a.robots[i].estimate, b.robots[i].estimate);
+    EXPECT_EQ(a.robots[i].mapping.nu, b.robots[i].mapping.nu);
+  }
+  EXPECT_NE(a.robots[0].truth.back(), other.robots[0].truth.back());
+  EXPECT_EQ(a.robots[std::size_t(r3)].truth, alone.robots[0].truth);
+}
+
+TEST(SlamExperiment, PrecomputedCommandsFollowThePath) {
+  const std::vector<Eigen::Vector2d> path = {{3.0, 0.0}, {3.0, 2.0}};
+  const auto commands = path_commands(core::Pose2(), path, 0.2, 60, 1.0, 1.5707963267948966);
+  core::Pose2 pose;
+  for (const auto& u : commands) pose = localization::integrate_motion(pose, u);
+  EXPECT_LT((pose.position() - path.back()).norm(), 0.15);
+  EXPECT_EQ(commands.back().v, 0.0);  // stopped at the end
+}
+
+TEST(SlamExperiment, PathsThroughWallsAreRefused) {
+  SlamScenario s = noise_free_rectangle();
+  s.robots[0].path = {{8.0, 1.0}};
+  expect_input_error([&] { prepare_slam(s); }, {"robots.team[0] (a)", "path", "wall"});
+  s = noise_free_rectangle();
+  s.robots[0].start = core::Pose2(0.1, 1.0, 0.0);
+  expect_input_error([&] { prepare_slam(s); }, {"robots.team[0] (a)", "start"});
+}
+
+TEST(SlamExperiment, OutputsTableAndFigures) {
+  const SlamScenario s = dalfonso();
+  SlamSetup setup = prepare_slam(s);
+  SlamCampaign c;
+  c.team = {run_slam(setup, 0, true), run_slam(setup, 1, true)};
+  c.alone = {run_slam(setup, 0, false, index_of(s, "r3"))};
+  const std::string md = slam_table_markdown(setup, c, true);
+  EXPECT_NE(md.find("| index | r1 | r2 | r3 | r3 alone |"), std::string::npos) << md;
+  EXPECT_NE(md.find("mu, seed 000 Table 1 | 1.66e-06"), std::string::npos) << md;
+  EXPECT_NE(md.find("times as many"), std::string::npos) << md;
+  const std::string csv = slam_table_csv(setup, c);
+  EXPECT_NE(csv.find("nu_m,r3,alone,"), std::string::npos);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 9 * 4);
+  const MeanStd m = mean_std({1.0, 2.0, 3.0});
+  EXPECT_DOUBLE_EQ(m.mean, 2.0);
+  EXPECT_DOUBLE_EQ(m.std, 1.0);
+  fleetmap::testing::TempDir dir;
+  const auto files = write_slam_outputs(setup, c, dir.path(), true);
+  for (const char* name : {"table1.md", "table1.csv", "runs.csv", "rendezvous.csv", "map_r1.png", "map_r3_alone.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / name)) << name;
+  }
+  EXPECT_EQ(files.size(), 8u);
+}
+
+}  // namespace
+}  // namespace fleetmap::experiments

@@ -1,0 +1,85 @@
+#include "experiments/slam_scenario.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/angle.h"
+#include "tests/test_support.h"
+
+namespace fleetmap::experiments {
+namespace {
+
+using fleetmap::testing::expect_input_error;
+
+constexpr const char* kMinimal = R"(
+room:
+  boundary: [[0, 0], [4, 0], [4, 3], [0, 3]]
+robots:
+  team:
+    - {name: a, start: [1, 1, 0], path: [[3, 1]]}
+)";
+
+TEST(SlamScenario, TheDalfonsoScenarioHasThePapersParameters) {
+  const SlamScenario s = load_slam_scenario(std::string(FLEETMAP_SOURCE_DIR) + "/scenarios/dalfonso_3robots.yaml");
+  EXPECT_EQ(s.method, "polynomial");
+  EXPECT_EQ(s.runs, 100);
+  EXPECT_EQ(s.steps, 200);
+  EXPECT_DOUBLE_EQ(s.period_s, 1.0);
+  ASSERT_EQ(s.robots.size(), 3u);
+  EXPECT_EQ(s.robots[2].name, "r3");
+  EXPECT_EQ(s.single_robot, "r3");
+  EXPECT_EQ(s.range.angles_rad.size(), 5u);  // five distance sensors
+  EXPECT_DOUBLE_EQ(s.range.noise_m, 0.02);
+  EXPECT_DOUBLE_EQ(s.noise.position_m, 0.001);
+  EXPECT_NEAR(s.noise.heading_rad, core::deg2rad(0.01), 1e-15);
+  EXPECT_DOUBLE_EQ(s.initial_sigma_xy, 0.05);
+  EXPECT_DOUBLE_EQ(s.initial_sigma_heading, 0.0175);
+  const auto& p = s.polynomial;
+  EXPECT_EQ(p.order, 3);
+  EXPECT_DOUBLE_EQ(p.rho_min, 0.08);
+  EXPECT_DOUBLE_EQ(p.rho_max, 0.24);
+  EXPECT_DOUBLE_EQ(p.sigma_min, 0.1);
+  EXPECT_DOUBLE_EQ(p.sigma_max, 0.3);
+  EXPECT_EQ(p.epsilon_m, 5);
+  EXPECT_EQ(p.epsilon_z, 10);
+  EXPECT_DOUBLE_EQ(p.k, 150.0);
+  EXPECT_DOUBLE_EQ(p.cluster_radius, 0.35);
+  EXPECT_DOUBLE_EQ(p.gamma_m, 0.35);
+  EXPECT_DOUBLE_EQ(p.range_noise, 0.02);
+  EXPECT_GE(room_walls(s.room).size(), 24u);
+}
+
+TEST(SlamScenario, DefaultsFillAMinimalScenario) {
+  const SlamScenario s = parse_slam_scenario(kMinimal, "min.yaml");
+  EXPECT_EQ(s.method, "polynomial");
+  EXPECT_EQ(s.runs, 100);
+  EXPECT_EQ(s.robots[0].path.size(), 1u);
+  EXPECT_EQ(s.range.angles_rad.size(), 5u);
+  EXPECT_EQ(room_walls(s.room).size(), 4u);
+}
+
+TEST(SlamScenario, BadInputNamesTheFileAndKey) {
+  const auto with = [](const std::string& extra) { return std::string(kMinimal) + extra; };
+  expect_input_error([&] { parse_slam_scenario(with("method: grid\n"), "s.yaml"); }, {"s.yaml", "method", "grid", "polynomial"});
+  expect_input_error([&] { parse_slam_scenario(with("colour: red\n"), "s.yaml"); }, {"s.yaml", "colour"});
+  expect_input_error([&] { parse_slam_scenario(with("steps: 0\n"), "s.yaml"); }, {"steps"});
+  expect_input_error([&] { parse_slam_scenario(with("polynomial: {rho: [0.3, 0.1]}\n"), "s.yaml"); }, {"polynomial.rho"});
+  expect_input_error([&] { parse_slam_scenario(with("polynomial: {epsilon_z: 0}\n"), "s.yaml"); }, {"epsilon_z"});
+  expect_input_error([&] { parse_slam_scenario(with("single_robot: zz\n"), "s.yaml"); }, {"single_robot", "zz"});
+  expect_input_error([&] { parse_slam_scenario("room: {boundary: [[0, 0], [1, 0]]}\nrobots: {team: []}\n", "s.yaml"); },
+                     {"room.boundary"});
+  expect_input_error([&] { parse_slam_scenario("room: {boundary: [[0, 0], [4, 0], [4, 3]]}\n", "s.yaml"); }, {"robots.team"});
+  expect_input_error(
+      [&] {
+        parse_slam_scenario(
+            "room: {boundary: [[0, 0], [4, 0], [4, 3]]}\nrobots: {team: [{name: a, start: [1, 1, 0], path: [[2, 1]]}, "
+            "{name: a, start: [2, 1, 0], path: [[3, 1]]}]}\n",
+            "s.yaml");
+      },
+      {"named 'a'"});
+  expect_input_error([&] { parse_slam_scenario("room: {boundary: [[0, 0], [4, x], [4, 3]]}\n", "s.yaml"); }, {"room.boundary"});
+}
+
+}  // namespace
+}  // namespace fleetmap::experiments
