@@ -10,51 +10,38 @@
 
 namespace fleetmap::exploration {
 
-namespace {
-
-struct Entry {
-  std::string name;
-  std::string help;
-  std::function<std::unique_ptr<CoordinationStrategy>(const StrategyOptions&)> make;
-};
-
-const std::vector<Entry>& registry() {
-  static const std::vector<Entry> kEntries = {
-      {"uncoordinated", "each robot to its nearest frontier by wave cost (Yamauchi 1998)", make_uncoordinated_strategy},
-      {"coordinated",
-       "greedy utility minus beta * cost, utility reduced around assigned targets (Burgard et al. 2005)",
-       make_coordinated_strategy},
-      {"optimized", "assignment minimising squared costs minus utility, solved exactly (seed 003 eq. (3), Hungarian)",
-       make_optimized_strategy},
-      {"directional", "nearest frontier with a preference for each robot's own direction (seed 003 §IV)",
-       make_directional_strategy},
-      {"market", "sequential single-item auction, min-max bids on wave cost (Koenig et al. 2006; Zlot et al. 2002)",
-       make_market_strategy},
-  };
-  return kEntries;
+core::Registry<StrategyFactory>& strategy_registry() {
+  static core::Registry<StrategyFactory> registry("strategy");
+  static const bool built_in = [] {
+    auto& r = registry;
+    r.add("uncoordinated", "each robot to its nearest frontier by wave cost (Yamauchi 1998)", make_uncoordinated_strategy);
+    r.add("coordinated", "greedy utility minus beta * cost, utility reduced around assigned targets (Burgard et al. 2005)",
+          make_coordinated_strategy);
+    r.add("optimized",
+          "assignment minimising squared costs minus utility, solved exactly (Hungarian method; the wave "
+          "algorithm paper's eq. (3))",
+          make_optimized_strategy);
+    r.add("directional", "nearest frontier with a preference for each robot's own direction (the wave algorithm's "
+                         "directional priority)",
+          make_directional_strategy);
+    r.add("market", "sequential single-item auction, min-max bids on wave cost (Koenig et al. 2006; Zlot et al. 2002)",
+          make_market_strategy);
+    return true;
+  }();
+  (void)built_in;
+  return registry;
 }
 
-}  // namespace
-
-std::vector<std::string> strategy_names() {
-  std::vector<std::string> names;
-  for (const auto& e : registry()) names.push_back(e.name);
-  return names;
+void register_strategy(std::string name, std::string help, StrategyFactory make) {
+  strategy_registry().add(std::move(name), std::move(help), std::move(make));
 }
 
-std::string strategy_help() {
-  std::string s;
-  for (const auto& e : registry()) s += "  " + e.name + ": " + e.help + "\n";
-  return s;
-}
+std::vector<std::string> strategy_names() { return strategy_registry().names(); }
+
+std::string strategy_help() { return strategy_registry().help(); }
 
 std::unique_ptr<CoordinationStrategy> make_strategy(const std::string& name, const StrategyOptions& options) {
-  for (const auto& e : registry()) {
-    if (e.name == name) return e.make(options);
-  }
-  std::string names;
-  for (const auto& e : registry()) names += (names.empty() ? "" : ", ") + e.name;
-  throw InputError("unknown strategy '" + name + "' (valid: " + names + ")");
+  return strategy_registry().get(name).make(options);
 }
 
 double visibility_overlap(double distance_m, double sensor_range_m) {

@@ -2,10 +2,13 @@
 // Coordination strategies: which robot goes to which frontier target. One interface, chosen by
 // name (`--strategy`, scenario files) through make_strategy(); tests iterate strategy_names().
 #include <Eigen/Core>
+
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "core/registry.h"
 #include "exploration/frontiers.h"
 
 namespace fleetmap::exploration {
@@ -43,6 +46,14 @@ class CoordinationStrategy {
   // that sends its spare robots after taken targets jams in the last corridor).
   virtual std::vector<int> assign(const AssignmentInput& input) const = 0;
 };
+
+using StrategyFactory = std::function<std::unique_ptr<CoordinationStrategy>(const StrategyOptions&)>;
+
+// Every coordination strategy by name: the built-in ones, then those registered by the program.
+core::Registry<StrategyFactory>& strategy_registry();
+// Adds a strategy: `--strategy NAME`, scenario files, sweeps and the test harnesses reach it.
+// Throws Error when the name is taken or unusable.
+void register_strategy(std::string name, std::string help, StrategyFactory make);
 
 std::vector<std::string> strategy_names();
 // One line per strategy with its source, for --help and README.

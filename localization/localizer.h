@@ -5,12 +5,14 @@
 // through make_localizer(); tests iterate over localizer_names().
 #include <Eigen/Core>
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/random.h"
+#include "core/registry.h"
 #include "core/transform2.h"
 #include "mapping/occupancy_grid.h"
 
@@ -149,6 +151,14 @@ class Localizer {
   // The grid the localizer builds itself, if any (`rbpf`: the best particle's map).
   virtual std::optional<mapping::OccupancyGrid> map_estimate() const { return std::nullopt; }
 };
+
+using LocalizerFactory = std::function<std::unique_ptr<Localizer>(const LocalizerContext&)>;
+
+// Every localizer by name: the built-in ones, then those registered by the program.
+core::Registry<LocalizerFactory>& localizer_registry();
+// Adds a localizer: `--localization NAME`, scenario files and the test harnesses reach it.
+// Throws Error when the name is taken or unusable.
+void register_localizer(std::string name, std::string help, LocalizerFactory make);
 
 // The registered names, in the order --help lists them.
 std::vector<std::string> localizer_names();

@@ -349,52 +349,81 @@ cv::Mat make_campus() {
   return img;
 }
 
-struct Entry {
-  BuiltinMapInfo info;
+struct Generator {
+  const char* name;
+  const char* description;
   cv::Mat (*make)();
 };
 
-const std::vector<Entry>& entries() {
-  static const std::vector<Entry> kEntries = {
-      {{"empty", "seed 003 Fig. 5A: an empty walled square"}, make_empty},
-      {{"unstructured", "seed 003 Fig. 5B: scattered obstacles of many shapes"}, make_unstructured},
-      {{"office", "seed 003 Fig. 5C: rooms on both sides of a corridor"}, make_office},
-      {{"corridor", "seed 003 Fig. 5D: a network of long corridors with alcoves"}, make_corridor},
-      {{"cave", "natural caves (cellular automaton)"}, make_cave},
-      {{"maze", "a 10x10 maze with a few loops"}, make_maze},
-      {{"warehouse", "rack aisles, a loading area with pallets, an office"}, make_warehouse},
-      {{"campus", "six office buildings, trees and a pond (large map)"}, make_campus},
+// The committed maps/ files are these generators' output.
+const std::vector<Generator>& generators() {
+  static const std::vector<Generator> kGenerators = {
+      {"empty", "the wave-algorithm paper's Fig. 5A: an empty walled square", make_empty},
+      {"unstructured", "the wave-algorithm paper's Fig. 5B: scattered obstacles of many shapes", make_unstructured},
+      {"office", "the wave-algorithm paper's Fig. 5C: rooms on both sides of a corridor", make_office},
+      {"corridor", "the wave-algorithm paper's Fig. 5D: a network of long corridors with alcoves", make_corridor},
+      {"cave", "natural caves (cellular automaton)", make_cave},
+      {"maze", "a 10x10 maze with a few loops", make_maze},
+      {"warehouse", "rack aisles, a loading area with pallets, an office", make_warehouse},
+      {"campus", "six office buildings, trees and a pond (large map)", make_campus},
   };
-  return kEntries;
+  return kGenerators;
+}
+
+// A built-in map's committed YAML, if `name` is one of the generated maps.
+std::optional<fs::path> generated_file(std::string_view name) {
+  for (const auto& g : generators()) {
+    if (g.name == name) return builtin_maps_dir() / (std::string(name) + ".yaml");
+  }
+  return std::nullopt;
 }
 
 }  // namespace
 
-const std::vector<BuiltinMapInfo>& builtin_maps() {
-  static const std::vector<BuiltinMapInfo> kInfos = [] {
-    std::vector<BuiltinMapInfo> v;
-    for (const auto& e : entries()) v.push_back(e.info);
-    return v;
+core::Registry<MapFactory>& map_registry() {
+  static core::Registry<MapFactory> registry("map");
+  static const bool built_in = [] {
+    for (const auto& g : generators()) {
+      const std::string name = g.name;
+      registry.add(name, g.description, [name](const io::MapLoadOptions& options) {
+        const fs::path yaml = *generated_file(name);
+        if (!fs::exists(yaml)) {
+          throw InputError("map '" + name + "': built-in map file " + yaml.string() +
+                           " is missing (set FLEETMAP_MAPS_DIR to the maps/ folder)");
+        }
+        return io::load_map(yaml, options);
+      });
+    }
+    return true;
   }();
-  return kInfos;
+  (void)built_in;
+  return registry;
 }
 
-bool is_builtin_map(std::string_view name) {
-  return std::any_of(entries().begin(), entries().end(), [&](const Entry& e) { return e.info.name == name; });
+void register_map(std::string name, std::string description, MapFactory make) {
+  map_registry().add(std::move(name), std::move(description), std::move(make));
 }
+
+std::vector<BuiltinMapInfo> builtin_maps() {
+  std::vector<BuiltinMapInfo> v;
+  for (const auto& name : map_registry().names()) v.push_back({name, map_registry().get(name).help});
+  return v;
+}
+
+bool is_builtin_map(std::string_view name) { return map_registry().contains(name); }
 
 std::string builtin_map_names() {
   std::string s;
-  for (const auto& e : entries()) s += (s.empty() ? "" : ", ") + e.info.name;
+  for (const auto& name : map_registry().names()) s += (s.empty() ? "" : ", ") + name;
   return s;
 }
 
 GeneratedMap generate_builtin_map(std::string_view name) {
-  for (const auto& e : entries()) {
-    if (e.info.name != name) continue;
+  for (const auto& g : generators()) {
+    if (g.name != name) continue;
     GeneratedMap m;
-    m.image = e.make();
-    m.yaml.image = e.info.name + ".png";
+    m.image = g.make();
+    m.yaml.image = std::string(g.name) + ".png";
     m.yaml.resolution = kResolution;
     return m;
   }
@@ -422,36 +451,27 @@ fs::path builtin_maps_dir() {
 
 namespace {
 
-// Where load_map_source takes `name_or_path` from: a file, or a built-in map's YAML.
-std::optional<fs::path> map_file(const std::string& name_or_path) {
+// A file of that name wins over a map of the registry; a folder named like one (e.g. the output
+// folder of `fleetmap explore --map maze`, out/maze) does not hide it. A link that leads nowhere
+// (or in a loop) is still the user's file: reading it says what is wrong.
+bool is_user_file(const std::string& name_or_path) {
   std::error_code ec;
-  // A file of that name wins; a folder named like a built-in map (e.g. the output folder of
-  // `fleetmap explore --map maze`, out/maze) does not hide the built-in map.
-  const bool builtin = is_builtin_map(name_or_path);
-  // A link that leads nowhere (or in a loop) is still the user's file: reading it says what is wrong.
-  if (fs::exists(fs::symlink_status(name_or_path, ec)) && !(builtin && fs::is_directory(name_or_path, ec))) {
-    return fs::path(name_or_path);
-  }
-  if (builtin) return builtin_maps_dir() / (name_or_path + ".yaml");
-  return std::nullopt;
+  if (!fs::exists(fs::symlink_status(name_or_path, ec))) return false;
+  return !(is_builtin_map(name_or_path) && fs::is_directory(name_or_path, ec));
 }
 
 }  // namespace
 
 std::vector<fs::path> map_source_files(const std::string& name_or_path) {
-  const auto file = map_file(name_or_path);
-  return file ? io::map_files(*file) : std::vector<fs::path>{};
+  if (is_user_file(name_or_path)) return io::map_files(name_or_path);
+  if (const auto file = generated_file(name_or_path)) return io::map_files(*file);
+  return {};
 }
 
 mapping::OccupancyGrid load_map_source(const std::string& name_or_path, const io::MapLoadOptions& options) {
   if (name_or_path.empty()) throw InputError("map: empty name (built-in maps: " + builtin_map_names() + ")");
-  if (const auto file = map_file(name_or_path)) {
-    if (is_builtin_map(name_or_path) && *file != fs::path(name_or_path) && !fs::exists(*file)) {
-      throw InputError("map '" + name_or_path + "': built-in map file " + file->string() +
-                       " is missing (set FLEETMAP_MAPS_DIR to the maps/ folder)");
-    }
-    return io::load_map(*file, options);
-  }
+  if (is_user_file(name_or_path)) return io::load_map(name_or_path, options);
+  if (is_builtin_map(name_or_path)) return map_registry().get(name_or_path).make(options);
   const bool looks_like_path = name_or_path.find_first_of("/.") != std::string::npos;
   if (looks_like_path) throw InputError(name_or_path + ": no such file");
   throw InputError("unknown map '" + name_or_path + "': not a file and not a built-in map (built-in maps: " +

@@ -5,10 +5,12 @@
 #include <opencv2/core/mat.hpp>
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "core/registry.h"
 #include "io/map_io.h"
 #include "mapping/occupancy_grid.h"
 
@@ -19,8 +21,16 @@ struct BuiltinMapInfo {
   std::string description;
 };
 
+// Makes a map by name, with the load options of the command that asks for it.
+using MapFactory = std::function<mapping::OccupancyGrid(const io::MapLoadOptions&)>;
+
+// Every map a name stands for: the generated ones of maps/, then those registered by the program.
+core::Registry<MapFactory>& map_registry();
+// Adds a named map: `--map NAME`, scenario files and sweeps reach it. Throws Error when taken.
+void register_map(std::string name, std::string description, MapFactory make);
+
 // In the order `fleetmap maps list` shows them.
-const std::vector<BuiltinMapInfo>& builtin_maps();
+std::vector<BuiltinMapInfo> builtin_maps();
 bool is_builtin_map(std::string_view name);
 // "empty, unstructured, ..." for messages.
 std::string builtin_map_names();

@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <iosfwd>
 #include <memory>
 #include <optional>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "core/range.h"
+#include "core/registry.h"
 #include "mapping/occupancy_grid.h"
 #include "planning/free_space.h"
 
@@ -125,8 +127,20 @@ struct PlannerInfo {
   bool complete = true;
 };
 
+// A registered planner: how to make one, and whether it is complete.
+struct PlannerMaker {
+  std::function<std::unique_ptr<Planner>()> make;
+  bool complete = true;
+};
+
+// Every planner by name: the built-in ones, then those registered by the program.
+core::Registry<PlannerMaker>& planner_registry();
+// Adds a planner: `fleetmap plan --planner NAME`, `--path-planner NAME` and the test harnesses
+// reach it. Throws Error when the name is taken or unusable.
+void register_planner(std::string name, std::string help, PlannerMaker maker);
+
 // The registered planners, in the order --help lists them.
-const std::vector<PlannerInfo>& planner_infos();
+std::vector<PlannerInfo> planner_infos();
 std::vector<std::string> planner_names();
 // One line per planner, for --help and README.
 std::string planner_help();

@@ -1,0 +1,85 @@
+#pragma once
+// One open registry per family of variants: coordination strategies, localizers, map aligners,
+// merge methods, planners, built-in maps. Each member has a name, a line of help and a factory.
+// The built-in members are added when the family is first used; a program that links fleetmap
+// adds its own through the family's public register_* call, and the command line, scenario files
+// and test harnesses then reach it by name like the built-in ones (as Nav2's plugins or OMPL's
+// planner allocators).
+#include <deque>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/error.h"
+
+namespace fleetmap::core {
+
+template <typename Factory>
+class Registry {
+ public:
+  struct Entry {
+    std::string name;
+    std::string help;  // one line: what the member does and its source
+    Factory make;
+  };
+
+  // `family` names the members in messages ("strategy", "localization", "planner").
+  explicit Registry(std::string family) : family_(std::move(family)) {}
+
+  // Throws Error for an empty name, a name with spaces or commas, or a name already taken.
+  void add(std::string name, std::string help, Factory make) {
+    if (name.empty() || name.find_first_of(" ,\t\n") != std::string::npos) {
+      throw Error("register " + family_ + ": '" + name + "' is not a usable name (no spaces or commas)");
+    }
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& e : entries_) {
+      if (e.name == name) throw Error("register " + family_ + ": '" + name + "' is already registered");
+    }
+    entries_.push_back({std::move(name), std::move(help), std::move(make)});
+  }
+
+  // Throws InputError naming the valid names for an unknown one.
+  const Entry& get(std::string_view name) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& e : entries_) {
+      if (e.name == name) return e;  // a deque keeps references valid while others are added
+    }
+    std::string names;
+    for (const auto& e : entries_) names += (names.empty() ? "" : ", ") + e.name;
+    throw InputError("unknown " + family_ + " '" + std::string(name) + "' (valid: " + names + ")");
+  }
+
+  bool contains(std::string_view name) const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& e : entries_) {
+      if (e.name == name) return true;
+    }
+    return false;
+  }
+
+  // In the order they were registered: the built-in ones first.
+  std::vector<std::string> names() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::string> out;
+    for (const auto& e : entries_) out.push_back(e.name);
+    return out;
+  }
+
+  // "  name: help" per member, for --help and README.
+  std::string help() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    std::string out;
+    for (const auto& e : entries_) out += "  " + e.name + ": " + e.help + "\n";
+    return out;
+  }
+
+  const std::string& family() const { return family_; }
+
+ private:
+  std::string family_;
+  mutable std::mutex mutex_;
+  std::deque<Entry> entries_;
+};
+
+}  // namespace fleetmap::core

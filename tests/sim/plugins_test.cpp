@@ -1,0 +1,99 @@
+// A program that links fleetmap adds its own coordination strategy, localizer, path planner and
+// map by name, and a scenario reaches them exactly as it reaches the built-in ones.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "exploration/strategy.h"
+#include "localization/localizer.h"
+#include "maps/builtin_maps.h"
+#include "planning/planner.h"
+#include "sim/scenario.h"
+#include "sim/simulation.h"
+#include "tests/sim/sim_test_maps.h"
+
+namespace fleetmap::sim {
+namespace {
+
+// Every robot drives to the target with the lowest cost that no other robot took yet.
+class FirstComeStrategy final : public exploration::CoordinationStrategy {
+ public:
+  std::string name() const override { return "first-come"; }
+  bool joint() const override { return true; }
+  std::vector<int> assign(const exploration::AssignmentInput& input) const override {
+    std::vector<int> out(input.robots.size(), -1);
+    std::vector<char> taken(input.targets.size(), 0);
+    for (std::size_t r = 0; r < input.robots.size(); ++r) {
+      double best = std::numeric_limits<double>::infinity();
+      for (std::size_t t = 0; t < input.targets.size(); ++t) {
+        const double c = input.robots[r].cost_m[t];
+        if (!taken[t] && std::isfinite(c) && c < best) best = c, out[r] = int(t);
+      }
+      if (out[r] >= 0) taken[std::size_t(out[r])] = 1;
+    }
+    ++calls_;
+    return out;
+  }
+  static inline int calls_ = 0;
+};
+
+// Dead reckoning that counts its predictions.
+class CountingLocalizer final : public localization::Localizer {
+ public:
+  explicit CountingLocalizer(const localization::LocalizerContext& c) : pose_(c.initial_pose) {}
+  std::string name() const override { return "counting"; }
+  void predict(const localization::Odometry& u) override {
+    pose_ = localization::integrate_motion(pose_, u);
+    ++predictions_;
+  }
+  core::Pose2 pose() const override { return pose_; }
+  Eigen::Matrix3d covariance() const override { return Eigen::Matrix3d::Zero(); }
+  std::vector<std::pair<std::string, double>> counters() const override { return {{"predictions", predictions_}}; }
+  void change_frame(const core::Transform2& t) override { pose_ = core::Pose2::from_transform(t * pose_.as_transform()); }
+
+ private:
+  core::Pose2 pose_;
+  int predictions_ = 0;
+};
+
+TEST(Plugins, ARegisteredStrategyLocalizerPlannerAndMapRunByName) {
+  exploration::register_strategy("first-come", "each robot takes the cheapest target left (a test's own)",
+                                 [](const exploration::StrategyOptions&) { return std::make_unique<FirstComeStrategy>(); });
+  localization::register_localizer("counting", "dead reckoning that counts (a test's own)",
+                                   [](const localization::LocalizerContext& c) { return std::make_unique<CountingLocalizer>(c); });
+  planning::register_planner("grid-astar-again", "the grid A*, registered again under another name",
+                             {[] { return planning::make_planner("astar"); }});
+  maps::register_map("test-room", "a walled 8 x 6 m room", [](const io::MapLoadOptions&) { return testing::walled_room(80, 60); });
+
+  // Everything that lists names sees them; a second registration of a name is refused.
+  for (const auto& [names, name] : {std::pair{exploration::strategy_names(), std::string("first-come")},
+                                    std::pair{localization::localizer_names(), std::string("counting")},
+                                    std::pair{planning::planner_names(), std::string("grid-astar-again")}}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+  }
+  EXPECT_TRUE(maps::is_builtin_map("test-room"));
+  EXPECT_THROW(exploration::register_strategy("first-come", "", {}), Error);
+  EXPECT_THROW(maps::register_map("office", "", {}), Error);
+
+  // A scenario file names them like the built-in ones.
+  const Scenario s = parse_scenario(R"(map: test-room
+robots: 2
+steps: 60
+localization: counting
+exploration: {strategy: first-come, path_planner: grid-astar-again}
+)",
+                                    "plugins.yaml", "");
+  Simulation simulation(s, maps::load_map_source(s.map));
+  const RunResult r = simulation.run();
+  EXPECT_GT(FirstComeStrategy::calls_, 0);
+  EXPECT_GT(r.coverage.back(), 0.5);
+  const auto& counters = r.robots.front().localizer_counters;
+  ASSERT_FALSE(counters.empty());
+  EXPECT_EQ(counters.front().first, "predictions");
+  EXPECT_EQ(counters.front().second, r.steps);
+}
+
+}  // namespace
+}  // namespace fleetmap::sim
