@@ -135,7 +135,7 @@ TEST(ExploreCommand, HelpListsStrategiesAndLocalizers) {
   TempDir dir;
   const auto r = run_fleetmap("explore --help", dir);
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* s : {"uncoordinated", "coordinated", "optimized", "directional", "market", "Burgard", "seed 003",
+  for (const char* s : {"uncoordinated", "coordinated", "optimized", "directional", "market", "Burgard", "wave algorithm",
                         "ideal", "odometry", "ekf", "--comm-range", "--animate", "--scenario"}) {
     EXPECT_NE(r.out.find(s), std::string::npos) << s;
   }

@@ -132,7 +132,7 @@ TEST(PlanCommand, HelpListsEveryPlannerAndFlagWithDefaults) {
   EXPECT_EQ(r.exit_code, 0);
   for (const char* word : {"rrtstar", "informedrrtstar", "prmstar", "rrtconnect", "bitstar", "astar", "reactive",
                            "--map", "--from", "--to", "--from-cell", "--to-cell", "--planner", "--time", "--radius",
-                           "--unknown", "--seed", "--out", "--json", "=obstacle", "=0.2", "=1", "seed 001"}) {
+                           "--unknown", "--seed", "--out", "--json", "=obstacle", "=0.2", "=1", "map-alignment paper"}) {
     EXPECT_NE(r.out.find(word), std::string::npos) << word << " not in:\n" << r.out;
   }
 }
