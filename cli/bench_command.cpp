@@ -61,8 +61,8 @@ bool any_sweep_flag(const BenchFlags& f) {
 
 fs::path results_of(const std::string& dir, const std::string& flag) {
   const fs::path d = dir;
-  if (!fs::is_directory(d)) throw InputError(flag + ": '" + dir + "' is not a folder");
-  if (!fs::is_regular_file(d / "results.csv")) {
+  if (!io::is_folder(d)) throw InputError(flag + ": '" + dir + "' is not a folder");
+  if (!io::is_regular_file(d / "results.csv")) {
     throw InputError(flag + ": '" + dir + "' holds no results.csv (not an output folder of fleetmap bench)");
   }
   return d / "results.csv";
@@ -70,7 +70,7 @@ fs::path results_of(const std::string& dir, const std::string& flag) {
 
 // The sweep a results folder was made by (its sweep.yaml), if it has one that still loads.
 std::optional<sweep::Sweep> sweep_of(const fs::path& dir) {
-  if (!fs::is_regular_file(dir / "sweep.yaml")) return std::nullopt;
+  if (!io::is_regular_file(dir / "sweep.yaml")) return std::nullopt;
   return sweep::load_sweep(dir / "sweep.yaml");
 }
 
@@ -105,7 +105,7 @@ void check_same_sweep(const fs::path& out, const sweep::Sweep& sweep, const std:
   const std::string where = "--out " + out.string() + ": ";
   const auto [sweep_yaml, scenario_yaml] = sweep_files(out, sweep);
   for (const auto& [name, now] : {std::pair{std::string("sweep.yaml"), sweep_yaml}, std::pair{std::string("scenario.yaml"), scenario_yaml}}) {
-    if (!fs::is_regular_file(out / name)) {
+    if (!io::is_regular_file(out / name)) {
       throw InputError(where + "holds results.csv but no " + name + ", so its sweep is unknown; choose another --out");
     }
     const std::string before = io::read_file(out / name, std::size_t{1} << 20);
@@ -253,7 +253,7 @@ int run_bench(const BenchFlags& f) {
   const std::string settings = sweep::settings_id(sweep.base);
 
   std::set<sweep::RunKey> done;
-  if (fs::exists(results)) {
+  if (io::path_exists(results)) {
     const auto table = sweep::read_results(results);
     check_same_sweep(out, sweep, runs, table.records);
     sweep::check_settings(table.records, settings, results);

@@ -10,6 +10,7 @@
 #include "core/angle.h"
 #include "core/error.h"
 #include "core/random.h"
+#include "io/file_io.h"
 #include "io/yaml_reader.h"
 #include "localization/localizer.h"
 #include "merging/fusion.h"
@@ -106,7 +107,10 @@ CorridorOptions parse_corridor_options(const std::string& text, const std::strin
       o.methods.clear();
       const auto node = *m.node("list");
       if (!node.IsSequence()) throw InputError(m.where("list") + ": expected a list of localizer names");
-      for (const auto& n : node) o.methods.push_back(n.as<std::string>());
+      for (const auto& n : node) {
+        if (!n.IsScalar()) throw InputError(m.where("list") + ": expected a list of localizer names, got an item " + io::describe_node(n));
+        o.methods.push_back(n.Scalar());
+      }
     }
     o.rbpf_particles = int(m.integer("rbpf_particles", o.rbpf_particles, 1, 10000));
     m.finish();

@@ -111,9 +111,24 @@ void ensure_directory(const fs::path& dir) {
   if (dir.empty()) return;
   std::error_code ec;
   fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) {
+  if (ec || !is_folder(dir)) {
     throw InputError(quoted_path(dir) + ": cannot create output directory (" + ec.message() + ")");
   }
+}
+
+bool path_exists(const fs::path& path) noexcept {
+  std::error_code ec;
+  return fs::exists(path, ec);
+}
+
+bool is_regular_file(const fs::path& path) noexcept {
+  std::error_code ec;
+  return fs::is_regular_file(path, ec);
+}
+
+bool is_folder(const fs::path& path) noexcept {
+  std::error_code ec;
+  return fs::is_directory(path, ec);
 }
 
 bool is_standard_output(const fs::path& path) { return path == "-" || path == "/dev/stdout"; }

@@ -23,6 +23,12 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view bytes
 // Creates a directory (and its parents) for outputs; throws InputError naming it on failure.
 void ensure_directory(const std::filesystem::path& dir);
 
+// Questions about a user's path that never throw: a name too long, a link loop or a missing
+// permission is simply "no".
+bool path_exists(const std::filesystem::path& path) noexcept;
+bool is_regular_file(const std::filesystem::path& path) noexcept;
+bool is_folder(const std::filesystem::path& path) noexcept;
+
 // "-" and "/dev/stdout" name the standard output; the command line writes those itself.
 bool is_standard_output(const std::filesystem::path& path);
 

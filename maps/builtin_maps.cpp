@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "core/random.h"
+#include "io/file_io.h"
 
 #ifndef FLEETMAP_SOURCE_MAPS_DIR
 #define FLEETMAP_SOURCE_MAPS_DIR ""
@@ -387,7 +388,7 @@ core::Registry<MapFactory>& map_registry() {
       const std::string name = g.name;
       registry.add(name, g.description, [name](const io::MapLoadOptions& options) {
         const fs::path yaml = *generated_file(name);
-        if (!fs::exists(yaml)) {
+        if (!io::path_exists(yaml)) {
           throw InputError("map '" + name + "': built-in map file " + yaml.string() +
                            " is missing (set FLEETMAP_MAPS_DIR to the maps/ folder)");
         }
@@ -439,12 +440,12 @@ std::string encode_png(const cv::Mat& image) {
 fs::path builtin_maps_dir() {
   if (const char* env = std::getenv("FLEETMAP_MAPS_DIR"); env && *env) return env;
   const fs::path source = FLEETMAP_SOURCE_MAPS_DIR;
-  if (!source.empty() && fs::exists(source / "empty.yaml")) return source;
+  if (!source.empty() && io::path_exists(source / "empty.yaml")) return source;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
     const fs::path installed = exe.parent_path().parent_path() / "share" / "fleetmap" / "maps";
-    if (fs::exists(installed / "empty.yaml")) return installed;
+    if (io::path_exists(installed / "empty.yaml")) return installed;
   }
   return source;
 }
@@ -457,7 +458,7 @@ namespace {
 bool is_user_file(const std::string& name_or_path) {
   std::error_code ec;
   if (!fs::exists(fs::symlink_status(name_or_path, ec))) return false;
-  return !(is_builtin_map(name_or_path) && fs::is_directory(name_or_path, ec));
+  return !(is_builtin_map(name_or_path) && io::is_folder(name_or_path));
 }
 
 }  // namespace

@@ -155,14 +155,14 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
     }
     fs::path p = scenario->Scalar();
     if (p.is_relative()) p = base_dir / p;
-    if (!fs::is_regular_file(p)) throw InputError(top.where("scenario") + ": no scenario file '" + p.string() + "'");
+    if (!io::is_regular_file(p)) throw InputError(top.where("scenario") + ": no scenario file '" + p.string() + "'");
     use_base(sweep, sim::load_scenario(p));
   }
   if (const auto maps = list_text(top, "maps")) {
     sweep.maps = parse_map_list(*maps, top.where("maps"));
     for (auto& m : sweep.maps) {
       // A file is relative to the sweep file; a built-in name stays a name unless such a file is there.
-      if (fs::path(m).is_relative() && (looks_like_file(m) || fs::is_regular_file(base_dir / m))) m = (base_dir / m).string();
+      if (fs::path(m).is_relative() && (looks_like_file(m) || io::is_regular_file(base_dir / m))) m = (base_dir / m).string();
     }
   }
   if (const auto s = list_text(top, "strategies")) sweep.strategies = parse_strategy_list(*s, top.where("strategies"));
@@ -192,7 +192,7 @@ Sweep load_sweep(const fs::path& path) {
 
 void apply_overrides(Sweep& sweep, const SweepOverrides& f) {
   if (f.scenario) {
-    if (!fs::is_regular_file(*f.scenario)) throw InputError("--scenario: no scenario file '" + *f.scenario + "'");
+    if (!io::is_regular_file(*f.scenario)) throw InputError("--scenario: no scenario file '" + *f.scenario + "'");
     use_base(sweep, sim::load_scenario(*f.scenario));
   }
   if (f.maps) sweep.maps = parse_map_list(*f.maps, "--maps");
@@ -250,7 +250,7 @@ void validate_sweep(const Sweep& sweep) {
 std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file) {
   std::string y = "# fleetmap bench sweep: run it again with `fleetmap bench --sweep FILE`\n";
   std::vector<std::string> maps;
-  for (const auto& m : sweep.maps) maps.push_back(io::yaml_quoted(looks_like_file(m) && fs::exists(m) ? fs::absolute(m).lexically_normal().string() : m));
+  for (const auto& m : sweep.maps) maps.push_back(io::yaml_quoted(looks_like_file(m) && io::path_exists(m) ? fs::absolute(m).lexically_normal().string() : m));
   y += "maps: [" + join(maps) + "]\n";
   y += "strategies: [" + join(sweep.strategies) + "]\n";
   std::vector<std::string> robots;

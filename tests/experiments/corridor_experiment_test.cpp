@@ -124,5 +124,11 @@ TEST(CorridorOptionsParsing, ReadsTheScenarioAndRejectsBadKeys) {
   expect_input_error([&] { run_corridor_experiment(bad); }, {"methods.list", "'mcl'"});
 }
 
+TEST(CorridorOptionsParsing, AMethodListOfListsIsOneLineNotACrash) {
+  // Found by fuzzing: a list inside the methods list reached yaml-cpp's conversion, which threw.
+  expect_input_error([] { parse_corridor_options("experiment: leon_corridor\nmethods:\n  list: [ideal, [odometry]]\n", "c.yaml"); },
+                     {"c.yaml:3: key 'methods.list': expected a list of localizer names, got an item a list"});
+}
+
 }  // namespace
 }  // namespace fleetmap::experiments

@@ -217,5 +217,12 @@ TEST(Sweep, WrittenSweepLoadsBackToTheSameRuns) {
   EXPECT_EQ(settings_id(s.base), settings_id(back.base));
 }
 
+TEST(Sweep, AMapNameTooLongForTheFileSystemIsJustAName) {
+  // Found by fuzzing: asking the file system about a 5000-character name threw instead of answering.
+  const std::string name = "maps/" + std::string(5000, 'x') + ".png";
+  const Sweep s = parse_sweep("maps: [\"" + name + "\"]\n", "long.yaml", "/nonexistent");
+  EXPECT_NE(sweep_to_yaml(s, "").find(std::string(5000, 'x')), std::string::npos);
+}
+
 }  // namespace
 }  // namespace fleetmap::sweep
