@@ -8,6 +8,7 @@
 #include <numbers>
 #include <vector>
 
+#include "mapping/range_scan.h"
 #include "localization/cow_grid.h"
 #include "localization/localizer.h"
 #include "localization/rbpf_localizer.h"
@@ -49,7 +50,7 @@ RangeScan scan_at(const mapping::OccupancyGrid& truth, const core::Pose2& pose) 
 void BM_ScanMatchPerScan(benchmark::State& state) {
   const auto truth = room(420);
   CowGrid map(truth.geometry());
-  for (double x : {4.0, 6.0, 8.0, 10.0, 12.0}) integrate_scan(map, {x, 7.0, 0.0}, scan_at(truth, {x, 7.0, 0.0}));
+  for (double x : {4.0, 6.0, 8.0, 10.0, 12.0}) mapping::insert_scan(map, {x, 7.0, 0.0}, scan_at(truth, {x, 7.0, 0.0}));
   const core::Pose2 at(9.0, 7.2, 0.1);
   const RangeScan scan = scan_at(truth, at);
   LocalizerOptions lo;

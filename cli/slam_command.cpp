@@ -4,20 +4,17 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
-#include <exception>
 #include <filesystem>
-#include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cli/command.h"
 #include "cli/corridor_command.h"
 #include "cli/progress.h"
 #include "cli/validators.h"
+#include "core/parallel.h"
 #include "io/file_io.h"
 #include "core/error.h"
 #include "experiments/slam_experiment.h"
@@ -66,39 +63,20 @@ int run_slam(const SlamFlags& f) {
   experiments::SlamCampaign campaign;
   campaign.team.resize(std::size_t(s.runs));
   if (single >= 0) campaign.alone.resize(std::size_t(s.runs));
-  std::atomic<int> next{0}, done{0};
-  std::exception_ptr failure;
-  std::mutex failure_mutex;
-  const auto worker = [&]() {
-    for (;;) {
-      const int job = next++;
-      if (job >= total) return;
-      try {
+  ProgressBar bar(!f.quiet);
+  int done = 0;
+  bar.update(0, total, "runs");
+  core::parallel_for(
+      total, f.jobs,
+      [&](int job) {
         if (job < s.runs) {
           campaign.team[std::size_t(job)] = experiments::run_slam(setup, job, s.exchange);
         } else {
           campaign.alone[std::size_t(job - s.runs)] = experiments::run_slam(setup, job - s.runs, false, single);
         }
-      } catch (...) {
-        const std::lock_guard<std::mutex> lock(failure_mutex);
-        if (!failure) failure = std::current_exception();
-        next = total;
-      }
-      ++done;
-    }
-  };
-  ProgressBar bar(!f.quiet);
-  const int jobs = std::clamp(f.jobs, 1, total);
-  std::vector<std::thread> threads;
-  for (int t = 0; t < jobs; ++t) threads.emplace_back(worker);
-  while (done < total && !failure) {
-    bar.update(done, total, "runs");
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  for (auto& t : threads) t.join();
-  bar.update(done, total, "runs");
+      },
+      [&](int) { bar.update(++done, total, "runs"); });
   bar.finish();
-  if (failure) std::rethrow_exception(failure);
 
   const auto written = experiments::write_slam_outputs(setup, campaign, out, s.paper_table);
   folder.finish(io::OutputFolder::names(written));

@@ -13,6 +13,8 @@
 #include "io/file_io.h"
 #include "io/yaml_reader.h"
 #include "localization/localizer.h"
+#include "mapping/distance_field.h"
+#include "mapping/range_scan.h"
 #include "merging/fusion.h"
 #include "merging/rendezvous.h"
 #include "sim/world.h"
@@ -253,14 +255,6 @@ localization::LocalizerContext context_for(const CorridorOptions& o, const core:
   return c;
 }
 
-void integrate(mapping::OccupancyGrid& map, const core::Pose2& pose, const localization::RangeScan& scan) {
-  for (std::size_t b = 0; b < scan.angles.size(); ++b) {
-    const double a = pose.theta + scan.angles[b];
-    const double r = scan.ranges[b].value_or(scan.max_range);
-    map.integrate_ray(pose.position(), pose.position() + r * Eigen::Vector2d(std::cos(a), std::sin(a)), scan.ranges[b].has_value());
-  }
-}
-
 struct Replay {
   std::vector<core::Pose2> estimate;
   std::vector<mapping::OccupancyGrid> maps;  // at each requested step
@@ -279,7 +273,7 @@ Replay replay(const Drive& d, const std::string& method, const localization::Loc
     if (k > 0) loc->predict(d.odometry[k - 1]);
     loc->observe_truth(d.truth[k]);
     loc->update_scan(d.scans[k], own);
-    integrate(own, loc->pose(), d.scans[k]);
+    mapping::insert_scan(own, loc->pose(), d.scans[k]);
     r.estimate.push_back(loc->pose());
     if (std::find(snapshots.begin(), snapshots.end(), int(k)) != snapshots.end()) {
       auto mine = loc->map_estimate();
@@ -374,12 +368,9 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
   // The truth: the other's frame in the world is its start pose.
   const core::Transform2 true_other_to_master = other_start.as_transform();
   // Distance to the nearest true wall, per world cell, for scoring.
-  cv::Mat free_space(g.height(), g.width(), CV_8UC1);
-  for (int y = 0; y < g.height(); ++y)
-    for (int x = 0; x < g.width(); ++x)
-      free_space.at<std::uint8_t>(y, x) = result.truth.state({x, y}) == mapping::CellState::Occupied ? 0 : 255;
-  cv::Mat wall_distance;
-  cv::distanceTransform(free_space, wall_distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  std::vector<std::uint8_t> walls(std::size_t(g.cell_count()));
+  for (int i = 0; i < g.cell_count(); ++i) walls[std::size_t(i)] = result.truth.state_at(i) == mapping::CellState::Occupied;
+  const std::vector<float> wall_distance = mapping::distance_to_blocked(g.width(), g.height(), walls, false);
   result.master_map = master_run.maps.front();
   result.other_map = other_run.maps.front();
   const mapping::OccupancyGrid& master_map = result.master_map;
@@ -401,7 +392,7 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
       for (int x = 0; x < other_map.width(); ++x) {
         if (other_map.state_at(other_map.geometry().index({x, y})) != mapping::CellState::Occupied) continue;
         const auto cell = g.world_to_cell(t.apply(other_map.geometry().cell_center({x, y})));
-        const double dist = cell ? wall_distance.at<float>(cell->y, cell->x) * o.resolution_m : 5.0;
+        const double dist = cell ? wall_distance[std::size_t(g.index(*cell))] * o.resolution_m : 5.0;
         sum += dist;
         misplaced += dist > 0.3;
         ++count;

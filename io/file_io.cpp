@@ -257,7 +257,7 @@ OutputFolder::OutputFolder(fs::path dir, std::string command, std::vector<std::s
   // A listed file, or a temporary of one that a killed run left ("<name>.tmp.<pid>.<n>", a video's
   // "<stem>.partial<ext>"). Without a list, every file is the user's.
   const auto ours = [&](const std::string& name) {
-    if (name == kListName) return true;
+    if (name == kListName || name.rfind(std::string(kListName) + ".tmp.", 0) == 0) return true;
     for (const auto& n : earlier_) {
       if (name == n || name.rfind(n + ".tmp.", 0) == 0) return true;
       const fs::path p = n;

@@ -15,6 +15,7 @@
 #include "core/registry.h"
 #include "core/transform2.h"
 #include "mapping/occupancy_grid.h"
+#include "mapping/range_scan.h"
 
 namespace fleetmap::localization {
 
@@ -44,11 +45,7 @@ struct Landmark {
 };
 
 // A 2D laser scan in the robot frame.
-struct RangeScan {
-  std::vector<double> angles;                // rad, robot frame
-  std::vector<std::optional<double>> ranges;  // nullopt: no return within max_range
-  double max_range = 0.0;
-};
+using mapping::RangeScan;
 
 // Another robot detected by this one, with what that robot believes of itself. other_pose and
 // other_covariance must be expressed in this robot's map frame.

@@ -1,3 +1,4 @@
+#include "mapping/range_scan.h"
 #include "localization/rbpf_localizer.h"
 
 #include <Eigen/Dense>
@@ -49,7 +50,7 @@ void RbpfLocalizer::update_scan(const RangeScan& scan, const mapping::OccupancyG
       p.log_weight += match.log_normalizer;
       ++matched_;
     }
-    integrate_scan(p.map, p.pose, scan);
+    mapping::insert_scan(p.map, p.pose, scan);
   }
   // Normalise, find the best particle, and resample when the weights have degenerated.
   double top = -1e300;

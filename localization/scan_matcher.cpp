@@ -191,13 +191,4 @@ ScanMatch match_scan_to_grid(const CowGrid& map, const RangeScan& scan, const co
   return match_scan(field, points, guess, o, prior_mean);
 }
 
-void integrate_scan(CowGrid& map, const core::Pose2& pose, const RangeScan& scan) {
-  for (std::size_t b = 0; b < scan.angles.size(); ++b) {
-    const double a = pose.theta + scan.angles[b];
-    const double r = scan.ranges[b].value_or(scan.max_range);
-    map.integrate_ray(pose.position(), pose.position() + r * Eigen::Vector2d(std::cos(a), std::sin(a)),
-                      scan.ranges[b].has_value());
-  }
-}
-
 }  // namespace fleetmap::localization

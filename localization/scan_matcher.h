@@ -65,8 +65,6 @@ ScanMatch match_scan(const LikelihoodField& field, const std::vector<Eigen::Vect
 ScanMatch match_scan_to_grid(const CowGrid& map, const RangeScan& scan, const core::Pose2& guess,
                              const ScanMatcherOptions& options, const std::optional<core::Pose2>& prior_mean = std::nullopt);
 
-// Integrates a scan into a grid at `pose` (every beam, as the simulator maps).
-void integrate_scan(CowGrid& map, const core::Pose2& pose, const RangeScan& scan);
 
 // Local refinement alone (step 2), from `start`; returns the refined pose and its log-likelihood.
 std::pair<core::Pose2, double> refine_pose(const LikelihoodField& field, const std::vector<Eigen::Vector2d>& points,

@@ -12,6 +12,7 @@
 // (a match is relative to the robot's own map, so it never shrinks the uncertainty).
 #include <cmath>
 
+#include "mapping/range_scan.h"
 #include "localization/cow_grid.h"
 #include "localization/ekf_models.h"
 #include "localization/localizer.h"
@@ -50,7 +51,7 @@ class ScanMatchingLocalizer final : public Localizer {
     }
     covariance_ += pending_;
     pending_.setZero();
-    integrate_scan(map_, pose_, scan);
+    mapping::insert_scan(map_, pose_, scan);
   }
 
   core::Pose2 pose() const override { return pose_; }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "mapping/distance_field.h"
 #include "mapping/grid_traversal.h"
 
 namespace fleetmap::planning {
@@ -27,34 +28,23 @@ FreeSpace::FreeSpace(const mapping::OccupancyGrid& grid, const FreeSpaceOptions&
   region_.assign(n, 0);
   if (n == 0) return;
 
-  // Non-zero where the robot's centre could be; a one-cell obstacle frame stands for the
-  // outside of the map. Row r of the matrix is cell row r - 1 (the orientation does not matter
-  // to a distance transform).
-  cv::Mat open(h + 2, w + 2, CV_8UC1, cv::Scalar(0));
+  // Where the robot's centre may not be; outside the map counts as an obstacle.
   const bool unknown_blocks = options_.unknown == UnknownCells::Obstacle;
-  for (int y = 0; y < h; ++y) {
-    auto* row = open.ptr<std::uint8_t>(y + 1);
-    for (int x = 0; x < w; ++x) {
-      const int i = geometry_.index({x, y});
-      const mapping::CellState s = grid.state_at(i);
-      const bool blocked = s == mapping::CellState::Occupied || (unknown_blocks && s == mapping::CellState::Unknown);
-      state_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(s);
-      obstacle_[static_cast<std::size_t>(i)] = blocked ? 1 : 0;
-      row[x + 1] = blocked ? 0 : 255;
-    }
+  for (int i = 0; i < int(n); ++i) {
+    const mapping::CellState s = grid.state_at(i);
+    const bool blocked = s == mapping::CellState::Occupied || (unknown_blocks && s == mapping::CellState::Unknown);
+    state_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(s);
+    obstacle_[static_cast<std::size_t>(i)] = blocked ? 1 : 0;
   }
-  // Distance in cells from each pixel's centre to the centre of the nearest zero pixel.
-  cv::Mat distance;
-  cv::distanceTransform(open, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  const std::vector<float> distance = mapping::distance_to_blocked(w, h, obstacle_);
 
   cv::Mat valid_mask(h, w, CV_8UC1, cv::Scalar(0));
   const double res = geometry_.resolution();
   for (int y = 0; y < h; ++y) {
-    const float* d = distance.ptr<float>(y + 1);
     auto* v = valid_mask.ptr<std::uint8_t>(y);
     for (int x = 0; x < w; ++x) {
       const auto i = static_cast<std::size_t>(geometry_.index({x, y}));
-      const double clearance_m = double(d[x + 1]) * res;
+      const double clearance_m = double(distance[i]) * res;
       clearance_[i] = static_cast<float>(clearance_m);
       // A clearance equal to the radius (up to rounding) does not exceed it.
       if (clearance_m > options_.robot_radius_m + 1e-9) {

@@ -13,6 +13,7 @@
 #include "localization/metrics.h"
 #include "io/map_io.h"
 #include "io/octomap_io.h"
+#include "sim/run_metrics.h"
 #include "viz/render.h"
 
 namespace fleetmap::sim {
@@ -65,17 +66,11 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   j["coverage"] = r.coverage.empty() ? 0.0 : r.coverage.back();
   j["steps_to_95"] = optional_int(r.steps_to_95);
   j["steps_to_99"] = optional_int(r.steps_to_99);
-  double distance = 0.0, position_rmse_sum = 0.0;
-  int blocked = 0;
+  const RunTotals totals = run_totals(r);
   json per_robot = json::array();
   for (std::size_t i = 0; i < r.robots.size(); ++i) {
     const auto& t = r.robots[i];
-    distance += t.distance_m;
-    blocked += t.blocked_moves;
-    localization::LocalizationMetrics lm;
-    for (std::size_t k = 0; k < t.truth.size(); ++k) lm.add(t.truth[k], t.estimate[k], t.covariance[k]);
-    const auto loc = lm.summary();
-    position_rmse_sum += loc.position_rmse;
+    const auto& loc = totals.per_robot[i];
     json robot = {{"robot", i + 1},
                   {"start", {t.truth.front().x, t.truth.front().y, core::rad2deg(t.truth.front().theta)}},
                   {"distance_m", t.distance_m},
@@ -83,7 +78,7 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
                   {"position_rmse_m", loc.position_rmse},
                   {"heading_rmse_deg", core::rad2deg(loc.heading_rmse)},
                   // Standard NEES (e^T P^-1 e) averaged over the steps with a positive-definite P,
-                  // with its two-sided 95% chi-square band; seed 000's mu (e^T P e) beside it.
+                  // with its two-sided 95% chi-square band; D'Alfonso et al.'s mu (e^T P e) beside it.
                   {"nees", loc.average_nees ? json(*loc.average_nees) : json(nullptr)},
                   {"nees_steps", loc.nees_steps},
                   {"nees_band_95", {loc.nees_band.lower, loc.nees_band.upper}},
@@ -92,9 +87,9 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
     for (const auto& [name, value] : t.localizer_counters) robot["localizer"][name] = value;
     per_robot.push_back(robot);
   }
-  j["distance_m"] = distance;
-  j["position_rmse_m"] = r.robots.empty() ? 0.0 : position_rmse_sum / double(r.robots.size());  // mean over robots
-  j["blocked_moves"] = blocked;
+  j["distance_m"] = totals.distance_m;
+  j["position_rmse_m"] = totals.position_rmse_m;
+  j["blocked_moves"] = totals.blocked_moves;
   j["redundancy"] = r.redundancy;
   j["bytes_sent"] = r.bytes_sent;
   j["meetings"] = r.meetings;
@@ -102,23 +97,20 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   j["landmarks"] = r.landmarks.size();
   j["per_robot"] = per_robot;
   json merges = json::array();
-  int merged = 0, refused = 0;
   for (const auto& m : r.merges) {
     json e = {{"step", m.step}, {"receiver", m.receiver + 1}, {"sender", m.sender + 1}, {"method", m.method},
               {"merged", m.merged}, {"confidence", m.confidence}};
     if (m.merged) {
       e["rotation_error_deg"] = m.rotation_error_deg;
       e["position_error_m"] = m.position_error_m;
-      ++merged;
     } else {
       e["reason"] = m.reason;
-      ++refused;
     }
     merges.push_back(e);
   }
   j["merges"] = merges;
-  j["merges_made"] = merged;
-  j["merges_refused"] = refused;
+  j["merges_made"] = totals.merges_made;
+  j["merges_refused"] = totals.merges_refused;
   std::map<std::string, int> event_counts;
   for (const auto& e : r.events) ++event_counts[e.kind];
   j["events"] = event_counts;

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/angle.h"
 #include "localization/localizers.h"
+#include "mapping/range_scan.h"
 #include "merging/merge.h"
 #include "merging/rendezvous.h"
 #include "planning/planner.h"
@@ -314,20 +315,15 @@ void Simulation::sense_and_map() {
     const auto& scan = scans[std::size_t(i)];
     const std::uint64_t bit = std::uint64_t{1} << i;
     auto& own = maps_[std::size_t(i)];
-    for (std::size_t b = 0; b < scan.angles.size(); ++b) {
-      const double a = est.theta + scan.angles[b];
-      const double range = scan.ranges[b].value_or(scan.max_range);
-      const Eigen::Vector2d end = est.position() + range * Eigen::Vector2d(std::cos(a), std::sin(a));
-      const bool hit = scan.ranges[b].has_value();
-      own.integrate_ray(est.position(), end, hit, [&](int cell, bool changed) {
+    const core::Pose2 world = in_world(i, est);
+    mapping::for_each_beam(est, scan, [&](const Eigen::Vector2d& from, const Eigen::Vector2d& end, bool hit) {
+      own.integrate_ray(from, end, hit, [&](int cell, bool changed) {
         if (changed) exchange_.touched(i, cell);
       });
       // The evaluation's merged map is in the world frame: the simulator knows where each frame lies.
-      const core::Pose2 world = in_world(i, est);
-      const Eigen::Vector2d world_end = frame_origin(i).apply(end);
-      merged_.integrate_ray(world.position(), world_end, hit,
+      merged_.integrate_ray(world.position(), frame_origin(i).apply(end), hit,
                             [&](int cell, bool) { sensed_by_[std::size_t(cell)] |= bit; });
-    }
+    });
   }
   timing_.mapping += seconds_since(t0);
 }

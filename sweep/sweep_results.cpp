@@ -15,22 +15,13 @@
 #include "core/error.h"
 #include "io/file_io.h"
 #include "sweep/lower_bound.h"
-#include "sim/run_output.h"
+#include "sim/run_metrics.h"
 
 namespace fleetmap::sweep {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-const std::vector<std::string>& columns() {
-  static const std::vector<std::string> kColumns = {
-      "map", "strategy", "robots", "seed", "localization", "merging", "comm_range_m", "sensor_range_m", "step_limit", "settings",
-      "steps", "finished", "coverage", "steps_to_95", "steps_to_99", "distance_m", "redundancy", "bytes_sent",
-      "meetings", "merges_made", "blocked_moves", "position_rmse_m", "lower_bound_steps", "lower_bound_travel_steps",
-      "lower_bound_area_steps", "efficiency", "wall_time_s", "steps_to_percent"};
-  return kColumns;
-}
 
 std::string fixed(double v, int decimals) {
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
@@ -61,6 +52,8 @@ std::vector<std::string> split_fields(const std::string& line) {
   }
 }
 
+std::string column_name(std::size_t i);
+
 // Parses the fields of one row; every error names the line and the column.
 struct FieldReader {
   const std::vector<std::string>& fields;
@@ -68,7 +61,7 @@ struct FieldReader {
   std::size_t next = 0;
 
   [[noreturn]] void fail(const std::string& expected) const {
-    throw InputError(where + ": column '" + columns()[next - 1] + "': expected " + expected + ", got '" + fields[next - 1] + "'");
+    throw InputError(where + ": column '" + column_name(next - 1) + "': expected " + expected + ", got '" + fields[next - 1] + "'");
   }
   const std::string& text() { return fields[next++]; }
   long long integer(long long lo = std::numeric_limits<long long>::min()) {
@@ -141,6 +134,69 @@ struct FieldReader {
   }
 };
 
+// Every column of results.csv, once: its name, how a record writes it, how a row reads it back.
+struct Column {
+  const char* name;
+  std::string (*write)(const RunRecord&);
+  void (*read)(FieldReader&, RunRecord&);
+};
+
+const std::vector<Column>& columns() {
+  using R = const RunRecord&;
+  using W = RunRecord&;
+  using F = FieldReader&;
+  static const std::vector<Column> kColumns = {
+      {"map", [](R r) { return r.key.map; }, [](F f, W r) { r.key.map = f.text(); }},
+      {"strategy", [](R r) { return r.key.strategy; }, [](F f, W r) { r.key.strategy = f.text(); }},
+      {"robots", [](R r) { return std::to_string(r.key.robots); }, [](F f, W r) { r.key.robots = int(f.integer(1)); }},
+      {"seed", [](R r) { return std::to_string(r.key.seed); }, [](F f, W r) { r.key.seed = f.unsigned_integer(); }},
+      {"localization", [](R r) { return r.localization; }, [](F f, W r) { r.localization = f.text(); }},
+      {"merging", [](R r) { return r.merging; }, [](F f, W r) { r.merging = f.text(); }},
+      {"comm_range_m", [](R r) { return std::isinf(r.comm_range_m) ? std::string("inf") : fixed(r.comm_range_m, 3); },
+       [](F f, W r) { r.comm_range_m = f.number(); }},
+      {"sensor_range_m", [](R r) { return fixed(r.sensor_range_m, 3); }, [](F f, W r) { r.sensor_range_m = f.number(); }},
+      {"step_limit", [](R r) { return std::to_string(r.step_limit); }, [](F f, W r) { r.step_limit = int(f.integer(1)); }},
+      {"settings", [](R r) { return r.settings; }, [](F f, W r) { r.settings = f.text(); }},
+      {"steps", [](R r) { return std::to_string(r.steps); }, [](F f, W r) { r.steps = int(f.integer(0)); }},
+      {"finished", [](R r) { return std::string(r.finished ? "true" : "false"); }, [](F f, W r) { r.finished = f.boolean(); }},
+      {"coverage", [](R r) { return fixed(r.coverage, 6); }, [](F f, W r) { r.coverage = f.number(); }},
+      {"steps_to_95", [](R r) { return optional_int(r.steps_to_95); }, [](F f, W r) { r.steps_to_95 = f.optional_integer(); }},
+      {"steps_to_99", [](R r) { return optional_int(r.steps_to_99); }, [](F f, W r) { r.steps_to_99 = f.optional_integer(); }},
+      {"distance_m", [](R r) { return fixed(r.distance_m, 3); }, [](F f, W r) { r.distance_m = f.number(); }},
+      {"redundancy", [](R r) { return fixed(r.redundancy, 6); }, [](F f, W r) { r.redundancy = f.number(); }},
+      {"bytes_sent", [](R r) { return std::to_string(r.bytes_sent); }, [](F f, W r) { r.bytes_sent = f.integer(0); }},
+      {"meetings", [](R r) { return std::to_string(r.meetings); }, [](F f, W r) { r.meetings = int(f.integer(0)); }},
+      {"merges_made", [](R r) { return std::to_string(r.merges_made); }, [](F f, W r) { r.merges_made = int(f.integer(0)); }},
+      {"blocked_moves", [](R r) { return std::to_string(r.blocked_moves); },
+       [](F f, W r) { r.blocked_moves = int(f.integer(0)); }},
+      {"position_rmse_m", [](R r) { return fixed(r.position_rmse_m, 6); }, [](F f, W r) { r.position_rmse_m = f.number(); }},
+      {"lower_bound_steps", [](R r) { return std::to_string(r.lower_bound_steps); },
+       [](F f, W r) { r.lower_bound_steps = int(f.integer(0)); }},
+      {"lower_bound_travel_steps", [](R r) { return std::to_string(r.lower_bound_travel_steps); },
+       [](F f, W r) { r.lower_bound_travel_steps = int(f.integer(0)); }},
+      {"lower_bound_area_steps", [](R r) { return std::to_string(r.lower_bound_area_steps); },
+       [](F f, W r) { r.lower_bound_area_steps = int(f.integer(0)); }},
+      {"efficiency", [](R r) { return r.efficiency ? fixed(*r.efficiency, 6) : std::string(); },
+       [](F f, W r) { r.efficiency = f.optional_number(); }},
+      {"wall_time_s", [](R r) { return fixed(r.wall_time_s, 3); }, [](F f, W r) { r.wall_time_s = f.number(); }},
+      {"steps_to_percent", [](R r) { return levels_text(r.steps_to_percent); },
+       [](F f, W r) { r.steps_to_percent = f.levels(); }},
+  };
+  return kColumns;
+}
+
+std::string column_name(std::size_t i) { return columns()[i].name; }
+
+// The row's text; without the wall time (the only column two runs of one key may differ in) when asked.
+std::string row_text(const RunRecord& r, bool wall_time) {
+  std::string line;
+  for (const auto& c : columns()) {
+    if (!wall_time && std::string_view(c.name) == "wall_time_s") continue;
+    line += (line.empty() ? "" : ",") + c.write(r);
+  }
+  return line;
+}
+
 std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
 
 std::string errno_text() { return std::strerror(errno); }
@@ -150,7 +206,7 @@ std::string errno_text() { return std::strerror(errno); }
 RunRecord make_record(const sim::RunResult& result, const sim::World& world, const std::string& map_label,
                       const std::string& settings, double wall_time_s) {
   const sim::Scenario& s = result.scenario;
-  const nlohmann::json m = sim::metrics_json(result, map_label);
+  const sim::RunTotals totals = sim::run_totals(result);
   RunRecord r;
   r.key = {map_label, s.exploration.strategy, s.robot_count, s.seed};
   r.localization = s.localization;
@@ -159,18 +215,18 @@ RunRecord make_record(const sim::RunResult& result, const sim::World& world, con
   r.sensor_range_m = s.range.max_range_m;
   r.step_limit = s.steps;
   r.settings = settings;
-  r.steps = m["steps"].get<int>();
-  r.finished = m["finished"].get<bool>();
-  r.coverage = m["coverage"].get<double>();
-  if (!m["steps_to_95"].is_null()) r.steps_to_95 = m["steps_to_95"].get<int>();
-  if (!m["steps_to_99"].is_null()) r.steps_to_99 = m["steps_to_99"].get<int>();
-  r.distance_m = m["distance_m"].get<double>();
-  r.redundancy = m["redundancy"].get<double>();
-  r.bytes_sent = m["bytes_sent"].get<std::int64_t>();
-  r.meetings = m["meetings"].get<int>();
-  r.merges_made = m["merges_made"].get<int>();
-  r.blocked_moves = m["blocked_moves"].get<int>();
-  r.position_rmse_m = m["position_rmse_m"].get<double>();
+  r.steps = result.steps;
+  r.finished = result.finished;
+  r.coverage = result.coverage.empty() ? 0.0 : result.coverage.back();
+  r.steps_to_95 = result.steps_to_95;
+  r.steps_to_99 = result.steps_to_99;
+  r.distance_m = totals.distance_m;
+  r.redundancy = result.redundancy;
+  r.bytes_sent = result.bytes_sent;
+  r.meetings = result.meetings;
+  r.merges_made = totals.merges_made;
+  r.blocked_moves = totals.blocked_moves;
+  r.position_rmse_m = totals.position_rmse_m;
 
   std::vector<Eigen::Vector2d> starts;
   for (const auto& t : result.robots) starts.push_back(t.truth.front().position());
@@ -186,10 +242,10 @@ RunRecord make_record(const sim::RunResult& result, const sim::World& world, con
 
   // The same rule as steps_to_95 / steps_to_99: the first step whose coverage reaches the level.
   r.steps_to_percent.assign(std::size_t(kCoverageLevels), std::nullopt);
-  const auto& curve = m["coverage_curve"];
+  const auto& curve = result.coverage;
   std::size_t level = 0;
   for (std::size_t step = 0; step < curve.size() && level < r.steps_to_percent.size(); ++step) {
-    const double c = curve[step].get<double>();
+    const double c = curve[step];
     while (level < r.steps_to_percent.size() && c >= double(level + 1) / 100.0) r.steps_to_percent[level++] = int(step);
   }
   r.wall_time_s = wall_time_s;
@@ -208,48 +264,13 @@ double coverage_at(const RunRecord& r, int step) {
 
 std::string results_header() {
   std::string h;
-  for (const auto& c : columns()) h += (h.empty() ? "" : ",") + c;
+  for (const auto& c : columns()) h += (h.empty() ? "" : ",") + std::string(c.name);
   return h;
 }
 
-std::string format_record(const RunRecord& r) {
-  std::string line = record_without_wall_time(r);
-  const auto cut = line.rfind(',');  // before steps_to_percent
-  return line.substr(0, cut) + "," + fixed(r.wall_time_s, 3) + line.substr(cut);
-}
+std::string format_record(const RunRecord& r) { return row_text(r, true); }
 
-std::string record_without_wall_time(const RunRecord& r) {
-  const std::vector<std::string> f = {r.key.map,
-                                      r.key.strategy,
-                                      std::to_string(r.key.robots),
-                                      std::to_string(r.key.seed),
-                                      r.localization,
-                                      r.merging,
-                                      std::isinf(r.comm_range_m) ? "inf" : fixed(r.comm_range_m, 3),
-                                      fixed(r.sensor_range_m, 3),
-                                      std::to_string(r.step_limit),
-                                      r.settings,
-                                      std::to_string(r.steps),
-                                      r.finished ? "true" : "false",
-                                      fixed(r.coverage, 6),
-                                      optional_int(r.steps_to_95),
-                                      optional_int(r.steps_to_99),
-                                      fixed(r.distance_m, 3),
-                                      fixed(r.redundancy, 6),
-                                      std::to_string(r.bytes_sent),
-                                      std::to_string(r.meetings),
-                                      std::to_string(r.merges_made),
-                                      std::to_string(r.blocked_moves),
-                                      fixed(r.position_rmse_m, 6),
-                                      std::to_string(r.lower_bound_steps),
-                                      std::to_string(r.lower_bound_travel_steps),
-                                      std::to_string(r.lower_bound_area_steps),
-                                      r.efficiency ? fixed(*r.efficiency, 6) : "",
-                                      levels_text(r.steps_to_percent)};
-  std::string line;
-  for (const auto& s : f) line += (line.empty() ? "" : ",") + s;
-  return line;
-}
+std::string record_without_wall_time(const RunRecord& r) { return row_text(r, false); }
 
 RunRecord parse_record(const std::string& line, const std::string& where) {
   const auto fields = split_fields(line);
@@ -258,34 +279,7 @@ RunRecord parse_record(const std::string& line, const std::string& where) {
   }
   FieldReader in{fields, where};
   RunRecord r;
-  r.key.map = in.text();
-  r.key.strategy = in.text();
-  r.key.robots = int(in.integer(1));
-  r.key.seed = in.unsigned_integer();
-  r.localization = in.text();
-  r.merging = in.text();
-  r.comm_range_m = in.number();
-  r.sensor_range_m = in.number();
-  r.step_limit = int(in.integer(1));
-  r.settings = in.text();
-  r.steps = int(in.integer(0));
-  r.finished = in.boolean();
-  r.coverage = in.number();
-  r.steps_to_95 = in.optional_integer();
-  r.steps_to_99 = in.optional_integer();
-  r.distance_m = in.number();
-  r.redundancy = in.number();
-  r.bytes_sent = in.integer(0);
-  r.meetings = int(in.integer(0));
-  r.merges_made = int(in.integer(0));
-  r.blocked_moves = int(in.integer(0));
-  r.position_rmse_m = in.number();
-  r.lower_bound_steps = int(in.integer(0));
-  r.lower_bound_travel_steps = int(in.integer(0));
-  r.lower_bound_area_steps = int(in.integer(0));
-  r.efficiency = in.optional_number();
-  r.wall_time_s = in.number();
-  r.steps_to_percent = in.levels();
+  for (const auto& c : columns()) c.read(in, r);
   if (r.key.map.empty() || r.key.strategy.empty()) throw InputError(where + ": empty map or strategy");
   return r;
 }

@@ -1,12 +1,9 @@
 #include "sweep/sweep_runner.h"
 
-#include <atomic>
 #include <chrono>
-#include <exception>
-#include <mutex>
-#include <thread>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/random.h"
 #include "sim/simulation.h"
 #include "sim/world.h"
@@ -52,32 +49,14 @@ void check_placements(const Sweep& sweep, const SweepMaps& maps) {
 void run_sweep(const Sweep& sweep, const std::vector<SweepRun>& runs, const SweepMaps& maps,
                const SweepRunOptions& options, const std::function<void(const RunRecord&)>& on_record) {
   for (const auto& r : runs) map_of(maps, r.map);
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> stop{false};
-  std::mutex mutex;  // guards on_record and `failure`
-  std::exception_ptr failure;
-  const auto worker = [&]() {
-    while (!stop) {
-      const std::size_t i = next++;
-      if (i >= runs.size()) return;
-      try {
-        const RunRecord record = run_one(sweep, runs[i], maps.at(runs[i].map));
-        const std::lock_guard lock(mutex);
-        on_record(record);
-      } catch (...) {
-        const std::lock_guard lock(mutex);
-        if (!failure) failure = std::current_exception();
-        stop = true;
-      }
-    }
-  };
-  const int jobs = std::max(1, std::min<int>(options.jobs, int(runs.size())));
-  {
-    std::vector<std::jthread> threads;
-    for (int j = 1; j < jobs; ++j) threads.emplace_back(worker);
-    worker();
-  }
-  if (failure) std::rethrow_exception(failure);
+  std::vector<RunRecord> done(runs.size());
+  core::parallel_for(
+      int(runs.size()), options.jobs,
+      [&](int i) { done[std::size_t(i)] = run_one(sweep, runs[std::size_t(i)], maps.at(runs[std::size_t(i)].map)); },
+      [&](int i) {
+        on_record(done[std::size_t(i)]);
+        done[std::size_t(i)] = {};  // a finished run's record is not kept
+      });
 }
 
 }  // namespace fleetmap::sweep

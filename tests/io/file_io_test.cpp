@@ -133,9 +133,11 @@ TEST(OutputFolder, TakesOnlyANewOrEmptyFolderOrOneOfAnEarlierRun) {
   fresh.finish({"a.png", "b.png", "c.png"});
   // A second, smaller run: b.png is replaced, c.png (not written again) removed, a leftover temporary too.
   write_file_atomic(d / "run" / "c.png.tmp.123.0", "half");
+  write_file_atomic(d / "run" / (std::string(OutputFolder::kListName) + ".tmp.123.1"), "half a list");
   OutputFolder again(d / "run", "explore", {"a.png", "b.png"}, {}, "--out run");
   again.claim();
   EXPECT_FALSE(fs::exists(d / "run" / "c.png.tmp.123.0"));
+  EXPECT_FALSE(fs::exists(d / "run" / (std::string(OutputFolder::kListName) + ".tmp.123.1")));
   write_file_atomic(d / "run" / "a.png", "new a");
   again.finish({"a.png"});
   EXPECT_EQ(read_text(d / "run" / "a.png"), "new a");

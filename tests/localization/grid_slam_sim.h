@@ -47,14 +47,4 @@ inline RangeScan scan_at(const mapping::OccupancyGrid& truth, const core::Pose2&
   return s;
 }
 
-// Integrates a scan into `map` at `pose`, as the simulator does with a robot's own map.
-inline void integrate_scan(mapping::OccupancyGrid& map, const core::Pose2& pose, const RangeScan& scan) {
-  for (std::size_t b = 0; b < scan.angles.size(); ++b) {
-    const double a = pose.theta + scan.angles[b];
-    const double r = scan.ranges[b].value_or(scan.max_range);
-    map.integrate_ray(pose.position(), pose.position() + r * Eigen::Vector2d(std::cos(a), std::sin(a)),
-                      scan.ranges[b].has_value());
-  }
-}
-
 }  // namespace fleetmap::localization::testing

@@ -5,6 +5,7 @@
 #include <unordered_set>
 
 #include "core/angle.h"
+#include "mapping/range_scan.h"
 #include "localization/cow_grid.h"
 #include "localization/localizer.h"
 #include "localization/rbpf_localizer.h"
@@ -14,7 +15,6 @@ namespace fleetmap::localization {
 namespace {
 
 using testing::asymmetric_room;
-using testing::integrate_scan;
 using testing::scan_at;
 
 TEST(CowGrid, CopiesShareTilesUntilTheFirstWrite) {
@@ -43,7 +43,7 @@ TEST(CowGrid, HoldsTheSameNumbersAsAnOccupancyGrid) {
   CowGrid cow(room.geometry());
   for (const core::Pose2 p : {core::Pose2(2, 2, 0), core::Pose2(6, 3, 1), core::Pose2(8.5, 1.5, 2)}) {
     const auto scan = scan_at(room, p, 0.02, rng);
-    integrate_scan(dense, p, scan);
+    mapping::insert_scan(dense, p, scan);
     for (std::size_t b = 0; b < scan.angles.size(); ++b) {
       const double r = scan.ranges[b].value_or(scan.max_range);
       cow.integrate_ray(p.position(), p.position() + r * Eigen::Vector2d(std::cos(p.theta + scan.angles[b]), std::sin(p.theta + scan.angles[b])),
@@ -87,7 +87,7 @@ TEST(RbpfLocalizer, WithOneParticleAndNoNoiseEqualsTheScanMatcher) {
     ASSERT_NEAR(pf->pose().x, sm->pose().x, 1e-9) << "step " << k;
     ASSERT_NEAR(pf->pose().y, sm->pose().y, 1e-9) << "step " << k;
     ASSERT_NEAR(pf->pose().theta, sm->pose().theta, 1e-9) << "step " << k;
-    integrate_scan(own, sm->pose(), scan);
+    mapping::insert_scan(own, sm->pose(), scan);
   }
   EXPECT_GT(moved_by_matching, 10);  // the comparison is not between two dead reckonings
   const auto pf_map = pf->map_estimate();
@@ -122,7 +122,7 @@ TEST(RbpfLocalizer, ParticleMapsShareMemoryCopyOnWrite) {
     }
     const auto scan = scan_at(room, truth, 0.01, rng);
     pf.update_scan(scan, own);
-    integrate_scan(own, pf.pose(), scan);
+    mapping::insert_scan(own, pf.pose(), scan);
   }
   const auto m = pf.memory();
   EXPECT_EQ(m.unshared_bytes, std::size_t(30) * 1000 * 1000 * CowGrid::tile_bytes() / (32 * 32));
@@ -170,7 +170,7 @@ TEST(RbpfLocalizer, CorrectsBiasedOdometry) {
     }
     const auto scan = scan_at(room, truth, 0.01, rng);
     pf->update_scan(scan, own);
-    integrate_scan(own, pf->pose(), scan);
+    mapping::insert_scan(own, pf->pose(), scan);
   }
   EXPECT_GT((odometry.position() - truth.position()).norm(), 0.12);
   EXPECT_LT((pf->pose().position() - truth.position()).norm(), 0.04);

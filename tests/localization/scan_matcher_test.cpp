@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/angle.h"
+#include "mapping/range_scan.h"
 #include "localization/likelihood_field.h"
 #include "localization/localizer.h"
 #include "localization/scan_matcher.h"
@@ -14,7 +15,6 @@ namespace fleetmap::localization {
 namespace {
 
 using testing::asymmetric_room;
-using testing::integrate_scan;
 using testing::scan_at;
 
 constexpr double kRangeNoise = 0.01;  // m
@@ -42,7 +42,7 @@ TEST(ScanMatcher, RecoversAKnownSmallPoseOffsetOnASyntheticRoom) {
   core::Random map_rng(70);
   for (const core::Pose2 p : {core::Pose2(1.0, 1.0, 0.0), core::Pose2(5.0, 1.0, 1.0), core::Pose2(8.5, 1.0, 2.0),
                               core::Pose2(5.0, 5.5, 3.0), core::Pose2(1.0, 6.0, -1.0), core::Pose2(5.0, 3.5, 0.5)}) {
-    integrate_scan(map, p, scan_at(room, p, kRangeNoise, map_rng));
+    mapping::insert_scan(map, p, scan_at(room, p, kRangeNoise, map_rng));
   }
   const auto field = LikelihoodField::of_grid(map, window_around(room.geometry(), {5.0, 3.5}, 20.0));
   core::Random rng(7);
@@ -97,7 +97,7 @@ TEST(ScanMatchingLocalizer, CorrectsBiasedOdometryOnItsOwnMap) {
   core::Pose2 truth = c.initial_pose;
   const auto first = scan_at(room, truth, kRangeNoise, rng);
   sm->update_scan(first, own);
-  integrate_scan(own, sm->pose(), first);
+  mapping::insert_scan(own, sm->pose(), first);
   for (int k = 0; k < 30; ++k) {
     const Odometry driven{0.1, k < 15 ? 0.0 : 0.05, 1.0};
     truth = integrate_motion(truth, driven);
@@ -106,7 +106,7 @@ TEST(ScanMatchingLocalizer, CorrectsBiasedOdometryOnItsOwnMap) {
     odo->predict(reported);
     const auto scan = scan_at(room, truth, kRangeNoise, rng);
     sm->update_scan(scan, own);
-    integrate_scan(own, sm->pose(), scan);
+    mapping::insert_scan(own, sm->pose(), scan);
   }
   const double sm_error = (sm->pose().position() - truth.position()).norm();
   const double odo_error = (odo->pose().position() - truth.position()).norm();

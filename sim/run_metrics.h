@@ -1,0 +1,21 @@
+#pragma once
+// The totals of a run that metrics.json, results.csv and the run summary all report, computed in
+// one place from the run's record.
+#include <vector>
+
+#include "localization/metrics.h"
+#include "sim/simulation.h"
+
+namespace fleetmap::sim {
+
+struct RunTotals {
+  double distance_m = 0.0;       // true path length of all robots
+  int blocked_moves = 0;
+  double position_rmse_m = 0.0;  // mean over robots of each robot's position RMSE
+  int merges_made = 0, merges_refused = 0;
+  std::vector<localization::LocalizationSummary> per_robot;  // from truth, estimate and covariance
+};
+
+RunTotals run_totals(const RunResult& result);
+
+}  // namespace fleetmap::sim
