@@ -1,4 +1,4 @@
-// Grid SLAM and MCL (seed 002): the time of one scan match (`scan-matching`'s update), of one
+// Grid SLAM and MCL (León et al.): the time of one scan match (`scan-matching`'s update), of one
 // `rbpf` step (predict + update) with 30 particles on a 1000 x 1000 map and the memory its
 // particle maps hold, and of one `mcl` update. Results: bench/README.md, "## Grid SLAM and MCL".
 #include <benchmark/benchmark.h>

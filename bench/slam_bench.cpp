@@ -1,4 +1,4 @@
-// Seed 000's polynomial EKF-SLAM: time per step per robot (predict, extraction and association,
+// D'Alfonso et al.'s polynomial EKF-SLAM: time per step per robot (predict, extraction and association,
 // update, received maps), on one run of scenarios/dalfonso_3robots.yaml (3 robots, 200 steps, map
 // exchange at rendezvous), and on a single robot's step alone. Results: bench/README.md,
 // "## Polynomial SLAM".
@@ -30,7 +30,7 @@ void BM_PolynomialSlamRun(benchmark::State& state) {
     for (const auto& robot : r.robots) {
       tau += robot.tau_s * double(robot.truth.size());
       nu += robot.mapping.nu;
-      mu += robot.localization.seed000_mu;
+      mu += robot.localization.dalfonso_mu;
       robot_steps += long(robot.truth.size());
     }
     benchmark::DoNotOptimize(r);

@@ -318,10 +318,10 @@ Command add_bench_command(CLI::App& root) {
       "redoing finished runs. The same flags give the same rows whatever --jobs (only wall_time_s differs).\n\n"
       "Examples:\n"
       "  fleetmap bench --maps office,cave --strategies all --robots 1,2,4,9 --seeds 20 --jobs 2 --out DIR\n"
-      "  fleetmap bench --sweep scenarios/sweeps/seed003.yaml --shard 2/4 --out DIR/shard_2\n"
+      "  fleetmap bench --sweep scenarios/sweeps/wave_paper.yaml --shard 2/4 --out DIR/shard_2\n"
       "  fleetmap bench --combine DIR/shard_1 DIR/shard_2 DIR/shard_3 DIR/shard_4 --out DIR/all\n"
       "  fleetmap bench --compare coordinated uncoordinated DIR\n"
-      "  bench/slurm/submit.sh 16 OUT --sweep scenarios/sweeps/seed003.yaml     (a Slurm job array)\n\n"
+      "  bench/slurm/submit.sh 16 OUT --sweep scenarios/sweeps/wave_paper.yaml     (a Slurm job array)\n\n"
       "Strategies (--strategies):\n" +
       exploration::strategy_help());
   auto f = std::make_shared<BenchFlags>();

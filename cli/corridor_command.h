@@ -1,5 +1,5 @@
 #pragma once
-// CLI glue of seed 002's corridor experiment (sim/corridor_experiment.h): `fleetmap slam` runs it
+// CLI glue of León et al.'s corridor experiment (sim/corridor_experiment.h): `fleetmap slam` runs it
 // for scenario files that say `experiment: leon_corridor` (cli/slam_command.cpp).
 #include <cstdint>
 #include <filesystem>

@@ -228,7 +228,7 @@ Command add_explore_command(CLI::App& root) {
       "\nMerging (--merging): how robots bring each other's maps into their own frame\n"
       "  known       every robot knows its start pose in one shared frame (default)\n"
       "  rendezvous  each robot maps in its own frame; robots that detect each other take the\n"
-      "              relative transform from the detection (seed 000 section 3.2)\n"
+      "              relative transform from the detection (D'Alfonso et al., section 3.2)\n"
       "  overlap     each robot maps in its own frame; robots that can talk search their maps for\n"
       "              the best overlap (as `fleetmap merge`) and merge only above a confidence\n");
   auto f = std::make_shared<ExploreFlags>();

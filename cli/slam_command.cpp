@@ -1,4 +1,4 @@
-// `fleetmap slam`: a SLAM experiment repeated over many runs (seed 000 §4 with
+// `fleetmap slam`: a SLAM experiment repeated over many runs (D'Alfonso et al., §4 with
 // scenarios/dalfonso_3robots.yaml): Table 1 as Markdown and CSV, every run's numbers, and the maps
 // of the first run as pictures. The scenario's `method` picks the SLAM method.
 #include <fmt/format.h>
@@ -94,17 +94,17 @@ int run_slam(const SlamFlags& f) {
 }  // namespace
 
 Command add_slam_command(CLI::App& root) {
-  CLI::App* app = root.add_subcommand("slam", "Reproduce a SLAM experiment: seed 000 section 4 (Table 1) or seed 002 corridor loop (Table I), with figures");
+  CLI::App* app = root.add_subcommand("slam", "Reproduce a SLAM experiment: D'Alfonso et al., section 4 (Table 1) or León et al. corridor loop (Table I), with figures");
   app->footer(
       "Robots follow precomputed paths in a room, each maps it and localizes itself on its own, and robots that\n"
       "see each other exchange maps. Writes Table 1 (means and standard deviations over the runs) as table1.md and\n"
       "table1.csv, runs.csv, rendezvous.csv, and the first run's maps as map_<robot>.png (and map_<robot>_alone.png\n"
-      "for the scenario's single_robot). Scenario keys: scenarios/dalfonso_3robots.yaml (commented) and README.md,\n\"Polynomial SLAM (seed 000)\".\n\n"
+      "for the scenario's single_robot). Scenario keys: scenarios/dalfonso_3robots.yaml (commented) and README.md,\n\"Polynomial SLAM (D'Alfonso et al.)\".\n\n"
       "Methods (the scenario's `method`): " + method_names() +
-      "\n  polynomial: seed 000's polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
+      "\n  polynomial: D'Alfonso et al.'s polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
       "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso\n\n"
-      "Scenarios with `experiment: leon_corridor` (scenarios/leon_corridor.yaml) run seed 002's corridor comparison\n"
-      "and merging by detection instead (--runs and --jobs do not apply); README.md, \"Grid SLAM and MCL (seed 002)\".");
+      "Scenarios with `experiment: leon_corridor` (scenarios/leon_corridor.yaml) run León et al.'s corridor comparison\n"
+      "and merging by detection instead (--runs and --jobs do not apply); README.md, \"Grid SLAM and MCL (León et al.)\".");
   auto f = std::make_shared<SlamFlags>();
   app->add_option("--scenario", f->scenario, "SLAM scenario YAML (see scenarios/dalfonso_3robots.yaml)")
       ->required()

@@ -6,7 +6,7 @@
 namespace fleetmap::core {
 
 // A rotation by `theta` followed by a translation `t`: p' = R(theta) p + t, the 3x3 homogeneous
-// matrix [[cos, -sin, tx], [sin, cos, ty], [0, 0, 1]] of the papers (seed 003 eq. (6)).
+// matrix [[cos, -sin, tx], [sin, cos, ty], [0, 0, 1]] of the papers (wave-algorithm paper, eq. (6)).
 // `a * b` applies b first, then a, like the matrix product.
 class Transform2 {
  public:

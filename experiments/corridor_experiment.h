@@ -1,5 +1,5 @@
 #pragma once
-// Seed 002's corridor comparison (§II.D, Table I) and its map merging by detection (§V).
+// León et al.'s corridor comparison (§II.D, Table I) and its map merging by detection (§V).
 //
 // The world: a rectangular corridor loop whose outer free extent is length x height (21.3 m x 17 m)
 // and whose corridors are long and featureless. One robot drives the loop's centre line laps times,
@@ -12,7 +12,7 @@
 //
 // Merging by detection: two robots map halves of the loop with scan matching, each in its own
 // frame; where they meet, the master measures range and bearing to the other and the other its
-// bearing to the master (seed 000 §3.2's rendezvous transform); the other's grid is placed into the
+// bearing to the master (D'Alfonso et al., §3.2's rendezvous transform); the other's grid is placed into the
 // master's frame with that relative pose and fused. An orientation error in the detection is added
 // to the other robot's bearing, and what it does to the merged map is measured.
 #include <cstdint>

@@ -167,7 +167,7 @@ std::vector<std::filesystem::path> write_corridor_outputs(const CorridorResult& 
     io::write_file_atomic(dir / name, bytes);
     written.push_back(dir / name);
   };
-  text("corridor_table.md", "# Seed 002, Table I: dimensional error of the corridor loop\n\n" + corridor_table_markdown(r));
+  text("corridor_table.md", "# León et al., Table I: dimensional error of the corridor loop\n\n" + corridor_table_markdown(r));
   text("corridor_table.csv", corridor_table_csv(r));
   text("corridor.json", corridor_json(r).dump(2) + "\n");
   const viz::Color red{220, 40, 40}, green{40, 160, 60}, blue{40, 90, 220};

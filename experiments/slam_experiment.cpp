@@ -123,7 +123,7 @@ SlamSetup prepare_slam(const SlamScenario& scenario) {
 
 namespace {
 
-// Seed 000's polynomial SLAM, one filter per robot.
+// D'Alfonso et al.'s polynomial SLAM, one filter per robot.
 SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange, int only) {
   const SlamScenario& sc = setup.scenario;
   std::vector<int> team;  // scenario robot index of each robot in this run

@@ -1,5 +1,5 @@
 #pragma once
-// Seed 000 §4's experiment: robots driven along precomputed paths (the commands are computed once,
+// D'Alfonso et al. §4's experiment: robots driven along precomputed paths (the commands are computed once,
 // noise-free, from the waypoints), each running its SLAM method from its own origin
 // (x_j,0 = [0 0 0] in R_j,0), exchanging maps when two robots see each other, and measured
 // against the truth: mu (the paper's form and the standard NEES), nu, tau, bytes per rendezvous.
@@ -27,7 +27,7 @@ mapping::OccupancyGrid rasterize_room(const SlamRoom& room, double margin_m = 0.
 
 // The commands that drive a robot from `start` along `path` at `speed`, one per step: heading for
 // the next waypoint (turning at most max_turn_rate, in place when more than 60 degrees off), and
-// (0, 0) once the last waypoint is reached. Noise-free, computed once (seed 000 §4: "angular
+// (0, 0) once the last waypoint is reached. Noise-free, computed once (D'Alfonso et al., §4: "angular
 // velocities precomputed").
 std::vector<localization::Odometry> path_commands(const core::Pose2& start, const std::vector<Eigen::Vector2d>& path,
                                                   double speed, int steps, double period_s, double max_turn_rate);
@@ -58,7 +58,7 @@ struct SlamRobotResult {
   std::string name;
   std::vector<core::Pose2> truth;     // k = 0..steps, room frame
   std::vector<core::Pose2> estimate;  // the estimate brought into the room frame by the true start
-  localization::LocalizationSummary localization;  // mu (seed000_mu), the standard NEES, RMSE
+  localization::LocalizationSummary localization;  // mu (dalfonso_mu), the standard NEES, RMSE
   mapping::MappingError mapping;      // nu
   double boundary_coverage = 0.0;     // share of the true walls within 0.1 m of the map
   double tau_s = 0.0;                 // mean SLAM time per step (predict, update, received maps)
@@ -76,7 +76,7 @@ struct SlamRunResult {
 
 // One run: the run index picks its random streams (per robot: motion, sensors, camera), so a run
 // without exchange has the same noise as the same run with it. `only` restricts the team to one
-// robot by index (-1: all), for the single-robot runs of seed 000 Fig. 8.
+// robot by index (-1: all), for the single-robot runs of D'Alfonso et al. Fig. 8.
 SlamRunResult run_slam(const SlamSetup& setup, int run, bool exchange, int only = -1);
 
 }  // namespace fleetmap::experiments

@@ -27,10 +27,10 @@ struct Metric {
 
 const std::vector<Metric>& metrics() {
   static const std::vector<Metric> kMetrics = {
-      {"mu", "mu_j (seed 000's form: e^T P e)", "%.3g", [](const SlamRobotResult& r) { return r.localization.seed000_mu; }},
+      {"mu", "mu_j (D'Alfonso et al.'s form: e^T P e)", "%.3g", [](const SlamRobotResult& r) { return r.localization.dalfonso_mu; }},
       {"nees", "NEES, standard (e^T P^-1 e; 3 when consistent)", "%.3g",
        [](const SlamRobotResult& r) { return r.localization.average_nees.value_or(kNaN); }},
-      {"nu_m", "nu_j, m (seed 000's form: per polynomial the sum of its distances, mean over polynomials)", "%.3g",
+      {"nu_m", "nu_j, m (D'Alfonso et al.'s form: per polynomial the sum of its distances, mean over polynomials)", "%.3g",
        [](const SlamRobotResult& r) { return r.mapping.nu; }},
       {"mean_distance_m", "mean distance of the map to the true walls, m", "%.3g",
        [](const SlamRobotResult& r) { return r.mapping.mean_distance; }},
@@ -50,7 +50,7 @@ const std::vector<Metric>& metrics() {
   return kMetrics;
 }
 
-// Seed 000 Table 1, by robot order (r1, r2, r3).
+// D'Alfonso et al. Table 1, by robot order (r1, r2, r3).
 const std::map<std::string, std::vector<std::string>>& paper_values() {
   static const std::map<std::string, std::vector<std::string>> kPaper = {
       {"mu", {"1.66e-06", "4.66e-07", "1.02e-06"}},
@@ -143,7 +143,7 @@ std::string slam_table_markdown(const SlamSetup& setup, const SlamCampaign& c, b
     md << "\n";
     const auto paper = paper_values().find(m.key);
     if (paper_columns && paper != paper_values().end()) {
-      md << "| " << m.key << ", seed 000 Table 1 |";
+      md << "| " << m.key << ", D'Alfonso et al. Table 1 |";
       for (std::size_t i = 0; i < cols.size(); ++i) {
         md << " " << (cols[i].mode != "alone" && i < paper->second.size() ? paper->second[i] : std::string()) << " |";
       }

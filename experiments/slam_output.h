@@ -1,7 +1,7 @@
 #pragma once
-// What `fleetmap slam` leaves behind: seed 000's Table 1 (means and standard deviations over the
+// What `fleetmap slam` leaves behind: D'Alfonso et al.'s Table 1 (means and standard deviations over the
 // runs) as Markdown and CSV, every run's numbers, the rendezvous' bytes, and pictures like
-// seed 000's Figs. 5-8. Every file is written to a temporary name and renamed.
+// D'Alfonso et al.'s Figs. 5-8. Every file is written to a temporary name and renamed.
 #include <opencv2/core/mat.hpp>
 
 #include <filesystem>
@@ -27,9 +27,9 @@ struct SlamCampaign {
   std::vector<SlamRunResult> alone;
 };
 
-// Table 1 with more rows: mu (seed 000's form), the standard NEES, nu (seed 000's form), the mean
+// Table 1 with more rows: mu (D'Alfonso et al.'s form), the standard NEES, nu (D'Alfonso et al.'s form), the mean
 // distance to the walls, position RMSE, boundary covered, polynomials, tau; one column per robot
-// and one for the single-robot run; seed 000's printed values beside the first three robots' when
+// and one for the single-robot run; D'Alfonso et al.'s printed values beside the first three robots' when
 // `paper_columns` (the dalfonso scenario). Then bytes per rendezvous against the grid patch.
 std::string slam_table_markdown(const SlamSetup& setup, const SlamCampaign& campaign, bool paper_columns);
 // The same numbers, one row per (metric, robot, mode): metric,robot,mode,mean,std,runs.
@@ -39,7 +39,7 @@ std::string slam_runs_csv(const SlamCampaign& campaign);
 // One row per rendezvous message.
 std::string slam_rendezvous_csv(const SlamCampaign& campaign);
 
-// A robot's result as seed 000 draws it: mapped polynomials green, true walls red, true path blue,
+// A robot's result as D'Alfonso et al. draws it: mapped polynomials green, true walls red, true path blue,
 // estimated path dashed red, rendezvous points; legend and scale bar.
 cv::Mat render_slam_robot(const SlamSetup& setup, const SlamRunResult& run, int robot, const std::string& title);
 

@@ -1,9 +1,9 @@
 #pragma once
 // A SLAM experiment (`fleetmap slam`): robots driven along precomputed paths in a room given as
 // polygons, sensing with distance sensors and a camera, each running a SLAM method on its own
-// and exchanging maps when two see each other (seed 000 §4). Loaded from YAML: every key checked,
+// and exchanging maps when two see each other (D'Alfonso et al., §4). Loaded from YAML: every key checked,
 // errors name the file, line and key. `method` picks the SLAM method; each method reads its own
-// options block (`polynomial:` for seed 000).
+// options block (`polynomial:` for D'Alfonso et al.).
 #include <Eigen/Core>
 
 #include <cstdint>
@@ -58,8 +58,8 @@ struct SlamScenario {
   bool exchange = true;                   // maps are exchanged at rendezvous
   double segment_tolerance_m = 0.005;     // §3.2's piecewise-linear approximation
   double grid_patch_resolution_m = 0.05;  // the equivalent occupancy-grid patch's cells
-  std::string single_robot;               // also run this robot alone (seed 000 Fig. 8); "" for none
-  bool paper_table = false;               // print seed 000's Table 1 beside the results (its own experiment)
+  std::string single_robot;               // also run this robot alone (D'Alfonso et al., Fig. 8); "" for none
+  bool paper_table = false;               // print D'Alfonso et al.'s Table 1 beside the results (its own experiment)
   localization::PolynomialSlamOptions polynomial;
 };
 

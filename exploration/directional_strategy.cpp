@@ -8,7 +8,7 @@ namespace fleetmap::exploration {
 
 namespace {
 
-// seed 003 §IV, the wave algorithm with directional priority: robot k of n prefers the direction
+// The wave-algorithm paper, §IV, the wave algorithm with directional priority: robot k of n prefers the direction
 // 2 pi k / n on the plane, so robots spread out from the start without talking. A target's rank is
 // its scaled wave cost plus weight * (1 - cos(angle between the target and the preferred
 // direction)) / 2.

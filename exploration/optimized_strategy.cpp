@@ -7,9 +7,9 @@ namespace fleetmap::exploration {
 
 namespace {
 
-// seed 003 eq. (3): choose the targets t_1..t_n for the robots that maximise
+// The wave-algorithm paper, eq. (3): choose the targets t_1..t_n for the robots that maximise
 // sum_i (U(t_i) - beta * V_i(t_i)^2); squaring the travel costs favours assignments that finish
-// together (seed 003 Fig. 4). Solved exactly as an assignment problem with the Hungarian method.
+// together (wave-algorithm paper, Fig. 4). Solved exactly as an assignment problem with the Hungarian method.
 class Optimized final : public CoordinationStrategy {
  public:
   explicit Optimized(const StrategyOptions& o) : beta_(o.beta) {}

@@ -14,7 +14,7 @@
 namespace fleetmap::exploration {
 
 struct StrategyOptions {
-  // Weight of travel cost against utility (Burgard et al. 2005's beta; seed 003 eq. (3)).
+  // Weight of travel cost against utility (Burgard et al. 2005's beta; the wave-algorithm paper, eq. (3)).
   double beta = 1.0;
   // `directional`: how strongly a robot prefers targets in its own direction (0: not at all).
   double directional_weight = 0.5;

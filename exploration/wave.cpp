@@ -53,7 +53,7 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
   constexpr std::uint32_t kNone = WaveField::kUnreachedUnits;
 
   if (!options.eight_connected && !weighted) {
-    // Unit costs: a plain BFS over a flat queue (seed 003, Table 1).
+    // Unit costs: a plain BFS over a flat queue (wave-algorithm paper, Table 1).
     thread_local std::vector<int> queue;
     queue.resize(n);
     std::size_t head = 0, tail = 0;

@@ -1,5 +1,5 @@
 #pragma once
-// The wave: distance fields over passable cells from one or more source cells (seed 003's wave
+// The wave: distance fields over passable cells from one or more source cells (the wave-algorithm paper's wave
 // algorithm, Table 1; with occupancy weights, Burgard et al. 2005's value iteration). The hot loop
 // of every exploration run: a flat-array BFS (4-connected, unit costs) or Dial's bucket queue over
 // reused storage (8-connected, or occupancy-weighted). Step costs are whole units of 1/70 cell:
@@ -16,7 +16,7 @@ namespace fleetmap::exploration {
 using core::Cell;
 
 struct WaveOptions {
-  // seed 003's pseudo code is 4-connected; 8-connected adds diagonal steps of cost sqrt(2).
+  // The wave-algorithm paper's pseudo code is 4-connected; 8-connected adds diagonal steps of cost sqrt(2).
   // A diagonal step needs both cells beside it passable, so waves never cut a corner.
   bool eight_connected = true;
   // Burgard's cost model: entering a cell costs its step length times (1 + occupancy_weight * P(occ)),

@@ -48,10 +48,10 @@ class EkfCore {
   // non-zero blocks: O(n^2) for a state of size n.
   void update(const Eigen::Vector2d& reading, const PointReading& predicted);
 
-  // Seed 000 eq. (4)-(5): appends the landmark g(x, y) seen as `reading` from the current pose and
+  // D'Alfonso et al. eq. (4)-(5): appends the landmark g(x, y) seen as `reading` from the current pose and
   // augments the covariance; returns its slot.
   int add_landmark(const Eigen::Vector2d& reading, const Eigen::Matrix2d& measurement_noise);
-  // Removes the slots' rows and columns (seed 000 §3.1); later slots move down to fill the gaps.
+  // Removes the slots' rows and columns (D'Alfonso et al., §3.1); later slots move down to fill the gaps.
   void remove_landmarks(const std::vector<int>& slots);
 
   // x_new = t x_old for the pose and every landmark; P_new = J P J^T with J the block rotation.
@@ -75,7 +75,7 @@ class EkfCore {
   Eigen::MatrixXd covariance_;
 };
 
-// A robot-robot detection in EKF form (seed 002's detection model): the other robot's estimated
+// A robot-robot detection in EKF form (León et al.'s detection model): the other robot's estimated
 // position is the point read, and its covariance joins the measurement noise. Applied only when
 // the reading passes the chi-square `gate`; returns whether it was.
 bool update_with_robot(EkfCore& filter, const RobotObservation& observation, const Eigen::Matrix2d& measurement_noise,

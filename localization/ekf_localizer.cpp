@@ -1,5 +1,5 @@
 // `ekf`: the pose (x, y, theta) estimated by an extended Kalman filter from the differential-drive
-// odometry and range-bearing readings of point landmarks at known positions (seed 003 §V: fixed
+// odometry and range-bearing readings of point landmarks at known positions (wave-algorithm paper, §V: fixed
 // artificial landmarks, LocalizerContext::known_landmarks).
 //
 // Data association:

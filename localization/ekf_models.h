@@ -3,7 +3,7 @@
 // every Jacobian against numerical differentiation:
 //  - differential-drive motion f(x, u) (integrate_motion) and F = df/dx;
 //  - the range-bearing reading h(x, m) of a point m and its Jacobians;
-//  - the landmark generation function g(x, y) of seed 000 eq. (4)-(5) (a reading turned into a
+//  - the landmark generation function g(x, y) of D'Alfonso et al. eq. (4)-(5) (a reading turned into a
 //    point) and its Jacobians G_x, G_y, with the covariance augmentation of eq. (4).
 // The state is x = (x, y, theta) for the pose, followed by (x, y) of each point landmark.
 #include <Eigen/Core>
@@ -51,14 +51,14 @@ RangeBearingJacobians range_bearing_jacobians(const core::Pose2& pose, const Eig
 // function, the inverse of h for one reading y = (range, bearing).
 Eigen::Vector2d landmark_from_reading(const core::Pose2& pose, const Eigen::Vector2d& reading);
 
-// The non-trivial blocks of seed 000 eq. (5): dg/d(pose) (2x3) and dg/dy (2x2).
+// The non-trivial blocks of D'Alfonso et al. eq. (5): dg/d(pose) (2x3) and dg/dy (2x2).
 struct LandmarkGenerationJacobians {
   Eigen::Matrix<double, 2, 3> pose;
   Eigen::Matrix2d reading;
 };
 LandmarkGenerationJacobians landmark_generation_jacobians(const core::Pose2& pose, const Eigen::Vector2d& reading);
 
-// Seed 000 eq. (4): P~ = G_x P G_x^T + G_y V G_y^T for a state whose first three entries are the
+// D'Alfonso et al. eq. (4): P~ = G_x P G_x^T + G_y V G_y^T for a state whose first three entries are the
 // pose, where G_x = [I_n; dg/dpose 0] and G_y = [0; dg/dy] (eq. (5)). Computed block-wise in
 // O(n) new entries, which equals the product of the full matrices; returns the (n+2)x(n+2) matrix.
 Eigen::MatrixXd augment_covariance(const Eigen::MatrixXd& covariance, const LandmarkGenerationJacobians& g,

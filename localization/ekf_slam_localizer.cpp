@@ -9,7 +9,7 @@
 //     - otherwise: global nearest neighbour in Mahalanobis distance gated at
 //       options.association_gate; an unmatched reading whose smallest distance to every landmark
 //       exceeds options.slam_new_landmark_gate is new, any other unmatched reading is rejected;
-//  2. adds each new landmark with g(x, y) and the covariance augmentation of seed 000 eq. (4),
+//  2. adds each new landmark with g(x, y) and the covariance augmentation of D'Alfonso et al. eq. (4),
 //     with G_x and G_y evaluated at x_{k|k-1} and y_k as eq. (5) prescribes;
 //  3. updates the state with each associated reading in turn.
 // The state shrinks when options.slam_forget_after_steps > 0: a landmark not observed for more
@@ -52,7 +52,7 @@ class EkfSlamLocalizer final : public Localizer {
   void update_landmarks(const std::vector<LandmarkObservation>& observations) override {
     const std::vector<int> target = options_.known_associations ? associate_by_id(observations)
                                                                 : associate_nearest(observations);
-    // Step 2: new landmarks, at the predicted state (seed 000 eq. (4)-(5)).
+    // Step 2: new landmarks, at the predicted state (D'Alfonso et al., eq. (4)-(5)).
     for (std::size_t i = 0; i < observations.size(); ++i) {
       if (target[i] != kNew) continue;
       filter_.add_landmark({observations[i].range, observations[i].bearing}, r_);

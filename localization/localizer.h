@@ -57,7 +57,7 @@ struct RobotObservation {
   Eigen::Matrix3d other_covariance = Eigen::Matrix3d::Zero();
 };
 
-// This robot seen by another (seed 002 §III.C, eq. (15)): the detector's range and bearing (rad, in
+// This robot seen by another (León et al., §III.C, eq. (15)): the detector's range and bearing (rad, in
 // the detector's frame) with their noise, and the detector's belief of its own pose, in this
 // robot's map frame.
 struct DetectedBy {
@@ -72,7 +72,7 @@ struct DetectedBy {
 
 // Noise models and filter settings shared by the localizers; each uses what it needs.
 struct LocalizerOptions {
-  // Odometry noise per step (standard deviations), the model's Q: seed 000 uses 0.001 m and 0.01 deg.
+  // Odometry noise per step (standard deviations), the model's Q: D'Alfonso et al. uses 0.001 m and 0.01 deg.
   double process_noise_xy = 0.001;         // m
   double process_noise_theta = 0.000174533;  // rad (0.01 deg)
   // Landmark sensor noise (standard deviations).
@@ -80,9 +80,9 @@ struct LocalizerOptions {
   double bearing_noise = 0.0175;  // rad
   // Range-scan noise (standard deviation of a beam's distance), for `polynomial`.
   double scan_range_noise = 0.02;  // m
-  // Initial pose uncertainty (standard deviations); seed 000: P0 = diag(0.05^2, 0.05^2, 0.0175^2).
+  // Initial pose uncertainty (standard deviations); D'Alfonso et al.: P0 = diag(0.05^2, 0.05^2, 0.0175^2).
   double initial_xy = 0.05;
-  double initial_theta = 0.017453292519943295;  // 1 deg (seed 000 uses 0.0175 rad)
+  double initial_theta = 0.017453292519943295;  // 1 deg (D'Alfonso et al., uses 0.0175 rad)
   // Data association: by the sensor's landmark identities, or by nearest neighbour with a
   // Mahalanobis gate (chi-square, 2 dof) when identities are unknown.
   bool known_associations = true;
@@ -93,7 +93,7 @@ struct LocalizerOptions {
   // a long run does not duplicate its landmarks.
   double slam_new_landmark_gate = 27.63;  // chi2(2) at 1 - 1e-6
   // `ekf-slam`: a landmark not observed for more than this many predict steps leaves the state
-  // (its rows and columns are removed, seed 000 §3.1); 0 keeps every landmark.
+  // (its rows and columns are removed, D'Alfonso et al. §3.1); 0 keeps every landmark.
   int slam_forget_after_steps = 0;
   // Robot-robot detections update the estimate (off by default).
   bool use_robot_detections = false;
@@ -108,11 +108,11 @@ struct LocalizerOptions {
 // What a localizer may be given at the start.
 struct LocalizerContext {
   core::Pose2 initial_pose;             // where the robot starts, in its map frame
-  std::vector<Landmark> known_landmarks;  // for `ekf` (seed 003 §V: fixed artificial landmarks)
+  std::vector<Landmark> known_landmarks;  // for `ekf` (wave-algorithm paper, §V: fixed artificial landmarks)
   LocalizerOptions options;
   std::uint64_t seed = 0;
   // `mcl`: the known map, in the robot's map frame; `global_localization`: the robot does not know
-  // initial_pose and starts from a uniform belief over the map's free cells (seed 002 §IV).
+  // initial_pose and starts from a uniform belief over the map's free cells (León et al., §IV).
   std::shared_ptr<const mapping::OccupancyGrid> known_map;
   bool global_localization = false;
 };
@@ -126,7 +126,7 @@ class Localizer {
   virtual void update_landmarks(const std::vector<LandmarkObservation>& /*observations*/) {}
   virtual void update_scan(const RangeScan& /*scan*/, const mapping::OccupancyGrid& /*own_map*/) {}
   virtual void update_robot(const RobotObservation& /*observation*/) {}
-  // This robot was detected by another (collaborative localization, seed 002 eq. (15)).
+  // This robot was detected by another (collaborative localization, León et al. eq. (15)).
   virtual void update_detected_by(const DetectedBy& /*detection*/) {}
   // Only the `ideal` localizer uses the simulator's truth.
   virtual void observe_truth(const core::Pose2& /*truth*/) {}

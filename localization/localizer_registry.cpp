@@ -12,11 +12,11 @@ core::Registry<LocalizerFactory>& localizer_registry() {
     r.add("ekf", "EKF on the pose with range-bearing readings of known landmarks (by id, or nearest neighbour gated)",
           make_ekf_localizer);
     r.add("ekf-slam",
-          "EKF-SLAM: pose and point landmarks learnt as they are seen (augmentation as D'Alfonso et al. 2013, "
+          "EKF-SLAM: pose and point landmarks learnt as they are seen (augmentation as D'Alfonso et al., "
           "eq. (4)-(5))",
           make_ekf_slam_localizer);
     r.add("polynomial",
-          "polynomial EKF-SLAM (D'Alfonso et al. 2013): walls as polynomials learnt from the range scan, c0 "
+          "polynomial EKF-SLAM (D'Alfonso et al.): walls as polynomials learnt from the range scan, c0 "
           "coefficients in the state",
           make_polynomial_localizer);
     r.add("scan-matching",
@@ -25,10 +25,10 @@ core::Registry<LocalizerFactory>& localizer_registry() {
           make_scan_matching_localizer);
     r.add("mcl",
           "Monte Carlo localization on the known map; collaborative with robot_detections, lost_robots start uniform "
-          "(León et al. 2009, sec. IV)",
+          "(León et al., sec. IV)",
           make_mcl_localizer);
     r.add("rbpf",
-          "Rao-Blackwellized particle filter, a grid per particle, scan-matching proposal (León et al. 2009, sec. II.C; "
+          "Rao-Blackwellized particle filter, a grid per particle, scan-matching proposal (León et al., sec. II.C; "
           "Grisetti et al. 2005)",
           make_rbpf_localizer);
     return true;

@@ -1,4 +1,4 @@
-// `mcl`: Monte Carlo localization on a known map (seed 002 §IV, eq. (12)-(17); Thrun, Burgard &
+// `mcl`: Monte Carlo localization on a known map (León et al., §IV, eq. (12)-(17); Thrun, Burgard &
 // Fox, Probabilistic Robotics §8.3), and its collaborative form (eq. (15)).
 //  - belief: particles (pose, weight); a Gaussian around the start (tracking) or uniform over the
 //    known map's free cells (global localization, LocalizerContext::global_localization);

@@ -42,7 +42,7 @@ std::optional<double> nees(const Eigen::Vector3d& error, const Eigen::Matrix3d& 
   return v;
 }
 
-double seed000_mu_term(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance) {
+double dalfonso_mu_term(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance) {
   return error.dot(covariance * error);
 }
 
@@ -56,7 +56,7 @@ void LocalizationMetrics::add(const core::Pose2& truth, const core::Pose2& estim
     nees_sum_ += *v;
     ++nees_steps_;
   }
-  mu_sum_ += seed000_mu_term(e, covariance);
+  mu_sum_ += dalfonso_mu_term(e, covariance);
 }
 
 LocalizationSummary LocalizationMetrics::summary(double confidence) const {
@@ -72,7 +72,7 @@ LocalizationSummary LocalizationMetrics::summary(double confidence) const {
     s.average_nees = nees_sum_ / static_cast<double>(nees_steps_);
     s.nees_inside_band = s.nees_band.contains(*s.average_nees);
   }
-  s.seed000_mu = mu_sum_ / n;
+  s.dalfonso_mu = mu_sum_ / n;
   return s;
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 // Localization metrics, defined once (DESIGN.md §5): position and heading RMSE, the standard
-// NEES e^T P^-1 e averaged over steps with its chi-square band, and seed 000's mu as that paper
+// NEES e^T P^-1 e averaged over steps with its chi-square band, and D'Alfonso et al.'s mu as that paper
 // prints it (e^T P e, without the inverse), to be reported side by side.
 #include <Eigen/Core>
 
@@ -34,9 +34,9 @@ Eigen::Vector3d pose_error(const core::Pose2& truth, const core::Pose2& estimate
 // The standard NEES e^T P^-1 e; nullopt when P is not positive definite (e.g. `ideal`'s zero P).
 std::optional<double> nees(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance);
 
-// Seed 000 §4's summand [x - x~]^T P [x - x~], as printed (P, not P^-1). It is not a consistency
+// D'Alfonso et al. §4's summand [x - x~]^T P [x - x~], as printed (P, not P^-1). It is not a consistency
 // measure (its scale is that of P times e^2); it is reported so results compare with Table 1.
-double seed000_mu_term(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance);
+double dalfonso_mu_term(const Eigen::Vector3d& error, const Eigen::Matrix3d& covariance);
 
 // One run's (or one robot's) localization summary.
 struct LocalizationSummary {
@@ -49,9 +49,9 @@ struct LocalizationSummary {
   long nees_steps = 0;
   ChiSquareBand nees_band;  // the band of the mean of `nees_steps` chi2(3) values (0, 0 if none)
   bool nees_inside_band = false;
-  // Seed 000's mu: 1/(k_f + 1) sum_{k=0}^{k_f} e^T P e over the same steps (add step 0 to match
+  // D'Alfonso et al.'s mu: 1/(k_f + 1) sum_{k=0}^{k_f} e^T P e over the same steps (add step 0 to match
   // the paper's sum).
-  double seed000_mu = 0.0;
+  double dalfonso_mu = 0.0;
 };
 
 // Accumulates one estimate per step against the truth.

@@ -1,5 +1,5 @@
 #pragma once
-// The extended Kalman filter of seed 000's polynomial SLAM (§3.1): the augmented state
+// The extended Kalman filter of D'Alfonso et al.'s polynomial SLAM (§3.1): the augmented state
 // X = [x, y, theta, c0_1, ..., c0_n], the pose followed by one position coefficient c_0 per
 // polynomial landmark ("slots" 0, 1, ... in state order). Readings are scalar (a distance along a
 // sensor axis, eq. (2)); landmarks enter by the covariance augmentation of eq. (4)-(5) and leave
@@ -25,7 +25,7 @@ struct ScalarReading {
   double noise = 0.0;                                       // Var(v)
 };
 
-// A new landmark's generation function c0_new = g(X, y) (seed 000 eq. (5)) linearised at the
+// A new landmark's generation function c0_new = g(X, y) (D'Alfonso et al., eq. (5)) linearised at the
 // predicted state: G_x = [I_n; g_x] with g_x's non-zero entries on the pose and on the slots of the
 // landmarks it was computed from; G_y V G_y^T reduces to `noise_variance`.
 struct LandmarkGeneration {
@@ -48,9 +48,9 @@ class PolynomialEkf {
   // Does nothing when S is not positive.
   void update(double z, const ScalarReading& r);
 
-  // Seed 000 eq. (4): appends c0_new and P~ = G_x P G_x^T + G_y V G_y^T; returns the new slot.
+  // D'Alfonso et al. eq. (4): appends c0_new and P~ = G_x P G_x^T + G_y V G_y^T; returns the new slot.
   int augment(const LandmarkGeneration& g);
-  // Removes the slots' rows and columns (seed 000 §3.1); later slots move down to fill the gaps.
+  // Removes the slots' rows and columns (D'Alfonso et al., §3.1); later slots move down to fill the gaps.
   void remove(const std::vector<int>& slots);
   // Re-expresses the state in another frame, x_new = new_from_old * x_old, where each landmark's
   // new c_0 is `positions[s]` and depends on its old one as d c0_new / d c0_old = `scales[s]`:
@@ -71,7 +71,7 @@ class PolynomialEkf {
   Eigen::MatrixXd covariance_;
 };
 
-// Seed 000 §3.1's divergence test P_k|k-1 > K P0: true when K P0 - P is not positive
+// D'Alfonso et al. §3.1's divergence test P_k|k-1 > K P0: true when K P0 - P is not positive
 // semi-definite (P exceeds K P0 in some direction).
 bool is_diverging(const Eigen::Matrix3d& predicted_covariance, double k, const Eigen::Matrix3d& initial_covariance);
 

@@ -1,4 +1,4 @@
-// `polynomial`: seed 000's polynomial EKF-SLAM as a Localizer. It learns its map from the range
+// `polynomial`: D'Alfonso et al.'s polynomial EKF-SLAM as a Localizer. It learns its map from the range
 // scans it is given (update_scan), as polynomials whose c_0 coefficients share the state with the
 // pose; point landmarks and robot detections are not used. The distance readings' noise is
 // options.scan_range_noise.
@@ -18,7 +18,7 @@ namespace fleetmap::localization {
 
 namespace {
 
-// Seed 000 uses five distance sensors; a 360-beam laser gives far more readings than the filter
+// D'Alfonso et al. uses five distance sensors; a 360-beam laser gives far more readings than the filter
 // needs (each is one O(n^2) update), so a scan is thinned to this many evenly spaced beams.
 constexpr std::size_t kMaxBeams = 36;
 

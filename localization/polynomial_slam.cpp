@@ -121,7 +121,7 @@ void PolynomialSlam::update(const std::vector<double>& angles, const std::vector
   const Eigen::Matrix3d p_pred = filter_.pose_covariance();
   thresholds_ = slam_thresholds(p_pred, initial_covariance_, options_);
   if (thresholds_.diverging) ++counters_.diverged_steps;
-  const double weight = 1.0 / std::max(spectral_norm(p_pred), 1e-12);  // seed 000 §3.3: 1 / ||P_k|k-1||
+  const double weight = 1.0 / std::max(spectral_norm(p_pred), 1e-12);  // D'Alfonso et al. §3.3: 1 / ||P_k|k-1||
   const core::Pose2 x = filter_.pose();
 
   // Association (§3.1), every reading at the predicted pose.
@@ -217,7 +217,7 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
   // refit of Q_bad points beyond p's end with R on p, say); such a polynomial maps nothing seen.
   if (mapping::stray_between_points(fit->polynomial, weighted) > options_.sigma_max) return std::nullopt;
 
-  // Seed 000 eq. (5): the gradient of c0_new = g(X, y) with respect to the pose, the source
+  // D'Alfonso et al. eq. (5): the gradient of c0_new = g(X, y) with respect to the pose, the source
   // landmarks' c0 and the readings, at x_k|k-1 and y_k.
   const std::vector<Eigen::Vector2d> grad = mapping::position_gradient(fit->polynomial, weighted);
   const Eigen::Vector2d dependent = fit->polynomial.dependent_direction();

@@ -1,5 +1,5 @@
 #pragma once
-// Seed 000's single-robot polynomial SLAM (§3.1, §3.3) and the merging of polynomials received
+// D'Alfonso et al.'s single-robot polynomial SLAM (§3.1, §3.3) and the merging of polynomials received
 // from another robot (§3.2-3.3). Each step, at the predicted pose x_k|k-1:
 //  1. the points pi_k^i of eq. (3) from the distance sensors' readings y_k;
 //  2. for each point, the best approximating polynomial p* and its error eps (Fig. 2), and one of
@@ -29,7 +29,7 @@
 namespace fleetmap::localization {
 
 struct PolynomialSlamOptions {
-  // Seed 000 §4's parameters.
+  // D'Alfonso et al. §4's parameters.
   int order = 3;                  // m
   double rho_min = 0.08;          // m, rho underbar
   double rho_max = 0.24;          // m, rho bar

@@ -1,5 +1,5 @@
 #pragma once
-// `rbpf`: a Rao-Blackwellized particle filter for grid SLAM (seed 002 §II.B-C; Grisetti, Stachniss
+// `rbpf`: a Rao-Blackwellized particle filter for grid SLAM (León et al., §II.B-C; Grisetti, Stachniss
 // & Burgard 2005). Every particle carries a pose and its own grid (grid FastSLAM). Each step:
 //  1. sampling: the particle's odometry step is drawn with the process noise
 //     (LocalizerOptions::rbpf_sample_motion);

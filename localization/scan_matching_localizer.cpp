@@ -1,4 +1,4 @@
-// `scan-matching`: maximum-likelihood incremental mapping (seed 002 §II.A, eq. (1)-(4); Hähnel et
+// `scan-matching`: maximum-likelihood incremental mapping (León et al., §II.A, eq. (1)-(4); Hähnel et
 // al. 2002). Each step the odometry gives a guess; the new scan is aligned to the robot's map so far
 // (m_{t-1}, built at the estimated poses) with match_scan_to_grid() and the aligned pose replaces the
 // odometry step; then the scan joins the map at that pose.

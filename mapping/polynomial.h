@@ -1,5 +1,5 @@
 #pragma once
-// Polynomial landmarks (seed 000 §2, Fig. 1-2): an m-th order polynomial p(xi) = sum_i b_i xi^i + c_0
+// Polynomial landmarks (D'Alfonso et al., §2, Fig. 1-2): an m-th order polynomial p(xi) = sum_i b_i xi^i + c_0
 // over a domain [lo, hi] of its independent variable. An x1-variate polynomial is the curve
 // x2 = p(x1); an x2-variate one is x1 = p(x2), so that steep walls are polynomials too (§3.1).
 // The shape coefficients b_m..b_1 are the "shape landmark", c_0 the "innovation landmark" that an
@@ -48,14 +48,14 @@ struct Polynomial {
 std::ostream& operator<<(std::ostream& os, PolynomialAxis axis);
 std::ostream& operator<<(std::ostream& os, const Polynomial& p);
 
-// Seed 000 Fig. 2, the approximation error of `point` by p, in metres. For a point in the region p
+// D'Alfonso et al. Fig. 2, the approximation error of `point` by p, in metres. For a point in the region p
 // approximates (its independent coordinate inside the domain) it is the LMS residual |eta - p(xi)|;
 // otherwise the distance to the nearer end point, min(|Q_m - pi|, |Q_M - pi|). The paper writes
 // both as squares; their square roots are used so that the error compares with the thresholds
 // rho and sigma, which the paper gives in metres.
 double approximation_error(const Polynomial& p, const Eigen::Vector2d& point);
 
-// A point for a weighted least-squares fit (seed 000 §3.3).
+// A point for a weighted least-squares fit (D'Alfonso et al., §3.3).
 struct WeightedPoint {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
   double weight = 1.0;
@@ -71,7 +71,7 @@ struct PolynomialFit {
   double max_residual = 0.0;  // largest |eta - p(xi)|
 };
 
-// Weighted least-squares m-th order polynomial along `axis` (seed 000 §3.1, §3.3): minimises
+// Weighted least-squares m-th order polynomial along `axis` (D'Alfonso et al., §3.1, §3.3): minimises
 // sum_k w_k (eta_k - p(xi_k))^2; the domain is [min xi_k, max xi_k]. Solved by QR in a centred
 // and scaled variable, then expanded to the monomial coefficients b_m..b_1, c_0. nullopt when the
 // points cannot determine an order-m polynomial (fewer than m + 1 distinct xi, a zero or negative
@@ -81,7 +81,7 @@ std::optional<PolynomialFit> fit_polynomial(const std::vector<WeightedPoint>& po
 // d c_0 / d pi_k of the weighted LMS *position* of `shape` through the points (world frame,
 // one 2-vector per point): with the shape held fixed, c_0 = sum_k w_k (eta_k - s(xi_k)) / sum_k w_k
 // where s is p without c_0, so d c_0 / d(xi_k, eta_k) = w_k / W (-p'(xi_k), 1). This is the
-// landmark generation function's gradient used for G_x and G_y (seed 000 eq. (5)): the paper's
+// landmark generation function's gradient used for G_x and G_y (D'Alfonso et al., eq. (5)): the paper's
 // state holds c_0 only, the shape being a landmark of the extraction step.
 std::vector<Eigen::Vector2d> position_gradient(const Polynomial& shape, const std::vector<WeightedPoint>& points);
 
@@ -96,10 +96,10 @@ std::vector<Eigen::Vector2d> sample_equally(const Polynomial& p, int count);
 // The same over a sub-interval [a, b] of the independent variable.
 std::vector<Eigen::Vector2d> sample_equally(const Polynomial& p, double a, double b, int count);
 
-// Points every `step` metres of curvilinear abscissa from Q_m, plus Q_M (seed 000 §4's nu).
+// Points every `step` metres of curvilinear abscissa from Q_m, plus Q_M (D'Alfonso et al., §4's nu).
 std::vector<Eigen::Vector2d> sample_arc_length(const Polynomial& p, double step);
 
-// Seed 000 §3.2: a piecewise-linear approximation of p whose vertices lie on p and whose segments
+// D'Alfonso et al. §3.2: a piecewise-linear approximation of p whose vertices lie on p and whose segments
 // stay within `tolerance` metres of the curve (Douglas-Peucker on the curve sampled finely enough
 // that the curve between samples cannot leave the tolerance). Returns the polyline's vertices,
 // from Q_m to Q_M. Throws std::invalid_argument for a non-positive tolerance.
@@ -110,7 +110,7 @@ double distance_to_polyline(const Eigen::Vector2d& point, const std::vector<Eige
 
 // Where a ray from `origin` at world angle `angle` first meets p inside its domain (widened by
 // `domain_margin` at both ends), within `max_distance`, and the derivatives of that distance:
-// seed 000 eq. (2)'s h for one sensor. By the implicit function theorem on
+// D'Alfonso et al. eq. (2)'s h for one sensor. By the implicit function theorem on
 // F(t) = p(o_xi + t u_xi) - (o_eta + t u_eta) = 0: dt/dz = -(dF/dz) / (dF/dt).
 struct RayHit {
   double distance = 0.0;                        // t

@@ -1,5 +1,5 @@
 #pragma once
-// A polynomial map (seed 000 §3.1): the landmark set E (polynomials, each with its set Q_bad of
+// A polynomial map (D'Alfonso et al., §3.1): the landmark set E (polynomials, each with its set Q_bad of
 // badly approximated points), the clusters Z of points not mapped yet, the geometry of Fig. 3
 // (how two polynomials overlap) and the mapping metrics of §4 against a true boundary.
 // The map holds data; the filter that moves the c_0 coefficients is localization/polynomial_slam.
@@ -18,7 +18,7 @@ namespace fleetmap::mapping {
 // Jacobians (eq. (5)) need to know of its origin.
 struct MapPoint {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();
-  double weight = 1.0;                                  // 1 / ||P_k|k-1|| (seed 000 §3.3)
+  double weight = 1.0;                                  // 1 / ||P_k|k-1|| (D'Alfonso et al., §3.3)
   Eigen::Vector2d observer = Eigen::Vector2d::Zero();   // the predicted robot position it was computed from
   Eigen::Vector2d beam = Eigen::Vector2d::UnitX();      // unit vector of the sensor axis
   long step = 0;
@@ -70,7 +70,7 @@ std::optional<Overlap> overlap(const Polynomial& a, const Polynomial& b);
 // The angle (radians, in [0, pi/2]) between the tangents of a and b at a's point a_xi.
 double tangent_angle(const Polynomial& a, double a_xi, const Polynomial& b);
 
-// Seed 000 §3.3's gamma: the LMS approximation error of `points` by b, as the RMS of the
+// D'Alfonso et al. §3.3's gamma: the LMS approximation error of `points` by b, as the RMS of the
 // residuals eta - b(xi) in metres (so that it compares with gamma_M, given in metres).
 double rms_residual(const Polynomial& b, const std::vector<Eigen::Vector2d>& points);
 
@@ -81,7 +81,7 @@ struct WallSegment {
 };
 double distance_to_walls(const Eigen::Vector2d& point, const std::vector<WallSegment>& walls);
 
-// Seed 000 §4's nu: each polynomial sampled every `step` metres of curvilinear abscissa, its
+// D'Alfonso et al. §4's nu: each polynomial sampled every `step` metres of curvilinear abscissa, its
 // samples brought into the walls' frame by `to_truth`, delta = the distance of each to the nearest
 // true boundary point; nu = (1/n) sum_q sum_i delta_q^i, as printed (a sum over each polynomial's
 // samples, averaged over the polynomials). mean_distance is the plain mean of all deltas.

@@ -143,7 +143,7 @@ cv::Mat make_empty() {
   return img;
 }
 
-// Scattered convex and concave obstacles of many sizes (seed 003 Fig. 5B).
+// Scattered convex and concave obstacles of many sizes (wave-algorithm paper, Fig. 5B).
 cv::Mat make_unstructured() {
   cv::Mat img(200, 200, CV_8UC1, cv::Scalar(kFree));
   core::Random rng(5003);
@@ -180,7 +180,7 @@ cv::Mat make_unstructured() {
   return img;
 }
 
-// An office floor: a corridor with rooms on both sides (seed 003 Fig. 5C).
+// An office floor: a corridor with rooms on both sides (wave-algorithm paper, Fig. 5C).
 cv::Mat make_office() {
   cv::Mat img(200, 200, CV_8UC1, cv::Scalar(kWall));
   core::Random rng(5005);
@@ -191,7 +191,7 @@ cv::Mat make_office() {
   return img;
 }
 
-// Long corridors 12 cells wide in a solid block: a ring, a cross and side alcoves (seed 003 Fig. 5D).
+// Long corridors 12 cells wide in a solid block: a ring, a cross and side alcoves (wave-algorithm paper, Fig. 5D).
 cv::Mat make_corridor() {
   cv::Mat img(200, 200, CV_8UC1, cv::Scalar(kWall));
   const int w = 12, lo = 4, hi = 196;

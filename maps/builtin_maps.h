@@ -1,5 +1,5 @@
 #pragma once
-// The built-in maps: seed 003's four 200x200 environments (Fig. 5: empty, unstructured, office,
+// The built-in maps: the wave-algorithm paper's four 200x200 environments (Fig. 5: empty, unstructured, office,
 // corridor) and more (cave, maze, warehouse, campus). Each is a PNG + map_server YAML pair in
 // maps/, made by generate_builtin_map(); regenerating gives the committed files bit for bit.
 #include <opencv2/core/mat.hpp>

@@ -1,5 +1,5 @@
 #pragma once
-// The acceptance index of seed 003 (after Birk & Carpin 2006): how much two maps agree when one
+// The acceptance index of the wave-algorithm paper (after Birk & Carpin 2006): how much two maps agree when one
 // is placed on the other, and the wall-based quality every merge method is judged by.
 #include <Eigen/Core>
 
@@ -11,7 +11,7 @@
 
 namespace fleetmap::merging {
 
-// agr and dis of seed 003 over the cells known in both maps: a cell of b (at its centre, moved by
+// agr and dis of the wave-algorithm paper, over the cells known in both maps: a cell of b (at its centre, moved by
 // b_to_a, rounded to the nearest cell of a) agrees when both have the same state, disagrees when
 // one is free and the other occupied. omega = agr / (agr + dis), 0 (not NaN) without common cells.
 struct Acceptance {

@@ -1,5 +1,5 @@
 #pragma once
-// Landmark maps (seed 001, §III-IV): aligning two robots' landmark maps by RANSAC data association
+// Landmark maps (map-alignment paper, §III-IV): aligning two robots' landmark maps by RANSAC data association
 // (eq. 2-6) or by inter-robot observation (eq. 7-9), choosing between them by the number of
 // overlapping landmarks (Fig. 3), and fusing them: transform (eq. 10), find duplicates, fuse
 // duplicates with covariance weighting (eq. 11-13).
@@ -19,7 +19,7 @@ namespace fleetmap::merging {
 struct MapLandmark {
   Eigen::Vector2d position = Eigen::Vector2d::Zero();            // m, in the map's frame
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity() * 0.01;  // m^2
-  Eigen::VectorXd signature;  // what the sensor tells landmarks apart by (seed 001: width, height); may be empty
+  Eigen::VectorXd signature;  // what the sensor tells landmarks apart by (map-alignment paper: width, height); may be empty
 };
 
 struct LandmarkMap {
@@ -80,7 +80,7 @@ struct LandmarkMergeResult {
 LandmarkMergeResult merge_landmark_maps(const LandmarkMap& self, const LandmarkMap& other,
                                         const core::Transform2& other_to_self, const LandmarkAlignmentOptions& options);
 
-// A rendezvous as seed 001 uses it: both robots' pose estimates and what they measured of each other.
+// A rendezvous as the map-alignment paper, uses it: both robots' pose estimates and what they measured of each other.
 struct Rendezvous {
   core::Pose2 self_pose;
   core::Pose2 other_pose;

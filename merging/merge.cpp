@@ -85,7 +85,7 @@ std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGr
 const std::vector<MergeMethod>& merge_methods() {
   static const std::vector<MergeMethod> kMethods = {
       {"overlap",
-       "grid overlap search (seed 003, Birk & Carpin 2006): Hough-spectrum rotations (Carpin 2008), FFT "
+       "grid overlap search (wave-algorithm paper, Birk & Carpin 2006): Hough-spectrum rotations (Carpin 2008), FFT "
        "correlation of walls for translations, coarse to fine; a rotation sweep when the spectra find nothing",
        {propose_overlap, propose_overlap_sweep}},
       {"features", "ORB and AKAZE keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",

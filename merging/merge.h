@@ -29,7 +29,7 @@ namespace fleetmap::merging {
 // confidence = agreement factor * acceptance factor * support factor * distinctiveness, each in [0, 1]:
 // - agreement factor: the share of matched walls among matched + contradicting walls, mapped
 //   linearly from zero_agreement (0) to full_agreement (1);
-// - acceptance factor: seed 003's omega over all cells known in both maps, mapped linearly from
+// - acceptance factor: the wave-algorithm paper's omega over all cells known in both maps, mapped linearly from
 //   zero_acceptance (0) to full_acceptance (1). Right answers agree on nearly every common cell;
 //   two unrelated maps laid edge to edge along a wall fit their walls but not the cells beside them;
 // - support factor: AlignmentQuality::constraint / full_constraint, at most 1 (a straight wall or a
@@ -78,7 +78,7 @@ struct MergeOptions {
 struct MergeResult {
   bool merged = false;            // confidence >= min_confidence
   core::Transform2 transform;     // b's cells into a's cells; the best candidate even when not merged
-  double acceptance = 0.0;        // omega of seed 003 at `transform`
+  double acceptance = 0.0;        // omega of the wave-algorithm paper, at `transform`
   double confidence = 0.0;        // in [0, 1]
   double distinctiveness = 0.0;
   AlignmentQuality quality;

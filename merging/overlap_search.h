@@ -1,5 +1,5 @@
 #pragma once
-// The `overlap` method: seed 003's search for the rotation and translation that best overlap two
+// The `overlap` method: the wave-algorithm paper's search for the rotation and translation that best overlap two
 // grids (after Birk & Carpin 2006), made global and fast. Rotations come from Hough spectra
 // (Carpin 2008), translations from an FFT correlation of the wall agreement on a coarse pyramid
 // level; the common refine step then takes every candidate to sub-cell accuracy.

@@ -33,7 +33,7 @@ std::vector<localization::ReceivedCurve> receive_polynomials(const PolynomialMes
                                                              const core::Pose2& receiver_pose, double distance,
                                                              double bearing_receiver_to_sender, int sender,
                                                              const ExchangeOptions& options) {
-  // Seed 000 §3.2 with both robots' distance readings averaged.
+  // D'Alfonso et al. §3.2 with both robots' distance readings averaged.
   const double d = 0.5 * (distance + m.distance);
   const core::Transform2 t = rendezvous_transform_matrices(receiver_pose, m.sender_pose, d, bearing_receiver_to_sender,
                                                            m.bearing_sender_to_receiver);

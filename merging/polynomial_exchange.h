@@ -1,5 +1,5 @@
 #pragma once
-// Seed 000 §3.2: what two robots exchange at a rendezvous, and how the receiver brings it into its
+// D'Alfonso et al. §3.2: what two robots exchange at a rendezvous, and how the receiver brings it into its
 // own frame. The sender r_l sends the polynomials it extracted since its last rendezvous with the
 // receiver r_j (Remark 1) with its pose estimate; r_j cuts each polynomial into segments (a rotated
 // polynomial is no polynomial), moves their end points with T_l0,j0 = T_j,j0 T_l,j T_l,l0^-1

@@ -29,7 +29,7 @@ core::Transform2 rendezvous_transform_matrices(const core::Pose2& receiver_pose,
       std::sin(vartheta), std::cos(vartheta), distance * std::sin(bearing_receiver_to_sender), 0.0, 0.0, 1.0;
   const Eigen::Matrix3d t_jj0 = receiver_pose.as_transform().matrix();
   const Eigen::Matrix3d t_ll0 = sender_pose.as_transform().matrix();
-  return core::Transform2::from_matrix(t_jj0 * t_lj * t_ll0.inverse());  // seed 000, §3.2
+  return core::Transform2::from_matrix(t_jj0 * t_lj * t_ll0.inverse());  // D'Alfonso et al., §3.2
 }
 
 namespace {

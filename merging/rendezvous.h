@@ -14,7 +14,7 @@ struct MutualObservation {
   double bearing_other_to_self = 0.0;  // rad, in the other robot's frame
 };
 
-// Seed 001, eq. (7)-(9): the transform of the other robot's map frame into this robot's, from
+// The map-alignment paper, eq. (7)-(9): the transform of the other robot's map frame into this robot's, from
 // both robots' pose estimates in their own maps and the mutual observation:
 //   rho = (rho_self,other + rho_other,self) / 2, theta = pi + phi_self,other - phi_other,self,
 //   Theta = phi_1 + theta - phi_2,
@@ -23,7 +23,7 @@ struct MutualObservation {
 core::Transform2 rendezvous_transform(const core::Pose2& self_pose, const core::Pose2& other_pose,
                                       const MutualObservation& observation);
 
-// Seed 000, §3.2: T_l0,j0 = T_j,j0 T_l,j T_l,l0^-1 (3x3 homogeneous matrices), the transform from
+// D'Alfonso et al., §3.2: T_l0,j0 = T_j,j0 T_l,j T_l,l0^-1 (3x3 homogeneous matrices), the transform from
 // the sender r_l's map frame R_l,0 into the receiver r_j's R_j,0. T_j,j0 and T_l,l0 are the robots'
 // poses in their maps; T_l,j places r_l in r_j's frame: rotation vartheta = pi + alpha_j,l - alpha_l,j
 // and translation d (cos alpha_j,l, sin alpha_j,l), with d their distance, alpha_j,l the bearing at

@@ -1,5 +1,5 @@
 #pragma once
-// One interface for every path planner: OMPL's sampling planners, grid A* and seed 001's reactive
+// One interface for every path planner: OMPL's sampling planners, grid A* and the map-alignment paper's reactive
 // steering. Planners are chosen by name (`fleetmap plan --planner`, scenario files) through
 // make_planner(); tests and benchmarks iterate over planner_names().
 //
@@ -57,7 +57,7 @@ struct PlanResult {
   bool success() const { return status == PlanStatus::Success; }
 };
 
-// seed 001 §VII: head for the target; when an obstacle cell lies within `look_ahead_m` (r_max)
+// The map-alignment paper, §VII: head for the target; when an obstacle cell lies within `look_ahead_m` (r_max)
 // and within `turn_angle_deg` of the heading, turn by that angle away from it and keep the new
 // heading until the obstacle is passed, then head for the target again.
 struct ReactiveOptions {

@@ -1,4 +1,4 @@
-// The naive baseline: seed 001 §VII's reactive steering, on an occupancy grid.
+// The naive baseline: the map-alignment paper, §VII's reactive steering, on an occupancy grid.
 //
 // The paper's robot computes the steering angle toward the target, and at each control step looks
 // for landmarks in the semicircle of radius r_max in front of it. A landmark whose bearing lies
@@ -32,7 +32,7 @@ double bearing(const Eigen::Vector2d& from, double heading, const Eigen::Vector2
 }
 
 // The nearest invalid cell centre within `look_ahead` of `p` whose bearing from `heading` lies in
-// (-cone, cone): seed 001's check for a landmark in the robot's path. Callers pass the distance to
+// (-cone, cone): the map-alignment paper's check for a landmark in the robot's path. Callers pass the distance to
 // the goal when it is shorter, since what lies beyond the goal hinders nothing.
 std::optional<Eigen::Vector2d> landmark_ahead(const FreeSpace& space, const Eigen::Vector2d& p, double heading,
                                               double look_ahead, double cone) {

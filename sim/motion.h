@@ -18,7 +18,7 @@ struct RobotOptions {
   double max_turn_rate_rps = 1.5707963267948966;  // 90 deg/s
 };
 
-// Additive Gaussian process noise per step, world frame (seed 000 eq. (1): 0.001 m, 0.01 deg).
+// Additive Gaussian process noise per step, world frame (D'Alfonso et al., eq. (1): 0.001 m, 0.01 deg).
 struct MotionNoise {
   double position_m = 0.001;
   double heading_rad = 0.00017453292519943296;

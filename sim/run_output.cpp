@@ -83,7 +83,7 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
                   {"nees_steps", loc.nees_steps},
                   {"nees_band_95", {loc.nees_band.lower, loc.nees_band.upper}},
                   {"nees_inside_band", loc.nees_inside_band},
-                  {"seed000_mu", loc.seed000_mu}};
+                  {"dalfonso_mu", loc.dalfonso_mu}};
     for (const auto& [name, value] : t.localizer_counters) robot["localizer"][name] = value;
     per_robot.push_back(robot);
   }

@@ -75,19 +75,19 @@ struct Scenario {
   RangeSensorOptions range;
   LandmarkSensorOptions landmark_sensor;
   RobotDetectorOptions detector;
-  std::vector<Eigen::Vector2d> landmarks;    // fixed artificial landmarks (seed 003 §V)
+  std::vector<Eigen::Vector2d> landmarks;    // fixed artificial landmarks (wave-algorithm paper, §V)
   double landmarks_along_walls = 0.0;        // plus this many per metre of wall, placed with the seed
 
   std::string localization = "ideal";
   localization::LocalizerOptions localization_options;
   // Robots (numbered from 1) that do not know where they start: `mcl` starts them from a uniform
-  // belief over the map (global localization, seed 002 §IV).
+  // belief over the map (global localization, León et al. §IV).
   std::vector<int> lost_robots;
   CommunicationOptions communication;
   exploration::ExplorationOptions exploration;
   // How robots bring others' maps into their frame: "known" (every robot knows its start pose in a
   // common frame), "rendezvous" (each robot maps in its own frame; robots that detect each other
-  // compute the relative transform from the detection, seed 000 §3.2) or "overlap" (robots that can
+  // compute the relative transform from the detection, D'Alfonso et al. §3.2) or "overlap" (robots that can
   // talk search their maps for the best overlap, merging/).
   std::string merging = "known";
   std::string merge_method = "auto";         // overlap: a method of `fleetmap merge`

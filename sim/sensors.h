@@ -13,7 +13,7 @@
 namespace fleetmap::sim {
 
 struct RangeSensorOptions {
-  // Beam angles in the robot frame (seed 000: five distance sensors at beta_i). When empty,
+  // Beam angles in the robot frame (D'Alfonso et al.: five distance sensors at beta_i). When empty,
   // a 360-degree laser of `beams` evenly spaced beams.
   std::vector<double> angles_rad;
   int beams = 360;
@@ -28,7 +28,7 @@ struct LandmarkSensorOptions {
   bool report_ids = true;             // the sensor tells which landmark it sees
 };
 
-struct RobotDetectorOptions {  // seed 000's camera, seed 002's detection
+struct RobotDetectorOptions {  // D'Alfonso et al.'s camera, León et al.'s detection
   double max_range_m = 5.0;
   double fov_rad = 6.283185307179586;  // centred on the heading
   double range_noise_m = 0.02;

@@ -295,7 +295,7 @@ void Simulation::sense_and_map() {
       }
     }
   }
-  // Collaborative localization (seed 002 eq. (15)): the detected robot learns from its detector.
+  // Collaborative localization (León et al., eq. (15)): the detected robot learns from its detector.
   if (scenario_.localization_options.use_robot_detections) {
     for (int i = 0; i < n; ++i) {
       for (const auto& d : detections_[std::size_t(i)]) {
@@ -397,7 +397,7 @@ void Simulation::try_merge(int i, int j) {
   record.sender = sender;
   std::optional<core::Transform2> t;  // sender's frame (metres) into the receiver's
   if (scenario_.merging == "rendezvous") {
-    // seed 000 §3.2: both robots see each other and exchange their poses and what they measured.
+    // D'Alfonso et al. §3.2: both robots see each other and exchange their poses and what they measured.
     const auto seen = [&](int a, int b) -> const Detection* {
       for (const auto& d : detections_[std::size_t(a)])
         if (d.other == b) return &d;

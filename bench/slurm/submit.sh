@@ -4,7 +4,7 @@
 # shards into OUT_DIR/all (results.csv, summary.csv, summary.md, plots). Logs go to OUT_DIR/logs/.
 #
 #   bench/slurm/submit.sh [--wait] SHARDS OUT_DIR [fleetmap bench flags...]
-#   bench/slurm/submit.sh 16 /scratch/$USER/seed003 --sweep scenarios/sweeps/seed003.yaml
+#   bench/slurm/submit.sh 16 /scratch/$USER/wave_paper --sweep scenarios/sweeps/wave_paper.yaml
 #
 # Prints the two job ids. --wait: returns when the combine job has ended, with its exit code (a
 # failed shard cancels the combine job). Environment: FLEETMAP, the fleetmap executable (default:

@@ -314,7 +314,7 @@ TEST(BenchCommand, ReadySweepFilesRun) {
   // The seed-003 sweep file, cut down by flags to one short run per strategy on one map.
   BenchDir b;
   const auto r = b.bench(std::string("--sweep '") + FLEETMAP_SOURCE_DIR +
-                         "/scenarios/sweeps/seed003.yaml' --maps hall.yaml --seeds 1 --steps 15 --jobs 2 --out s");
+                         "/scenarios/sweeps/wave_paper.yaml' --maps hall.yaml --seeds 1 --steps 15 --jobs 2 --out s");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const CsvTable t = read_csv(b / "s" / "results.csv");
   ASSERT_EQ(t.rows.size(), 5u);  // every strategy

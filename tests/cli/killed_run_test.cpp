@@ -94,12 +94,8 @@ TEST(KilledRun, LeavesNoTruncatedFile) {
   EXPECT_GT(killed, 0) << "no run was killed while writing";
   // Whatever a killed run left, the next run takes the folder: it ends well and leaves exactly its
   // own files (listed in outputs.txt), no temporaries.
-  const pid_t pid = spawn_fleetmap({"explore", "--map", "campus", "--robots", "2", "--steps", "3", "--out", out.string(),
-                                    "--quiet"});
-  ASSERT_GT(pid, 0);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "a run into a killed run's folder failed";
+  const auto last = fleetmap::testing::run_fleetmap("explore --map campus --robots 2 --steps 3 --quiet --out run", dir);
+  ASSERT_EQ(last.exit_code, 0) << "a run into a killed run's folder failed: " << last.err;
   const std::string listed = slurp(out / "outputs.txt");
   for (const auto& entry : fs::directory_iterator(out)) {
     const std::string name = entry.path().filename().string();

@@ -58,7 +58,7 @@ TEST(Transform2, MatrixRoundTripAndProduct) {
 }
 
 TEST(Transform2, MatrixMatchesThePapersForm) {
-  // seed 003 eq. (6): rotation about the origin by phi, then translation by (tx, ty).
+  // The wave-algorithm paper, eq. (6): rotation about the origin by phi, then translation by (tx, ty).
   const Transform2 t(2.0, 3.0, kPi / 2.0);
   Eigen::Matrix3d expected;
   expected << 0, -1, 2, 1, 0, 3, 0, 0, 1;

@@ -48,7 +48,7 @@ TEST(SlamExperiment, NoiseFreeRunMapsARectangularRoom) {
   ASSERT_EQ(run.robots.size(), 1u);
   const SlamRobotResult& r = run.robots[0];
   EXPECT_EQ(r.truth.size(), 151u);
-  // nu as seed 000 defines it (each polynomial's distances summed), and its per-point mean.
+  // nu as D'Alfonso et al. defines it (each polynomial's distances summed), and its per-point mean.
   EXPECT_LT(r.mapping.nu, 0.05);
   EXPECT_LT(r.mapping.mean_distance, 0.001);
   EXPECT_GE(r.polynomials, 4);
@@ -119,7 +119,7 @@ TEST(SlamExperiment, OutputsTableAndFigures) {
   c.alone = {run_slam(setup, 0, false, index_of(s, "r3"))};
   const std::string md = slam_table_markdown(setup, c, true);
   EXPECT_NE(md.find("| index | r1 | r2 | r3 | r3 alone |"), std::string::npos) << md;
-  EXPECT_NE(md.find("mu, seed 000 Table 1 | 1.66e-06"), std::string::npos) << md;
+  EXPECT_NE(md.find("mu, D'Alfonso et al. Table 1 | 1.66e-06"), std::string::npos) << md;
   EXPECT_NE(md.find("times as many"), std::string::npos) << md;
   const std::string csv = slam_table_csv(setup, c);
   EXPECT_NE(csv.find("nu_m,r3,alone,"), std::string::npos);

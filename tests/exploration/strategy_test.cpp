@@ -109,7 +109,7 @@ TEST(Strategies, UncoordinatedTakesTheNearest) {
 }
 
 TEST(Strategies, OptimizedFinishesTogetherWhereGreedyDoesNot) {
-  // seed 003 Fig. 4: the greedy assignment takes the cheapest pair first (robot 2 -> a) and leaves
+  // The wave-algorithm paper, Fig. 4: the greedy assignment takes the cheapest pair first (robot 2 -> a) and leaves
   // robot 1 the long way; squared costs prefer the assignment whose slowest robot is faster.
   AssignmentInput in;
   in.sensor_range_m = 1.0;  // targets far apart: no utility interplay

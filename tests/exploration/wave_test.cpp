@@ -140,7 +140,7 @@ TEST(Wave, PathsDescendTheWaveAndHaveItsLength) {
 }
 
 TEST(Wave, FourConnectedIsSeedThreeCounting) {
-  // seed 003 Fig. 1: the robot's cell is 0, its neighbours 1, theirs 2, ...
+  // The wave-algorithm paper, Fig. 1: the robot's cell is 0, its neighbours 1, theirs 2, ...
   std::vector<std::uint8_t> open(5 * 5, 1);
   const WaveField f = compute_wave({5, 5, open, {}}, std::vector<Cell>{{2, 2}}, WaveOptions{false, 0.0});
   EXPECT_EQ(f.cost({2, 2}), 0.0f);

@@ -94,7 +94,7 @@ TEST(LandmarkGeneration, InvertsTheReadingAndItsJacobiansMatchNumericalDifferent
   }
 }
 
-// Seed 000 eq. (4) with the full matrices G_x = [I; dg/dpose 0] and G_y = [0; dg/dy].
+// D'Alfonso et al. eq. (4) with the full matrices G_x = [I; dg/dpose 0] and G_y = [0; dg/dy].
 TEST(AugmentCovariance, EqualsTheFullProductOfEquationFour) {
   core::Random rng(13);
   const int n = 7;  // pose + 2 landmarks

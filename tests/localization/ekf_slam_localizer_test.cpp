@@ -85,9 +85,9 @@ TEST(EkfSlam, WithoutNoiseStaysOnTheTruthAndMapsTheLandmarksExactly) {
   }
 }
 
-// Seed 000 eq. (4)-(5): a landmark enters at g(x_{k|k-1}, y_k) with covariance
+// D'Alfonso et al. eq. (4)-(5): a landmark enters at g(x_{k|k-1}, y_k) with covariance
 // G_pose P_{k|k-1} G_pose^T + G_y V G_y^T.
-TEST(EkfSlam, AddsALandmarkByTheAugmentationOfSeed000) {
+TEST(EkfSlam, AddsALandmarkByTheAugmentationOfDAlfonso) {
   LocalizerOptions o = noisy_options();
   o.initial_xy = 0.2;
   o.initial_theta = 0.05;

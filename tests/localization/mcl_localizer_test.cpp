@@ -1,5 +1,5 @@
 // `mcl` (localization/mcl_localizer.cpp): global localization in a room without symmetry, and
-// the collaborative form (seed 002 eq. (15)).
+// the collaborative form (León et al., eq. (15)).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -65,7 +65,7 @@ TEST(Nees, UsesTheInverseCovarianceAndRefusesASingularOne) {
   const Eigen::Vector3d e(0.2, -0.1, 0.05);
   const Eigen::Matrix3d p = Eigen::Vector3d(0.04, 0.01, 0.0025).asDiagonal();
   EXPECT_NEAR(*nees(e, p), 1.0 + 1.0 + 1.0, 1e-12);
-  EXPECT_NEAR(seed000_mu_term(e, p), 0.04 * 0.04 + 0.01 * 0.01 + 0.0025 * 0.0025, 1e-15);
+  EXPECT_NEAR(dalfonso_mu_term(e, p), 0.04 * 0.04 + 0.01 * 0.01 + 0.0025 * 0.0025, 1e-15);
   EXPECT_FALSE(nees(e, Eigen::Matrix3d::Zero()).has_value());
   Eigen::Matrix3d indefinite = p;
   indefinite(2, 2) = -1.0;
@@ -87,7 +87,7 @@ TEST(LocalizationMetrics, SummarisesARun) {
   EXPECT_EQ(s.nees_steps, 3);
   EXPECT_NEAR(s.nees_band.lower, average_chi_square_band(3, 3).lower, 1e-12);
   EXPECT_TRUE(s.nees_inside_band);
-  EXPECT_NEAR(s.seed000_mu, (0.01 * 0.01 + 0.04 * 0.01 + 1e-4 * 1e-4) / 3.0, 1e-15);
+  EXPECT_NEAR(s.dalfonso_mu, (0.01 * 0.01 + 0.04 * 0.01 + 1e-4 * 1e-4) / 3.0, 1e-15);
 }
 
 TEST(LocalizationMetrics, ReportsNoNeesForAZeroCovarianceAndNeedsASample) {
@@ -98,7 +98,7 @@ TEST(LocalizationMetrics, ReportsNoNeesForAZeroCovarianceAndNeedsASample) {
   EXPECT_FALSE(s.average_nees.has_value());
   EXPECT_FALSE(s.nees_inside_band);
   EXPECT_EQ(s.position_rmse, 0.0);
-  EXPECT_EQ(s.seed000_mu, 0.0);
+  EXPECT_EQ(s.dalfonso_mu, 0.0);
   EXPECT_EQ(s.nees_steps, 0);
 }
 

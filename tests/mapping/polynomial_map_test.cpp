@@ -49,7 +49,7 @@ TEST(PolynomialMapGeometry, OverlapOfFig3) {
   EXPECT_NEAR(rms_residual(flat(1.1, 0.0, 2.0), {{0.0, 1.0}, {1.0, 1.0}}), 0.1, 1e-12);
 }
 
-TEST(PolynomialMapGeometry, MappingErrorNuAsSeed000DefinesIt) {
+TEST(PolynomialMapGeometry, MappingErrorNuAsDAlfonsoDefinesIt) {
   const std::vector<WallSegment> walls = {{{0.0, 0.0}, {4.0, 0.0}}, {{4.0, 0.0}, {4.0, 3.0}}};
   // On the wall: no error.
   const MappingError exact = mapping_error({flat(0.0, 0.5, 3.5)}, core::Transform2(), walls, 0.01);

@@ -12,7 +12,7 @@ namespace {
 
 // Two robots' landmark maps of one area: `common` landmarks seen by both (other's copy moved by
 // the inverse of `other_to_self`, with measurement noise), plus landmarks only one of them has.
-// Signatures are 3-D (width, height, colour) as in seed 001; noise on them is small.
+// Signatures are 3-D (width, height, colour) as in the map-alignment paper; noise on them is small.
 struct LandmarkScene {
   LandmarkMap self, other;
   core::Transform2 other_to_self;
@@ -67,7 +67,7 @@ TEST(LandmarkAlignment, TwoPairsGiveTheExactTransform) {
   EXPECT_TRUE(quarter.is_approx(core::Transform2(1.0, 2.0, std::numbers::pi / 2), 1e-12)) << quarter;
 }
 
-// Seed 001 §III.A with 30% outliers: 30% of other's landmarks are not in self's map at all.
+// The map-alignment paper, §III.A with 30% outliers: 30% of other's landmarks are not in self's map at all.
 TEST(LandmarkAlignment, RansacRecoversAKnownTransformWith30PercentOutliers) {
   core::Random random(7);
   LandmarkAlignmentOptions o;

@@ -42,7 +42,7 @@ Meeting random_meeting(core::Random& r) {
   return m;
 }
 
-TEST(Rendezvous, Seed001Equations7To9RecoverTheMapTransform) {
+TEST(Rendezvous, MapAlignmentPaperEquations7To9RecoverTheMapTransform) {
   core::Random random(3);
   for (int i = 0; i < 100; ++i) {
     const Meeting m = random_meeting(random);
@@ -51,7 +51,7 @@ TEST(Rendezvous, Seed001Equations7To9RecoverTheMapTransform) {
   }
 }
 
-TEST(Rendezvous, Seed000MatrixProductAgrees) {
+TEST(Rendezvous, DAlfonsoMatrixProductAgrees) {
   core::Random random(4);
   for (int i = 0; i < 100; ++i) {
     const Meeting m = random_meeting(random);

@@ -1,4 +1,4 @@
-// seed 001 §VII's reactive steering: the naive baseline.
+// The map-alignment paper, §VII's reactive steering: the naive baseline.
 #include <gtest/gtest.h>
 
 #include "planning/planner.h"

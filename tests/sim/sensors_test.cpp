@@ -17,7 +17,7 @@ TEST(RangeSensor, ZeroNoiseReadsExactDistances) {
   const World world(testing::walled_room(40, 30), {});
   core::Random rng(1);
   RangeSensorOptions o;
-  o.angles_rad = {0.0, kPi / 2, kPi, -kPi / 2, kPi / 4};  // five distance sensors (seed 000)
+  o.angles_rad = {0.0, kPi / 2, kPi, -kPi / 2, kPi / 4};  // five distance sensors (D'Alfonso et al.)
   o.max_range_m = 10.0;
   o.noise_m = 0.0;
   const core::Pose2 pose(1.0, 1.2, 0.0);

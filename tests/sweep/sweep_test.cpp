@@ -158,14 +158,14 @@ TEST(Sweep, SweepFileErrorsNameTheFileLineAndKey) {
 
 TEST(Sweep, ReadySweepFiles) {
   const std::string dir = std::string(FLEETMAP_SOURCE_DIR) + "/scenarios/sweeps/";
-  const Sweep seed003 = load_sweep(dir + "seed003.yaml");
-  EXPECT_EQ(seed003.maps, (std::vector<std::string>{"empty", "unstructured", "office", "corridor"}));
-  EXPECT_EQ(seed003.strategies, exploration::strategy_names());
-  EXPECT_EQ(seed003.robots, (std::vector<int>{9}));
-  EXPECT_EQ(seed003.seeds, 20);
-  EXPECT_EQ(seed003.base.steps, 2000);
-  EXPECT_TRUE(std::isinf(seed003.base.communication.range_m));
-  EXPECT_DOUBLE_EQ(seed003.base.range.max_range_m, 4.0);
+  const Sweep wave_paper = load_sweep(dir + "wave_paper.yaml");
+  EXPECT_EQ(wave_paper.maps, (std::vector<std::string>{"empty", "unstructured", "office", "corridor"}));
+  EXPECT_EQ(wave_paper.strategies, exploration::strategy_names());
+  EXPECT_EQ(wave_paper.robots, (std::vector<int>{9}));
+  EXPECT_EQ(wave_paper.seeds, 20);
+  EXPECT_EQ(wave_paper.base.steps, 2000);
+  EXPECT_TRUE(std::isinf(wave_paper.base.communication.range_m));
+  EXPECT_DOUBLE_EQ(wave_paper.base.range.max_range_m, 4.0);
   const Sweep burgard = load_sweep(dir + "burgard.yaml");
   EXPECT_EQ(burgard.strategies, (std::vector<std::string>{"coordinated", "uncoordinated"}));
   EXPECT_EQ(burgard.robots, (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 9}));
