@@ -1,6 +1,8 @@
 // `fleetmap bench`: the coordination-strategy benchmark. Runs a sweep (maps x strategies x team
 // sizes x seeds) on a pool of threads, appending each run's row to results.csv; resumes an
 // interrupted sweep; runs one shard of it; combines shards; compares two strategies run by run.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -137,12 +139,12 @@ std::vector<std::string> bench_files(const std::vector<std::string>& map_labels)
 }
 
 void print_outputs(const fs::path& out, const std::vector<fs::path>& reports) {
-  std::printf("results: %s\nsummary: %s\n", (out / "results.csv").c_str(), (out / "summary.md").c_str());
-  std::printf("plots:");
+  fmt::print("results: {}\nsummary: {}\n", (out / "results.csv").string(), (out / "summary.md").string());
+  fmt::print("plots:");
   for (const auto& p : reports) {
-    if (p.extension() == ".png") std::printf(" %s", p.filename().c_str());
+    if (p.extension() == ".png") fmt::print(" {}", p.filename().string());
   }
-  std::printf("\n");
+  fmt::print("\n");
 }
 
 int run_compare(const BenchFlags& f) {
@@ -150,7 +152,7 @@ int run_compare(const BenchFlags& f) {
   const fs::path path = results_of(f.compare[2], "--compare");
   const auto table = sweep::read_results(path);
   const auto comparison = sweep::compare_strategies(table.records, f.compare[0], f.compare[1], f.metric);
-  std::printf("%s", sweep::comparison_text(comparison).c_str());
+  fmt::print("{}", sweep::comparison_text(comparison));
   return 0;
 }
 
@@ -206,10 +208,10 @@ int run_combine(const BenchFlags& f) {
   const auto reports = sweep::write_sweep_reports(out, records);
   written.insert(written.end(), reports.begin(), reports.end());
   folder.finish(io::OutputFolder::names(written));
-  std::printf("combined %zu runs from %zu folders into %s\n", records.size(), f.combine.size(), out.c_str());
+  fmt::print("combined {} runs from {} folders into {}\n", records.size(), f.combine.size(), out.string());
   if (expected > records.size()) {
-    std::printf("note: %zu of the sweep's %zu runs are missing (shards not finished or not given)\n",
-                expected - records.size(), expected);
+    fmt::print("note: {} of the sweep's {} runs are missing (shards not finished or not given)\n",
+               expected - records.size(), expected);
   }
   print_outputs(out, reports);
   return 0;
@@ -291,15 +293,17 @@ int run_bench(const BenchFlags& f) {
   folder.finish(io::OutputFolder::names(written));
 
   if (f.quiet) {
-    std::printf("%s\n", results.c_str());
+    fmt::print("{}\n", results.string());
     return 0;
   }
-  std::printf("%zu runs of %s x %s x %s x %s", all_runs.size(), counted(sweep.maps.size(), "map").c_str(),
-              counted(sweep.strategies.size(), "strategy", "strategies").c_str(),
-              counted(sweep.robots.size(), "team size").c_str(), counted(std::size_t(sweep.seeds), "seed").c_str());
-  if (shard) std::printf("; shard %d/%d: %zu runs", shard->index, shard->count, runs.size());
-  std::printf("\nran %zu runs in %.1f s with %d jobs; %zu were already in results.csv\n", todo.size(), elapsed,
-              std::max(1, std::min<int>(f.jobs, int(std::max<std::size_t>(1, todo.size())))), runs.size() - todo.size());
+  fmt::print("{} runs of {} x {} x {} x {}", all_runs.size(), counted(sweep.maps.size(), "map"),
+             counted(sweep.strategies.size(), "strategy", "strategies"), counted(sweep.robots.size(), "team size"),
+             counted(std::size_t(sweep.seeds), "seed"));
+  if (shard) fmt::print("; shard {}/{}: {} runs", shard->index, shard->count, runs.size());
+  fmt::print("\nran {} in {:.1f} s with {} job{}; {} already in results.csv\n", counted(todo.size(), "run"), elapsed,
+             std::max(1, std::min<int>(f.jobs, int(std::max<std::size_t>(1, todo.size())))),
+             std::min<int>(f.jobs, int(std::max<std::size_t>(1, todo.size()))) > 1 ? "s" : "",
+             counted(runs.size() - todo.size(), "run"));
   print_outputs(out, reports);
   return 0;
 }

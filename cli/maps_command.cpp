@@ -29,17 +29,16 @@ struct ShowOptions {
 };
 
 int run_list() {
-  std::printf("%-13s %11s %17s %11s  %s\n", "name", "cells", "metres", "free m^2", "description");
+  fmt::print("{:<13} {:>11} {:>17} {:>11}  {}\n", "name", "cells", "metres", "free m^2", "description");
   for (const auto& info : maps::builtin_maps()) {
     const auto grid = maps::load_map_source(info.name);
     const double free_m2 = double(grid.count(mapping::CellState::Free)) * grid.resolution() * grid.resolution();
-    char cells[32], metres[48];
-    std::snprintf(cells, sizeof cells, "%dx%d", grid.width(), grid.height());
-    std::snprintf(metres, sizeof metres, "%.1f x %.1f m", grid.geometry().width_m(), grid.geometry().height_m());
-    std::printf("%-13s %11s %17s %11.1f  %s\n", info.name.c_str(), cells, metres, free_m2, info.description.c_str());
+    fmt::print("{:<13} {:>11} {:>17} {:>11.1f}  {}\n", info.name, fmt::format("{}x{}", grid.width(), grid.height()),
+               fmt::format("{:.1f} x {:.1f} m", grid.geometry().width_m(), grid.geometry().height_m()), free_m2,
+               info.description);
   }
-  std::printf("\nFiles: %s (PNG + map_server YAML). Use a name wherever a map is asked for.\n",
-              maps::builtin_maps_dir().c_str());
+  fmt::print("\nFiles: {} (PNG + map_server YAML). Use a name wherever a map is asked for.\n",
+             maps::builtin_maps_dir().string());
   return 0;
 }
 

@@ -87,10 +87,8 @@ cv::Mat picture(const PlanCommandOptions& o, const mapping::OccupancyGrid& grid,
     for (int x = 0; x < grid.width(); ++x)
       if (!space.is_obstacle({x, y}) && !space.valid(core::Cell{x, y})) inflated.cells.push_back({x, y});
   overlays.cells.push_back(std::move(inflated));
-  char label[96];
   if (r.success()) {
-    std::snprintf(label, sizeof label, "%s path, %.2f m", r.planner.c_str(), r.length_m);
-    overlays.paths.push_back({r.path, viz::palette_color(0), label, 2, false});
+    overlays.paths.push_back({r.path, viz::palette_color(0), fmt::format("{} path, {:.2f} m", r.planner, r.length_m), 2, false});
   }
   // The robot at both ends, heading along the path (or straight at the goal when there is none).
   const auto heading = [](const Eigen::Vector2d& from, const Eigen::Vector2d& to) {

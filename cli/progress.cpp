@@ -1,5 +1,7 @@
 #include "cli/progress.h"
 
+#include <fmt/format.h>
+
 #include <unistd.h>
 
 #include <chrono>
@@ -14,9 +16,7 @@ double now_s() {
 }  // namespace
 
 std::string format_percent(double fraction) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f%%", 100.0 * fraction);
-  return buf;
+  return fmt::format("{:.1f}%", 100.0 * fraction);
 }
 
 ProgressBar::ProgressBar(bool enabled) : enabled_(enabled && ::isatty(STDERR_FILENO)), started_(now_s()) {}
@@ -31,14 +31,15 @@ void ProgressBar::update(long done, long total, const std::string& note) {
   const int filled = int(f * kWidth);
   const double elapsed = t - started_;
   const double eta = done > 0 ? elapsed * double(total - done) / double(done) : 0.0;
-  std::fprintf(stderr, "\r[%.*s%*s] %ld/%ld %s  %.0fs elapsed, eta %.0fs   ", filled, "##############################",
-               kWidth - filled, "", done, total, note.c_str(), elapsed, eta);
+  fmt::print(stderr, "\r[{}{}] {}/{} {}  {:.0f}s elapsed, eta {}   ", std::string(std::size_t(filled), '#'),
+             std::string(std::size_t(kWidth - filled), ' '), done, total, note, elapsed,
+             done > 0 ? fmt::format("{:.0f}s", eta) : std::string("unknown"));
   std::fflush(stderr);
   drawn_ = true;
 }
 
 void ProgressBar::finish() {
-  if (drawn_) std::fprintf(stderr, "\n");
+  if (drawn_) fmt::print(stderr, "\n");
   drawn_ = false;
 }
 

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
 #include "core/angle.h"
 #include "core/error.h"
 #include "core/random.h"
@@ -38,9 +39,7 @@ constexpr double kWall = 0.3;    // m, wall thickness
 constexpr double kMargin = 1.0;  // m, free space around the outer wall
 
 std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", v);
-  return b;
+  return fmt::format("{:g}", v);
 }
 
 }  // namespace

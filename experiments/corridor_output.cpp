@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "core/format.h"
 #include "io/file_io.h"
 #include "io/map_io.h"
 #include "viz/render.h"
@@ -12,9 +13,7 @@ namespace fleetmap::experiments {
 namespace {
 
 std::string num(double v, int decimals) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%.*f", decimals, v);
-  return b;
+  return core::fixed(v, decimals);
 }
 
 std::vector<const CorridorRun*> runs_with_laps(const CorridorResult& r, int laps) {

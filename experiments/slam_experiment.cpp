@@ -9,6 +9,7 @@
 #include <limits>
 #include <numbers>
 
+#include "core/format.h"
 #include "core/angle.h"
 #include "core/error.h"
 #include "core/random.h"
@@ -39,9 +40,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 std::string format_point(const Eigen::Vector2d& p) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "(%.2f, %.2f)", p.x(), p.y());
-  return buf;
+  return core::format_point(p);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include <fmt/format.h>
 #include "io/file_io.h"
 #include "io/map_io.h"
 #include "viz/render.h"
@@ -27,19 +28,19 @@ struct Metric {
 
 const std::vector<Metric>& metrics() {
   static const std::vector<Metric> kMetrics = {
-      {"mu", "mu_j (D'Alfonso et al.'s form: e^T P e)", "%.3g", [](const SlamRobotResult& r) { return r.localization.dalfonso_mu; }},
-      {"nees", "NEES, standard (e^T P^-1 e; 3 when consistent)", "%.3g",
+      {"mu", "mu_j (D'Alfonso et al.'s form: e^T P e)", "{:.3g}", [](const SlamRobotResult& r) { return r.localization.dalfonso_mu; }},
+      {"nees", "NEES, standard (e^T P^-1 e; 3 when consistent)", "{:.3g}",
        [](const SlamRobotResult& r) { return r.localization.average_nees.value_or(kNaN); }},
-      {"nu_m", "nu_j, m (D'Alfonso et al.'s form: per polynomial the sum of its distances, mean over polynomials)", "%.3g",
+      {"nu_m", "nu_j, m (D'Alfonso et al.'s form: per polynomial the sum of its distances, mean over polynomials)", "{:.3g}",
        [](const SlamRobotResult& r) { return r.mapping.nu; }},
-      {"mean_distance_m", "mean distance of the map to the true walls, m", "%.3g",
+      {"mean_distance_m", "mean distance of the map to the true walls, m", "{:.3g}",
        [](const SlamRobotResult& r) { return r.mapping.mean_distance; }},
-      {"position_rmse_m", "position RMSE, m", "%.3g", [](const SlamRobotResult& r) { return r.localization.position_rmse; }},
-      {"walls_mapped_pct", "true walls within 0.1 m of the map, %", "%.3g",
+      {"position_rmse_m", "position RMSE, m", "{:.3g}", [](const SlamRobotResult& r) { return r.localization.position_rmse; }},
+      {"walls_mapped_pct", "true walls within 0.1 m of the map, %", "{:.3g}",
        [](const SlamRobotResult& r) { return 100.0 * r.boundary_coverage; }},
-      {"polynomials", "polynomials in the map", "%.3g", [](const SlamRobotResult& r) { return double(r.polynomials); }},
-      {"tau_ms", "tau_j, ms per step", "%.3g", [](const SlamRobotResult& r) { return 1e3 * r.tau_s; }},
-      {"diverged_steps", "steps with P(k|k-1) > K P0 (diverging)", "%.3g",
+      {"polynomials", "polynomials in the map", "{:.3g}", [](const SlamRobotResult& r) { return double(r.polynomials); }},
+      {"tau_ms", "tau_j, ms per step", "{:.3g}", [](const SlamRobotResult& r) { return 1e3 * r.tau_s; }},
+      {"diverged_steps", "steps with P(k|k-1) > K P0 (diverging)", "{:.3g}",
        [](const SlamRobotResult& r) {
          for (const auto& [k, v] : r.counters) {
            if (k == "diverged_steps") return v;
@@ -62,9 +63,7 @@ const std::map<std::string, std::vector<std::string>>& paper_values() {
 
 std::string fmt(const char* format, double v) {
   if (std::isnan(v)) return "n/a";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
+  return fmt::format(fmt::runtime(format), v);
 }
 
 // The values of one metric for robot `name` over the runs.
@@ -165,14 +164,12 @@ std::string slam_table_markdown(const SlamSetup& setup, const SlamCampaign& c, b
     md << "No rendezvous" << (setup.scenario.exchange ? "" : " (exchange disabled)") << ".\n";
   } else {
     const MeanStd b = mean_std(bytes), g = mean_std(grid), p = mean_std(polys), n = mean_std(per_run);
-    char line[512];
-    std::snprintf(line, sizeof line,
-                  "%.2f messages per run (one each way per meeting); per message %.1f polynomials, %.0f ± %.0f bytes; "
-                  "the equivalent occupancy-grid patch (bounding box, %.2f m cells, 1 byte each) %.0f ± %.0f bytes, "
-                  "%.1f times as many.\n",
-                  n.mean, p.mean, b.mean, b.std, setup.scenario.grid_patch_resolution_m, g.mean, g.std,
-                  b.mean > 0.0 ? g.mean / b.mean : 0.0);
-    md << line;
+    md << fmt::format(
+        "{:.2f} messages per run (one each way per meeting); per message {:.1f} polynomials, {:.0f} ± {:.0f} bytes; "
+        "the equivalent occupancy-grid patch (bounding box, {:.2f} m cells, 1 byte each) {:.0f} ± {:.0f} bytes, "
+        "{:.1f} times as many.\n",
+        n.mean, p.mean, b.mean, b.std, setup.scenario.grid_patch_resolution_m, g.mean, g.std,
+        b.mean > 0.0 ? g.mean / b.mean : 0.0);
   }
   return md.str();
 }
@@ -183,9 +180,8 @@ std::string slam_table_csv(const SlamSetup& setup, const SlamCampaign& c) {
   for (const auto& m : metrics()) {
     for (const auto& col : columns(setup, c)) {
       const MeanStd s = mean_std(values(*col.runs, col.name, m));
-      char buf[128];
-      std::snprintf(buf, sizeof buf, "%.9g,%.9g,%d", s.mean, s.std, s.count);
-      csv << m.key << "," << csv_text(col.name) << "," << csv_text(col.mode) << "," << buf << "\n";
+      csv << m.key << "," << csv_text(col.name) << "," << csv_text(col.mode) << ","
+          << fmt::format("{:.9g},{:.9g},{}", s.mean, s.std, s.count) << "\n";
     }
   }
   return csv.str();
@@ -208,9 +204,7 @@ std::string slam_runs_csv(const SlamCampaign& c) {
       for (const auto& r : run.robots) {
         csv << run.run << "," << csv_text(r.name) << "," << (runs == &c.alone ? "alone" : run.exchange ? "team" : "team, no exchange");
         for (const auto& m : metrics()) {
-          char buf[64];
-          std::snprintf(buf, sizeof buf, ",%.9g", m.value(r));
-          csv << buf;
+          csv << fmt::format(",{:.9g}", m.value(r));
         }
         csv << "," << r.localization.nees_steps;
         for (const auto& name : counter_names) {
@@ -218,9 +212,7 @@ std::string slam_runs_csv(const SlamCampaign& c) {
           for (const auto& [key, value] : r.counters) {
             if (key == name) v = value;
           }
-          char buf[64];
-          std::snprintf(buf, sizeof buf, ",%.9g", v);
-          csv << buf;
+          csv << fmt::format(",{:.9g}", v);
         }
         csv << "\n";
       }

@@ -265,11 +265,9 @@ namespace {
 // As map_saver writes numbers ("%.6f", or "%.3f" for thresholds) when that reads back as the same
 // number, else the shortest text that does (a resolution of 0.05 / 3 must not lose digits).
 std::string exact_number(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  if (std::strtod(buf, nullptr) == v) return buf;
-  const auto end = std::to_chars(buf, buf + sizeof buf, v).ptr;
-  return std::string(buf, end);
+  const std::string text = fmt::format("{:.{}f}", v, decimals);
+  if (std::strtod(text.c_str(), nullptr) == v) return text;
+  return fmt::format("{}", v);
 }
 
 // A file name as map_saver writes it (plain), or quoted when YAML would read a plain one otherwise.

@@ -1,6 +1,7 @@
 // Writes every built-in map (PNG + YAML) into a folder, by default the maps/ folder beside this
 // file. The committed files are this program's output; tests/maps checks they still match.
 //   build/maps/fleetmap_generate_maps [OUT_DIR]
+#include <fmt/format.h>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -16,11 +17,10 @@ int main(int argc, char** argv) {
       const auto m = fm::maps::generate_builtin_map(info.name);
       fm::io::write_file_atomic(out / (info.name + ".png"), fm::maps::encode_png(m.image));
       fm::io::write_file_atomic(out / (info.name + ".yaml"), fm::io::format_map_yaml(m.yaml));
-      std::printf("%-13s %4dx%-4d -> %s\n", info.name.c_str(), m.image.cols, m.image.rows,
-                  (out / (info.name + ".png")).c_str());
+      fmt::print("{:<13} {:>4}x{:<4} -> {}\n", info.name, m.image.cols, m.image.rows, (out / (info.name + ".png")).string());
     }
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "fleetmap_generate_maps: %s\n", e.what());
+    fmt::print(stderr, "fleetmap_generate_maps: {}\n", e.what());
     return 1;
   }
   return 0;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
 #include "core/angle.h"
 #include "core/error.h"
 
@@ -183,13 +184,11 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   result.confidence = agree_factor * acceptance_factor * support_factor * result.distinctiveness;
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {
-    char buf[256];
-    std::snprintf(buf, sizeof buf,
-                  "no reliable overlap: confidence %.2f < %.2f (wall agreement %.2f, acceptance %.2f, "
-                  "constraint %.1f, distinctiveness %.2f)",
-                  result.confidence, options.min_confidence, best_q.agreement, result.acceptance,
-                  best_q.constraint, result.distinctiveness);
-    result.reason = buf;
+    result.reason = fmt::format(
+        "no reliable overlap: confidence {:.2f} < {:.2f} (wall agreement {:.2f}, acceptance {:.2f}, constraint {:.1f}, "
+        "distinctiveness {:.2f})",
+        result.confidence, options.min_confidence, best_q.agreement, result.acceptance, best_q.constraint,
+        result.distinctiveness);
   }
   return result;
 }

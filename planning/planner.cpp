@@ -6,30 +6,14 @@
 #include <ostream>
 
 #include "core/error.h"
+#include "core/format.h"
 
 namespace fleetmap::planning {
 
 namespace {
 
-std::string format_point(const Eigen::Vector2d& p) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "(%.2f, %.2f)", p.x(), p.y());
-  return buf;
-}
-
-// "x from 0.00 to 20.00 m, y from 0.00 to 20.00 m": the box around the map's corners.
-std::string format_extent(const GridGeometry& g) {
-  double lo_x = INFINITY, hi_x = -INFINITY, lo_y = INFINITY, hi_y = -INFINITY;
-  for (const auto& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(g.width(), 0), Eigen::Vector2d(0, g.height()),
-                             Eigen::Vector2d(g.width(), g.height())}) {
-    const Eigen::Vector2d w = g.grid_to_world(corner);
-    lo_x = std::min(lo_x, w.x()), hi_x = std::max(hi_x, w.x());
-    lo_y = std::min(lo_y, w.y()), hi_y = std::max(hi_y, w.y());
-  }
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "x from %.2f to %.2f m, y from %.2f to %.2f m", lo_x, hi_x, lo_y, hi_y);
-  return buf;
-}
+using core::format_extent;
+using core::format_point;
 
 // Why a point inside the map is not a valid robot position.
 std::string why_invalid(const FreeSpace& space, const Eigen::Vector2d& p) {
@@ -39,10 +23,8 @@ std::string why_invalid(const FreeSpace& space, const Eigen::Vector2d& p) {
                ? "is in unknown space (unknown cells count as obstacles)"
                : "is inside an obstacle";
   }
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "is %.2f m from the nearest obstacle, not more than the robot radius %.2f m",
-                space.clearance(c), space.robot_radius());
-  return buf;
+  return fmt::format("is {:.2f} m from the nearest obstacle, not more than the robot radius {:.2f} m", space.clearance(c),
+                     space.robot_radius());
 }
 
 }  // namespace
@@ -95,8 +77,7 @@ PlanResult Planner::plan(const FreeSpace& space, const Eigen::Vector2d& start, c
   if (!space.valid(start)) return finish(PlanStatus::StartInObstacle, "start " + format_point(start) + " " + why_invalid(space, start));
   if (!space.valid(goal)) return finish(PlanStatus::GoalInObstacle, "goal " + format_point(goal) + " " + why_invalid(space, goal));
   if (options.check_reachability && !space.connected(*g.world_to_cell(start), *g.world_to_cell(goal))) {
-    char radius[32];
-    std::snprintf(radius, sizeof radius, "%.2f", space.robot_radius());
+    const std::string radius = fmt::format("{:.2f}", space.robot_radius());
     return finish(PlanStatus::Unreachable, "goal " + format_point(goal) + " cannot be reached from start " +
                                                format_point(start) + ": no collision-free corridor joins them for a robot of radius " +
                                                radius + " m");
@@ -115,17 +96,13 @@ PlanResult Planner::plan(const FreeSpace& space, const Eigen::Vector2d& start, c
   if (!found.found) {
     if (found.unreachable) return finish(PlanStatus::Unreachable, found.detail);
     if (found.detail.empty()) {
-      char buf[96];
-      std::snprintf(buf, sizeof buf, " found no path within %.2f s", options.time_budget_s);
-      found.detail = name() + buf;
+      found.detail = fmt::format("{} found no path within {:.2f} s", name(), options.time_budget_s);
     }
     return finish(PlanStatus::NotFound, found.detail);
   }
   result.path = std::move(found.path);
   result.length_m = path_length(result.path);
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "path of %.2f m with %zu waypoints", result.length_m, result.path.size());
-  return finish(PlanStatus::Success, buf);
+  return finish(PlanStatus::Success, fmt::format("path of {:.2f} m with {} waypoints", result.length_m, result.path.size()));
 }
 
 PlanResult plan_path(const mapping::OccupancyGrid& grid, const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,

@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 
+#include "core/format.h"
 #include "core/angle.h"
 #include "core/error.h"
 #include "planning/planners.h"
@@ -84,7 +85,6 @@ class ReactivePlanner final : public Planner {
     int turn_sign = 0;  // +1 left, -1 right, 0 not avoiding anything
     bool avoiding = false;  // a sub-target is set
     Eigen::Vector2d sub_target = Eigen::Vector2d::Zero();
-    char buf[160];
 
     while (true) {
       const Eigen::Vector2d to_goal = goal - p;
@@ -94,13 +94,11 @@ class ReactivePlanner final : public Planner {
         break;
       }
       if (Clock::now() > deadline) {
-        std::snprintf(buf, sizeof buf, "reactive: no path within %.2f s (travelled %.1f m)", options.time_budget_s, travelled);
-        s.detail = buf;
+        s.detail = fmt::format("reactive: no path within {:.2f} s (travelled {:.1f} m)", options.time_budget_s, travelled);
         return s;
       }
       if (travelled > max_travel) {
-        std::snprintf(buf, sizeof buf, "reactive: gave up after travelling %.1f m without reaching the goal", travelled);
-        s.detail = buf;
+        s.detail = fmt::format("reactive: gave up after travelling {:.1f} m without reaching the goal", travelled);
         return s;
       }
       if (!avoiding) heading = std::atan2(to_goal.y(), to_goal.x());
@@ -122,8 +120,7 @@ class ReactivePlanner final : public Planner {
           break;
         }
         if (turns >= max_turns) {
-          std::snprintf(buf, sizeof buf, "reactive: boxed in at (%.2f, %.2f)", p.x(), p.y());
-          s.detail = buf;
+          s.detail = "reactive: boxed in at " + core::format_point(p);
           return s;
         }
         if (turn_sign == 0) turn_sign = bearing(p, heading, *blocker) < 0.0 ? +1 : -1;

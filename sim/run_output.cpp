@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <map>
 
+#include <fmt/format.h>
 #include "core/angle.h"
 #include "core/error.h"
 #include "io/file_io.h"
@@ -28,10 +29,8 @@ json optional_int(const std::optional<int>& v) { return v ? json(*v) : json(null
 json range_value(double v) { return std::isinf(v) ? json("inf") : json(v); }
 
 std::string title(const RunResult& r, const std::string& map_label) {
-  char buf[256];
-  std::snprintf(buf, sizeof buf, "%s: %d robots, %s", map_label.c_str(), r.scenario.robot_count,
-                r.scenario.exploration.strategy.c_str());
-  return buf;
+  return fmt::format("{}: {} robot{}, {}", map_label, r.scenario.robot_count, r.scenario.robot_count == 1 ? "" : "s",
+                     r.scenario.exploration.strategy);
 }
 
 std::vector<Eigen::Vector2d> positions(const std::vector<core::Pose2>& poses) {
@@ -153,9 +152,8 @@ cv::Mat render_merged(const RunResult& r, const std::string& map_label, const vi
   o.paths.insert(o.paths.end(), extra.paths.begin(), extra.paths.end());
   o.points.insert(o.points.end(), extra.points.begin(), extra.points.end());
   o.poses.insert(o.poses.end(), extra.poses.begin(), extra.poses.end());
-  char buf[128];
-  std::snprintf(buf, sizeof buf, ", %d steps, %.1f%%", r.steps, 100.0 * (r.coverage.empty() ? 0.0 : r.coverage.back()));
-  return viz::render_map(r.merged, o, render_options(title(r, map_label) + buf));
+  const std::string numbers = fmt::format(", {} steps, {:.1f}%", r.steps, 100.0 * (r.coverage.empty() ? 0.0 : r.coverage.back()));
+  return viz::render_map(r.merged, o, render_options(title(r, map_label) + numbers));
 }
 
 cv::Mat render_robot(const RunResult& r, int robot, const std::string& map_label) {
@@ -241,10 +239,8 @@ void RunVideo::add_frame(const Simulation& sim, const std::string& map_label) {
     }
     o.poses.push_back({sim.true_poses()[std::size_t(i)], sim.scenario().robot.radius_m, colour, ""});
   }
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%s: step %d, %.1f%%", map_label.c_str(), sim.step_count(), 100.0 * sim.coverage());
   viz::RenderOptions ro;
-  ro.title = buf;
+  ro.title = fmt::format("{}: step {}, {:.1f}%", map_label, sim.step_count(), 100.0 * sim.coverage());
   ro.max_size_px = 1600;
   cv::Mat frame = viz::render_map(sim.merged_map(), o, ro);
   if (!impl_->writer.isOpened()) {

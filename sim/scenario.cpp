@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include <fmt/format.h>
 #include "core/angle.h"
 #include "core/error.h"
 #include "io/file_io.h"
@@ -52,9 +53,7 @@ std::vector<std::vector<double>> number_rows(io::YamlMap& m, const std::string& 
 
 std::string fmt(double v) {
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.15g", v);
-  return buf;
+  return fmt::format("{:.15g}", v);
 }
 
 

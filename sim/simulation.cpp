@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/format.h"
 #include "core/angle.h"
 #include "localization/localizers.h"
 #include "mapping/range_scan.h"
@@ -25,19 +26,9 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-std::string point_text(const Eigen::Vector2d& p) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "(%.2f, %.2f)", p.x(), p.y());
-  return buf;
-}
+std::string point_text(const Eigen::Vector2d& p) { return core::format_point(p); }
 
-std::string extent_text(const core::GridGeometry& g) {
-  const Eigen::Vector2d lo = g.grid_to_world({0, 0}), hi = g.grid_to_world({double(g.width()), double(g.height())});
-  char buf[128];
-  std::snprintf(buf, sizeof buf, "the map spans x %.2f..%.2f m, y %.2f..%.2f m", std::min(lo.x(), hi.x()),
-                std::max(lo.x(), hi.x()), std::min(lo.y(), hi.y()), std::max(lo.y(), hi.y()));
-  return buf;
-}
+std::string extent_text(const core::GridGeometry& g) { return core::format_extent(g); }
 
 // Free cells in order of 4-connected BFS distance from the free cell nearest to `centre`.
 std::vector<Cell> free_cells_from(const World& world, const Eigen::Vector2d& centre, std::size_t enough) {
@@ -86,9 +77,7 @@ std::vector<core::Pose2> place_robots(const Scenario& s, const World& world, cor
       if (world.blocked(*cell)) throw InputError(who + ", inside a wall");
       if (!world.disc_free(p, r)) {
         const double clearance = world.clearance(p, 2.0 * r);
-        char buf[96];
-        std::snprintf(buf, sizeof buf, ", too close to a wall (clearance %.2f m, radius %.2f m)", clearance, r);
-        throw InputError(who + buf);
+        throw InputError(who + fmt::format(", too close to a wall (clearance {:.2f} m, radius {:.2f} m)", clearance, r));
       }
       for (std::size_t j = 0; j < i; ++j) {
         if ((s.starts[j].position() - p).norm() < 2.0 * r) {
@@ -439,10 +428,9 @@ void Simulation::try_merge(int i, int j) {
   record.rotation_error_deg = core::rad2deg(std::abs(core::normalize_angle(t->rotation() - truth.rotation())));
   record.position_error_m = (t->apply(at) - truth.apply(at)).norm();
   merges_.push_back(record);
-  char detail[160];
-  std::snprintf(detail, sizeof detail, "%s merge, confidence %.2f: rotation error %.2f deg, position error %.3f m",
-                record.method.c_str(), record.confidence, record.rotation_error_deg, record.position_error_m);
-  events_.push_back({step_, "merge", receiver, sender, detail});
+  events_.push_back({step_, "merge", receiver, sender,
+                     fmt::format("{} merge, confidence {:.2f}: rotation error {:.2f} deg, position error {:.3f} m",
+                                 record.method, record.confidence, record.rotation_error_deg, record.position_error_m)});
   adopt_frame(frame_of_[std::size_t(sender)], frame_of_[std::size_t(receiver)], *t);
 }
 

@@ -6,6 +6,7 @@
 #include <limits>
 #include <set>
 
+#include <fmt/format.h>
 #include "core/error.h"
 #include "io/file_io.h"
 #include "io/yaml_reader.h"
@@ -78,9 +79,7 @@ bool looks_like_file(const std::string& source) {
 
 std::string number_text(double v) {
   if (std::isinf(v)) return "inf";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+  return fmt::format("{:.17g}", v);
 }
 
 void use_base(Sweep& sweep, sim::Scenario base) {
@@ -328,9 +327,7 @@ std::string settings_id(const sim::Scenario& base) {
     h ^= c;
     h *= 1099511628211ull;
   }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+  return fmt::format("{:016x}", h);
 }
 
 }  // namespace fleetmap::sweep

@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "core/format.h"
 #include "core/error.h"
 #include "io/file_io.h"
 #include "io/map_io.h"
@@ -23,17 +24,13 @@ std::optional<double> optional_steps(const std::optional<int>& v) {
 
 std::string number(double v, int decimals) {
   if (!std::isfinite(v)) return "";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
+  return core::fixed(v, decimals);
 }
 
 // Full precision for CSV: the same records give the same text.
 std::string csv_number(double v) {
   if (!std::isfinite(v)) return "";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
+  return fmt::format("{:.10g}", v);
 }
 
 std::string team_text(int robots) { return std::to_string(robots) + (robots == 1 ? " robot" : " robots"); }
@@ -166,11 +163,10 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
   std::vector<std::string> team_texts;
   for (int t : teams) team_texts.push_back(std::to_string(t));
   const RunRecord& first = records.front();
-  char settings[256];
-  std::snprintf(settings, sizeof settings,
-                "localization %s, merging %s, communication range %s, sensor range %g m, step limit %d (settings %s)",
-                first.localization.c_str(), first.merging.c_str(), std::isinf(first.comm_range_m) ? "unlimited" : (number(first.comm_range_m, 1) + " m").c_str(),
-                first.sensor_range_m, first.step_limit, first.settings.c_str());
+  const std::string settings = fmt::format(
+      "localization {}, merging {}, communication range {}, sensor range {:g} m, step limit {} (settings {})",
+      first.localization, first.merging, std::isinf(first.comm_range_m) ? "unlimited" : number(first.comm_range_m, 1) + " m",
+      first.sensor_range_m, first.step_limit, first.settings);
   md += std::to_string(records.size()) + " runs: maps " + join(maps) + "; strategies " + join(strategies) +
         "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) + (seeds.size() == 1 ? " seed. " : " seeds. ") + settings + ".\n\n";
   md += "Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
@@ -297,8 +293,9 @@ std::string comparison_text(const StrategyComparison& c) {
     const auto& x = row.comparison;
     const int a_better = c.higher_is_better ? x.b_lower : x.a_lower;
     const int b_better = c.higher_is_better ? x.a_lower : x.b_lower;
-    char p[32] = "";
-    if (std::isfinite(x.p_value)) std::snprintf(p, sizeof p, x.p_value < 0.001 ? "%.1e" : "%.3f", x.p_value);
+    const std::string p = !std::isfinite(x.p_value) ? ""
+                          : x.p_value < 0.001     ? fmt::format("{:.1e}", x.p_value)
+                                                  : fmt::format("{:.3f}", x.p_value);
     const std::string ci = x.difference.n > 1 ? "[" + number(x.difference.ci_low, d) + ", " + number(x.difference.ci_high, d) + "]" : "";
     t += "| " + row.map + " | " + (row.robots > 0 ? std::to_string(row.robots) : std::string("all")) + " | " +
          std::to_string(x.difference.n) + " | " + number(x.difference.mean, d) + " | " + ci + " | " + p + " | " +

@@ -12,6 +12,7 @@
 #include <limits>
 #include <sstream>
 
+#include "core/format.h"
 #include "core/error.h"
 #include "io/file_io.h"
 #include "sweep/lower_bound.h"
@@ -23,12 +24,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string fixed(double v, int decimals) {
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
+using core::fixed;
 
 std::string optional_int(const std::optional<int>& v) { return v ? std::to_string(*v) : ""; }
 

@@ -1,4 +1,5 @@
 #include "viz/plot.h"
+#include <fmt/format.h>
 
 #include <opencv2/imgproc.hpp>
 
@@ -51,9 +52,7 @@ void put_vertical(cv::Mat& img, const std::string& text, int cx, int cy, double 
 // Decimals enough to tell ticks `step` apart.
 std::string tick_text(double v, double step) {
   const int decimals = std::clamp(int(-std::floor(std::log10(step) + 1e-9)), 0, 6);
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, std::abs(v) < step * 1e-9 ? 0.0 : v);
-  return buf;
+  return fmt::format("{:.{}f}", std::abs(v) < step * 1e-9 ? 0.0 : v, decimals);
 }
 
 double tick_step(const std::vector<double>& ticks) { return ticks.size() > 1 ? ticks[1] - ticks[0] : 1.0; }

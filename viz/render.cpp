@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <opencv2/imgproc.hpp>
 
+#include <fmt/format.h>
 #include "core/error.h"
 
 namespace fleetmap::viz {
@@ -50,10 +51,7 @@ double nice_length(double target) {
 }
 
 std::string format_metres(double m) {
-  char buf[32];
-  if (m >= 1.0) std::snprintf(buf, sizeof buf, "%g m", m);
-  else std::snprintf(buf, sizeof buf, "%g cm", m * 100.0);
-  return buf;
+  return m >= 1.0 ? fmt::format("{:g} m", m) : fmt::format("{:g} cm", m * 100.0);
 }
 
 struct LegendEntry {

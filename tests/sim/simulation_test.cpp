@@ -119,7 +119,7 @@ TEST(SimulationBadInput, StartsAndCountsAreChecked) {
   };
   expect_input_error([&] { Simulation(with_starts({{0.05, 2.0, 0}}), room); }, {"robot 1 starts at (0.05, 2.00)", "inside a wall"});
   expect_input_error([&] { Simulation(with_starts({{1.0, 1.0, 0}, {9.0, 1.0, 0}}), room); },
-                     {"robot 2 starts at (9.00, 1.00)", "outside the map", "x 0.00..5.00"});
+                     {"robot 2 starts at (9.00, 1.00)", "outside the map", "x from 0.00 to 5.00 m"});
   expect_input_error([&] { Simulation(with_starts({{1.0, 1.0, 0}, {1.2, 1.1, 0}}), room); }, {"robot 2", "on robot 1"});
   expect_input_error([&] { Simulation(with_starts({{0.2, 2.0, 0}}), room); }, {"robot 1", "too close to a wall"});
   Scenario none = small("room", 0, 10);
