@@ -68,7 +68,8 @@ void check_size(const std::string& path, std::int64_t w, std::int64_t h, const M
                                  w > kHugeSide ? "width" : "height", kHugeSide, options.max_cells));
   }
   if (w > options.max_cells / h) {  // w * h > max_cells, without overflow
-    throw InputError(fmt::format("{}: image is {}x{} = {} cells, over the size limit of {} cells", path, w, h, w * h,
+    const std::string cells = w <= INT64_MAX / h ? std::to_string(w * h) : std::string("more than 9e18");
+    throw InputError(fmt::format("{}: image is {}x{} = {} cells, over the size limit of {} cells", path, w, h, cells,
                                  options.max_cells));
   }
 }

@@ -122,6 +122,12 @@ TEST(MapIoBadInput, BrokenNetpbmImages) {
   expect_input_error([] { decode("P3\n1 1\n255\n10 x 30\n"); }, {"test.pgm", "cannot decode PPM"});
 }
 
+TEST(MapIoBadInput, HugeDeclaredSizesAreRefusedWithoutOverflow) {
+  // Found by fuzzing: a PNG header of about 2^31 x 2^30 pixels made the size message multiply past 64 bits.
+  const std::string pgm = "P5\n1099511627776 1099511627776\n255\n";
+  expect_input_error([&] { decode(pgm); }, {"image is 1099511627776x1099511627776 = more than 9e18 cells, over the size limit"});
+}
+
 // One row of grey pixels; map_server: occ = (255 - v) / 255, occupied > 0.65, free < 0.196.
 cv::Mat grey_row(const std::vector<int>& values) {
   cv::Mat m(1, int(values.size()), CV_8UC1);
