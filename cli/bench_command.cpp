@@ -16,6 +16,7 @@
 
 #include "cli/command.h"
 #include "cli/progress.h"
+#include "cli/sweep_flags.h"
 #include "cli/validators.h"
 #include "core/error.h"
 #include "io/file_io.h"
@@ -36,7 +37,7 @@ namespace {
 
 struct BenchFlags {
   std::string sweep_file;
-  sweep::SweepOverrides sweep;
+  SweepFlags sweep;
   int jobs = std::max(1u, std::thread::hardware_concurrency());
   std::string shard;
   std::string out;
@@ -56,9 +57,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 bool any_sweep_flag(const BenchFlags& f) {
-  const auto& s = f.sweep;
-  return !f.sweep_file.empty() || !f.shard.empty() || s.maps || s.strategies || s.robots || s.seeds || s.first_seed ||
-         s.scenario || s.steps || s.localization || s.merging || s.comm_range || s.sensor_range;
+  return !f.sweep_file.empty() || !f.shard.empty() || f.sweep.any();
 }
 
 fs::path results_of(const std::string& dir, const std::string& flag) {
@@ -151,7 +150,14 @@ int run_compare(const BenchFlags& f) {
   if (any_sweep_flag(f) || !f.combine.empty()) throw InputError("--compare A B DIR takes no sweep flags and no --combine");
   const fs::path path = results_of(f.compare[2], "--compare");
   const auto table = sweep::read_results(path);
-  const auto comparison = sweep::compare_strategies(table.records, f.compare[0], f.compare[1], f.metric);
+  const auto comparison = [&] {
+    try {
+      return sweep::compare_strategies(table.records, f.compare[0], f.compare[1], f.metric);
+    } catch (const InputError& e) {
+      throw InputError(std::string(e.what()).rfind("metric", 0) == 0 ? "--" + std::string(e.what())
+                                                                     : "--compare: " + std::string(e.what()));
+    }
+  }();
   fmt::print("{}", sweep::comparison_text(comparison));
   return 0;
 }
@@ -223,9 +229,9 @@ int run_bench(const BenchFlags& f) {
 
   sweep::Sweep sweep;
   if (!f.sweep_file.empty()) sweep = sweep::load_sweep(f.sweep_file);
-  sweep::apply_overrides(sweep, f.sweep);
+  apply_sweep_flags(sweep, f.sweep);
   sweep::validate_sweep(sweep);
-  const std::optional<sweep::Shard> shard = f.shard.empty() ? std::nullopt : std::optional(sweep::parse_shard(f.shard));
+  const std::optional<sweep::Shard> shard = f.shard.empty() ? std::nullopt : std::optional(parse_shard(f.shard));
 
   // Every output is checked before the maps are read or a run starts.
   const fs::path out = f.out.empty() ? fs::path("out/bench") : fs::path(f.out);

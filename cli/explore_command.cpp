@@ -62,6 +62,13 @@ sim::Scenario scenario_from(const ExploreFlags& f) {
   if (f.beams) s.range.beams = *f.beams, s.range.angles_rad.clear();
   if (f.landmarks) s.landmarks_along_walls = *f.landmarks;
   if (f.path_planner) s.path_planner = *f.path_planner;
+  // Said here with the flag that helps; a scenario's own check names the keys only.
+  if ((s.localization == "ekf" || s.localization == "ekf-slam") && s.landmarks.empty() && s.landmarks_along_walls <= 0.0) {
+    throw InputError("localization '" + s.localization +
+                     "' localizes against landmarks, and there are none: add some (--landmarks 0.5 places one per "
+                     "2 m of wall; in a scenario, landmarks: {along_walls: 0.5} or landmarks: {points: [[x, y]]}), "
+                     "or choose a localizer that needs none (odometry, scan-matching, rbpf, mcl, polynomial)");
+  }
   sim::validate_scenario(s);
   // From here on the map is named as it is loaded: a built-in name, or a path from here.
   s.map = sim::map_source(s);

@@ -231,7 +231,7 @@ OutputFolder::OutputFolder(fs::path dir, std::string command, std::vector<std::s
     const fs::path folder = fs::weakly_canonical(fs::absolute(input, e1).parent_path(), e1);
     if (!e1 && same_file(folder, dir_)) {
       throw InputError(where + "holds the input " + quoted_path(input) +
-                       "; a run writes into a folder of its own: choose another --out, or move the input");
+                       "; a run writes into a folder of its own: choose another output folder, or move the input");
     }
   }
   const fs::path list = dir_ / kListName;

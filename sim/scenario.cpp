@@ -286,8 +286,8 @@ void validate_scenario(const Scenario& s) {
   // Landmark localizers without landmarks would quietly be dead reckoning.
   if ((s.localization == "ekf" || s.localization == "ekf-slam") && s.landmarks.empty() && s.landmarks_along_walls <= 0.0) {
     throw InputError("localization '" + s.localization +
-                     "' localizes against landmarks, and there are none: add some (--landmarks 0.5 places one per "
-                     "2 m of wall; in a scenario, landmarks: {along_walls: 0.5} or landmarks: {points: [[x, y]]}), "
+                     "' localizes against landmarks, and there are none: add some (landmarks: {along_walls: 0.5} places one "
+                     "per 2 m of wall, landmarks: {points: [[x, y]]} where you want them), "
                      "or choose a localizer that needs none (odometry, scan-matching, rbpf, mcl, polynomial)");
   }
   check_name("merging", s.merging, merging_names());

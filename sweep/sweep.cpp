@@ -82,12 +82,13 @@ std::string number_text(double v) {
   return fmt::format("{:.17g}", v);
 }
 
+
+}  // namespace
+
 void use_base(Sweep& sweep, sim::Scenario base) {
   if (base.placement == sim::Placement::List) base.placement = sim::Placement::Cluster, base.starts.clear();
   sweep.base = std::move(base);
 }
-
-}  // namespace
 
 std::string map_label(const std::string& source) {
   return looks_like_file(source) ? fs::path(source).stem().string() : source;
@@ -189,29 +190,6 @@ Sweep load_sweep(const fs::path& path) {
   return parse_sweep(io::read_file(path, std::size_t{1} << 20), path.string(), path.parent_path());
 }
 
-void apply_overrides(Sweep& sweep, const SweepOverrides& f) {
-  if (f.scenario) {
-    if (!io::is_regular_file(*f.scenario)) throw InputError("--scenario: no scenario file '" + *f.scenario + "'");
-    use_base(sweep, sim::load_scenario(*f.scenario));
-  }
-  if (f.maps) sweep.maps = parse_map_list(*f.maps, "--maps");
-  if (f.strategies) sweep.strategies = parse_strategy_list(*f.strategies, "--strategies");
-  if (f.robots) sweep.robots = parse_team_sizes(*f.robots, "--robots");
-  if (f.seeds) sweep.seeds = *f.seeds;
-  if (f.first_seed) sweep.first_seed = *f.first_seed;
-  if (f.steps) sweep.base.steps = *f.steps;
-  if (f.localization) sweep.base.localization = *f.localization;
-  if (f.merging) {
-    const auto names = sim::merging_names();
-    if (std::find(names.begin(), names.end(), *f.merging) == names.end()) {
-      throw InputError("--merging: unknown mode '" + *f.merging + "' (valid: " + join(names) + ")");
-    }
-    sweep.base.merging = *f.merging;
-  }
-  if (f.comm_range) sweep.base.communication.range_m = parse_comm_range(*f.comm_range, "--comm-range");
-  if (f.sensor_range) sweep.base.range.max_range_m = *f.sensor_range;
-}
-
 void validate_sweep(const Sweep& sweep) {
   if (sweep.maps.empty()) throw InputError("maps: the sweep needs at least one map");
   if (sweep.strategies.empty()) throw InputError("strategies: the sweep needs at least one strategy");
@@ -287,22 +265,6 @@ sim::Scenario run_scenario(const Sweep& sweep, const SweepRun& run) {
   s.robot_count = run.robots;
   s.seed = run.seed;
   return s;
-}
-
-Shard parse_shard(const std::string& text) {
-  const auto slash = text.find('/');
-  const auto number = [](const std::string& part) {
-    if (part.empty() || part.size() > 6 || !std::all_of(part.begin(), part.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-      return -1;
-    }
-    return std::stoi(part);
-  };
-  const int k = slash == std::string::npos ? -1 : number(text.substr(0, slash));
-  const int n = slash == std::string::npos ? -1 : number(text.substr(slash + 1));
-  if (k < 1 || n < 1 || k > n) {
-    throw InputError("--shard '" + text + "': expected K/N with 1 <= K <= N, e.g. 2/4 (the second of four slices)");
-  }
-  return {k, n};
 }
 
 std::vector<SweepRun> shard_runs(const std::vector<SweepRun>& runs, const Shard& shard) {

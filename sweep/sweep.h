@@ -30,19 +30,6 @@ struct Sweep {
   sim::Scenario base;
 };
 
-// Flags given on the command line; each replaces the sweep file's value. Lists are as typed.
-struct SweepOverrides {
-  std::optional<std::string> maps, strategies, robots;
-  std::optional<int> seeds;
-  std::optional<std::uint64_t> first_seed;
-  std::optional<std::string> scenario;  // a scenario file: the base
-  std::optional<int> steps;
-  std::optional<std::string> localization;
-  std::optional<std::string> merging;     // known, rendezvous or overlap
-  std::optional<std::string> comm_range;  // metres, or "inf"
-  std::optional<double> sensor_range;
-};
-
 // The name a map goes by in results: a built-in name as is, a file by its stem ("maps/lab.png": "lab").
 std::string map_label(const std::string& source);
 
@@ -60,9 +47,8 @@ double parse_comm_range(const std::string& text, const std::string& what);
 // files are relative to `base_dir` (the sweep file's folder).
 Sweep parse_sweep(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 Sweep load_sweep(const std::filesystem::path& path);
-// Applies flags over `sweep` (relative paths in flags are relative to the working directory).
-// Numbers are checked by the flags' own validators (the same ranges as the file's).
-void apply_overrides(Sweep& sweep, const SweepOverrides& flags);
+// The base scenario of a sweep: listed starts become a cluster of each run's team size.
+void use_base(Sweep& sweep, sim::Scenario base);
 // Non-empty lists without repeats, distinct map labels, seeds >= 1, and a valid base scenario.
 void validate_sweep(const Sweep& sweep);
 // The sweep file that defines `sweep` with its base scenario in `scenario_file` (scenario_to_yaml;
@@ -89,8 +75,6 @@ struct Shard {
   int index = 1;
   int count = 1;
 };
-// "K/N"; throws InputError naming --shard.
-Shard parse_shard(const std::string& text);
 std::vector<SweepRun> shard_runs(const std::vector<SweepRun>& runs, const Shard& shard);
 
 // 16 hex digits identifying every setting of the base but the map, strategy, robot count and seed:

@@ -228,15 +228,15 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
 
 StrategyComparison compare_strategies(const std::vector<RunRecord>& records, const std::string& a, const std::string& b,
                                       const std::string& metric_name) {
-  const ReportMetric& metric = find_report_metric(metric_name, "--metric");
+  const ReportMetric& metric = find_report_metric(metric_name, "metric");
   const auto strategies = strategies_of(records);
   for (const auto& s : {a, b}) {
     if (std::find(strategies.begin(), strategies.end(), s) == strategies.end()) {
-      throw InputError("--compare: no runs of strategy '" + s + "' in the results (strategies there: " +
+      throw InputError("no runs of strategy '" + s + "' in the results (strategies there: " +
                        (strategies.empty() ? std::string("none") : join(strategies)) + ")");
     }
   }
-  if (a == b) throw InputError("--compare: give two different strategies, got '" + a + "' twice");
+  if (a == b) throw InputError("give two different strategies, got '" + a + "' twice");
   StrategyComparison c;
   c.a = a;
   c.b = b;

@@ -286,7 +286,7 @@ ResultsTable read_results(const fs::path& path) {
   const std::string name = path.string();
   if (first_line(text) != results_header()) {
     throw InputError(name + ":1: not a results table of this fleetmap bench (its columns differ: written by another "
-                            "version or another program); use another --out");
+                            "version or another program); use another output folder");
   }
   std::map<RunKey, std::pair<std::size_t, int>> seen;  // key -> (record index, line)
   std::size_t pos = text.find('\n');
@@ -322,7 +322,7 @@ void check_settings(const std::vector<RunRecord>& records, const std::string& se
     throw InputError(path.string() + ": the run " + r.key.map + "/" + r.key.strategy + "/" + std::to_string(r.key.robots) +
                      " robots/seed " + std::to_string(r.key.seed) + " is from a sweep with other settings (settings " +
                      r.settings + ", this sweep " + settings + "; its localization " + r.localization + ", step limit " +
-                     std::to_string(r.step_limit) + "): use another --out, or the same settings");
+                     std::to_string(r.step_limit) + "): use another output folder, or the same settings");
   }
 }
 
@@ -347,7 +347,7 @@ void ResultsAppender::prepare() {
   if (st.st_size > 0) {
     text = io::read_file(path);
     if (first_line(text) != results_header()) {
-      throw InputError(path.string() + ":1: not a results table of this fleetmap bench; use another --out");
+      throw InputError(path.string() + ":1: not a results table of this fleetmap bench; use another output folder");
     }
     // A row cut short (the machine stopped inside a write) is dropped, so appends start on a new line.
     const auto last_newline = text.rfind('\n');

@@ -129,7 +129,7 @@ TEST(SweepReport, PairedComparisonOfTwoStrategies) {
   EXPECT_NE(text.find("2 runs had no partner"), std::string::npos);
   expect_input_error([&] { compare_strategies(records, "fast", "nowhere", "steps_to_99"); }, {"nowhere", "fast, slow"});
   expect_input_error([&] { compare_strategies(records, "fast", "fast", "steps_to_99"); }, {"two different"});
-  expect_input_error([&] { compare_strategies(records, "fast", "slow", "speed"); }, {"--metric", "'speed'", "steps_to_99"});
+  expect_input_error([&] { compare_strategies(records, "fast", "slow", "speed"); }, {"metric: unknown metric", "'speed'", "steps_to_99"});
 }
 
 TEST(SweepReport, PlotsForEveryMapAndEfficiency) {

@@ -128,7 +128,7 @@ TEST(SweepResults, ForeignFilesAndConflictsAreRefused) {
   RunRecord foreign_settings = sample("market", 1, 5);
   foreign_settings.settings = "ffffffffffffffff";
   expect_input_error([&] { check_settings({r, foreign_settings}, r.settings, "x/results.csv"); },
-                     {"x/results.csv", "seed 5", "other settings", "another --out"});
+                     {"x/results.csv", "seed 5", "other settings", "another output folder"});
 }
 
 TEST(SweepResults, SortsIntoTheSweepsOrderAndWritesAtomically) {

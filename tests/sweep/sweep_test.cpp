@@ -61,15 +61,6 @@ TEST(Sweep, ShardsPartitionTheRuns) {
   }
 }
 
-TEST(Sweep, ShardFlagIsChecked) {
-  const Shard s = parse_shard("2/4");
-  EXPECT_EQ(s.index, 2);
-  EXPECT_EQ(s.count, 4);
-  for (const char* bad : {"5/4", "0/3", "3", "a/b", "1/0", "-1/3", "2/", "/4", "1/2/3", ""}) {
-    expect_input_error([&] { parse_shard(bad); }, {"--shard", "K/N"});
-  }
-}
-
 TEST(Sweep, ListsFromFlags) {
   EXPECT_EQ(parse_team_sizes("1,2,4,9", "--robots"), (std::vector<int>{1, 2, 4, 9}));
   EXPECT_EQ(parse_team_sizes("1-4", "--robots"), (std::vector<int>{1, 2, 3, 4}));
@@ -122,19 +113,6 @@ TEST(Sweep, SweepFileWithEveryKey) {
   const auto runs = sweep_runs(s);
   ASSERT_EQ(runs.size(), 2u * 2u * 3u * 4u);
   EXPECT_EQ(runs.front().seed, 10u);
-  // Flags override the file.
-  Sweep o = s;
-  SweepOverrides flags;
-  flags.robots = "9";
-  flags.steps = 50;
-  flags.comm_range = "inf";
-  flags.merging = "overlap";
-  apply_overrides(o, flags);
-  EXPECT_EQ(o.base.merging, "overlap");
-  EXPECT_EQ(o.robots, (std::vector<int>{9}));
-  EXPECT_EQ(o.base.steps, 50);
-  EXPECT_TRUE(std::isinf(o.base.communication.range_m));
-  EXPECT_EQ(o.maps, s.maps);
 }
 
 TEST(Sweep, SweepFileErrorsNameTheFileLineAndKey) {
@@ -150,10 +128,6 @@ TEST(Sweep, SweepFileErrorsNameTheFileLineAndKey) {
   expect_input_error([&] { load_sweep(dir.write("h.yaml", "maps: {office: 1}\n")); }, {"h.yaml:1", "maps", "expected a list"});
   expect_input_error([&] { load_sweep(dir.write("i.yaml", "localization: psychic\n")); }, {"i.yaml", "localization", "psychic"});
   expect_input_error([&] { load_sweep(dir.write("j.yaml", "merging: telepathy\n")); }, {"j.yaml:1", "merging", "telepathy"});
-  Sweep s;
-  SweepOverrides flags;
-  flags.merging = "telepathy";
-  expect_input_error([&] { apply_overrides(s, flags); }, {"--merging", "telepathy"});
 }
 
 TEST(Sweep, ReadySweepFiles) {
