@@ -112,21 +112,46 @@ void print_summary(const sim::RunResult& result, const std::string& label) {
   }
 }
 
+// A plan after the run (--plan-from/--plan-to): its endpoints are checked before the run starts.
+struct PlanRequest {
+  Eigen::Vector2d from, to;
+  std::string planner;
+  double time_s = 1.0;
+};
+
+std::optional<PlanRequest> plan_request(const ExploreFlags& f) {
+  if (f.plan_from.empty() != f.plan_to.empty()) throw InputError("--plan-from and --plan-to go together: give both");
+  if (f.plan_from.empty()) return std::nullopt;
+  planning::make_planner(f.planner);  // an unknown planner is refused before the run
+  const auto point = [](const std::string& flag, const std::string& text) {
+    const auto p = parse_pair(text);
+    if (!p) throw InputError(flag + " '" + text + "': expected x,y in metres, e.g. 2.5,4");
+    return Eigen::Vector2d(p->first, p->second);
+  };
+  return PlanRequest{point("--plan-from", f.plan_from), point("--plan-to", f.plan_to), f.planner, f.plan_time};
+}
+
+// Plans on the run's merged map and adds the path and its ends to `extra` (for merged.png).
+planning::PlanResult plan_on(const sim::RunResult& result, const PlanRequest& request, const sim::Scenario& s,
+                             viz::Overlays& extra) {
+  planning::PlanPathOptions o;
+  o.planner = request.planner;
+  o.space.robot_radius_m = s.robot.radius_m;
+  o.search.time_budget_s = request.time_s;
+  o.search.seed = s.seed;
+  const planning::PlanResult plan = planning::plan_path(result.merged, request.from, request.to, o);
+  if (plan.success()) {
+    extra.paths.push_back(
+        {plan.path, {20, 20, 20}, fmt::format("{} path on the merged map, {:.2f} m", plan.planner, plan.length_m), 3, false});
+  }
+  extra.poses.push_back({{request.from.x(), request.from.y(), 0.0}, s.robot.radius_m, {44, 160, 44}, "plan start"});
+  extra.poses.push_back({{request.to.x(), request.to.y(), 0.0}, s.robot.radius_m, {214, 39, 40}, "plan goal"});
+  return plan;
+}
+
 int run_explore(const ExploreFlags& f) {
   sim::Scenario s = scenario_from(f);
-  // A plan after the run: its endpoints are checked before the run starts.
-  std::optional<Eigen::Vector2d> plan_from, plan_to;
-  if (f.plan_from.empty() != f.plan_to.empty()) throw InputError("--plan-from and --plan-to go together: give both");
-  if (!f.plan_from.empty()) {
-    planning::make_planner(f.planner);  // an unknown planner is refused before the run
-    const auto point = [](const std::string& flag, const std::string& text) {
-      const auto p = parse_pair(text);
-      if (!p) throw InputError(flag + " '" + text + "': expected x,y in metres, e.g. 2.5,4");
-      return Eigen::Vector2d(p->first, p->second);
-    };
-    plan_from = point("--plan-from", f.plan_from);
-    plan_to = point("--plan-to", f.plan_to);
-  }
+  const std::optional<PlanRequest> request = plan_request(f);
 
   // Every output is checked before anything is read or run; nothing is written on bad input.
   const std::string label = maps::is_builtin_map(s.map) ? s.map : fs::path(s.map).stem().string();
@@ -134,7 +159,7 @@ int run_explore(const ExploreFlags& f) {
   std::vector<fs::path> inputs = maps::map_source_files(s.map);
   if (!f.scenario.empty()) inputs.push_back(f.scenario);
   std::vector<std::string> files = sim::run_output_files(s);
-  if (plan_from) files.push_back("path.json");
+  if (request) files.push_back("path.json");
   if (f.animate) files.push_back("run.mp4");
   io::OutputFolder folder(out, "explore", files, inputs, "--out " + out.string());
 
@@ -165,26 +190,12 @@ int run_explore(const ExploreFlags& f) {
   bar.finish();
 
   // The plan on the merged map, drawn on merged.png and written to path.json.
-  std::optional<planning::PlanResult> plan;
   viz::Overlays extra;
-  if (plan_from) {
-    planning::PlanPathOptions o;
-    o.planner = f.planner;
-    o.space.robot_radius_m = s.robot.radius_m;
-    o.search.time_budget_s = f.plan_time;
-    o.search.seed = s.seed;
-    plan = planning::plan_path(result.merged, *plan_from, *plan_to, o);
-    if (plan->success()) {
-      extra.paths.push_back(
-          {plan->path, {20, 20, 20}, fmt::format("{} path on the merged map, {:.2f} m", plan->planner, plan->length_m), 3, false});
-    }
-    extra.poses.push_back({{plan_from->x(), plan_from->y(), 0.0}, s.robot.radius_m, {44, 160, 44}, "plan start"});
-    extra.poses.push_back({{plan_to->x(), plan_to->y(), 0.0}, s.robot.radius_m, {214, 39, 40}, "plan goal"});
-  }
+  const std::optional<planning::PlanResult> plan = request ? std::optional(plan_on(result, *request, s, extra)) : std::nullopt;
   auto written = sim::write_run_outputs(result, label, out, extra);
   if (plan) {
     io::write_file_atomic(out / "path.json",
-                            plan_json(*plan, {label, *plan_from, *plan_to, s.robot.radius_m, "obstacle", f.plan_time, s.seed})
+                            plan_json(*plan, {label, request->from, request->to, s.robot.radius_m, "obstacle", f.plan_time, s.seed})
                                     .dump(2) +
                                 "\n");
     written.push_back(out / "path.json");

@@ -48,24 +48,10 @@ viz::RenderOptions render_options(const std::string& t) {
 
 }  // namespace
 
-json metrics_json(const RunResult& r, const std::string& map_label) {
-  const Scenario& s = r.scenario;
-  json j;
-  j["map"] = map_label;
-  j["robots"] = s.robot_count;
-  j["strategy"] = s.exploration.strategy;
-  j["localization"] = s.localization;
-  j["merging"] = s.merging;
-  j["communication_range_m"] = range_value(s.communication.range_m);
-  j["seed"] = s.seed;
-  j["step_limit"] = s.steps;
-  j["period_s"] = s.period_s;
-  j["steps"] = r.steps;
-  j["finished"] = r.finished;
-  j["coverage"] = r.coverage.empty() ? 0.0 : r.coverage.back();
-  j["steps_to_95"] = optional_int(r.steps_to_95);
-  j["steps_to_99"] = optional_int(r.steps_to_99);
-  const RunTotals totals = run_totals(r);
+namespace {
+
+// One entry per robot: start, distance, blocked moves, localization quality, localizer counters.
+json per_robot_json(const RunResult& r, const RunTotals& totals) {
   json per_robot = json::array();
   for (std::size_t i = 0; i < r.robots.size(); ++i) {
     const auto& t = r.robots[i];
@@ -86,15 +72,11 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
     for (const auto& [name, value] : t.localizer_counters) robot["localizer"][name] = value;
     per_robot.push_back(robot);
   }
-  j["distance_m"] = totals.distance_m;
-  j["position_rmse_m"] = totals.position_rmse_m;
-  j["blocked_moves"] = totals.blocked_moves;
-  j["redundancy"] = r.redundancy;
-  j["bytes_sent"] = r.bytes_sent;
-  j["meetings"] = r.meetings;
-  j["reachable_free_cells"] = r.reachable_free_cells;
-  j["landmarks"] = r.landmarks.size();
-  j["per_robot"] = per_robot;
+  return per_robot;
+}
+
+// Every attempt to bring a teammate's map into a robot's frame.
+json merges_json(const RunResult& r) {
   json merges = json::array();
   for (const auto& m : r.merges) {
     json e = {{"step", m.step}, {"receiver", m.receiver + 1}, {"sender", m.sender + 1}, {"method", m.method},
@@ -107,32 +89,72 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
     }
     merges.push_back(e);
   }
-  j["merges"] = merges;
+  return merges;
+}
+
+json exploration_json(const RunResult& r) {
+  return {{"assignment_rounds", r.exploration.assignment_rounds},
+          {"waves", r.exploration.waves},
+          {"targets_reached", r.exploration.targets_reached},
+          {"targets_given_up", r.exploration.targets_given_up},
+          {"given_up_stalled", r.exploration.given_up_stalled},
+          {"given_up_unreachable", r.exploration.given_up_unreachable},
+          {"unobservable_frontiers", r.exploration.unobservable},
+          {"paths_replanned", r.exploration.paths_replanned},
+          {"detours", r.exploration.detours},
+          {"yields", r.exploration.yields},
+          {"path_planner", r.scenario.path_planner},
+          {"planner_paths", r.exploration.provider_paths},
+          {"planner_fallbacks", r.exploration.provider_fallbacks}};
+}
+
+json timing_json(const RunResult& r) {
+  const auto& tm = r.timing;
+  return {{"total_s", tm.total},           {"motion_s", tm.motion},
+          {"sensing_s", tm.sensing},       {"localization_s", tm.localization},
+          {"mapping_s", tm.mapping},       {"communication_s", tm.communication},
+          {"exploration_s", tm.exploration}, {"metrics_s", tm.metrics},
+          {"per_step_ms", r.steps > 0 ? 1000.0 * tm.total / r.steps : 0.0}};
+}
+
+}  // namespace
+
+json metrics_json(const RunResult& r, const std::string& map_label) {
+  const Scenario& s = r.scenario;
+  json j;
+  j["map"] = map_label;
+  j["robots"] = s.robot_count;
+  j["strategy"] = s.exploration.strategy;
+  j["localization"] = s.localization;
+  j["merging"] = s.merging;
+  j["communication_range_m"] = range_value(s.communication.range_m);
+  j["seed"] = s.seed;
+  j["step_limit"] = s.steps;
+  j["period_s"] = s.period_s;
+  j["steps"] = r.steps;
+  j["finished"] = r.finished;
+  j["coverage"] = r.coverage.empty() ? 0.0 : r.coverage.back();
+  j["steps_to_95"] = optional_int(r.steps_to_95);
+  j["steps_to_99"] = optional_int(r.steps_to_99);
+  const RunTotals totals = run_totals(r);
+  j["distance_m"] = totals.distance_m;
+  j["position_rmse_m"] = totals.position_rmse_m;
+  j["blocked_moves"] = totals.blocked_moves;
+  j["redundancy"] = r.redundancy;
+  j["bytes_sent"] = r.bytes_sent;
+  j["meetings"] = r.meetings;
+  j["reachable_free_cells"] = r.reachable_free_cells;
+  j["landmarks"] = r.landmarks.size();
+  j["per_robot"] = per_robot_json(r, totals);
+  j["merges"] = merges_json(r);
   j["merges_made"] = totals.merges_made;
   j["merges_refused"] = totals.merges_refused;
   std::map<std::string, int> event_counts;
   for (const auto& e : r.events) ++event_counts[e.kind];
   j["events"] = event_counts;
-  j["exploration"] = {{"assignment_rounds", r.exploration.assignment_rounds},
-                      {"waves", r.exploration.waves},
-                      {"targets_reached", r.exploration.targets_reached},
-                      {"targets_given_up", r.exploration.targets_given_up},
-                      {"given_up_stalled", r.exploration.given_up_stalled},
-                      {"given_up_unreachable", r.exploration.given_up_unreachable},
-                      {"unobservable_frontiers", r.exploration.unobservable},
-                      {"paths_replanned", r.exploration.paths_replanned},
-                      {"detours", r.exploration.detours},
-                      {"yields", r.exploration.yields},
-                      {"path_planner", r.scenario.path_planner},
-                      {"planner_paths", r.exploration.provider_paths},
-                      {"planner_fallbacks", r.exploration.provider_fallbacks}};
+  j["exploration"] = exploration_json(r);
   j["coverage_curve"] = r.coverage;
-  const auto& tm = r.timing;
-  j["timing"] = {{"total_s", tm.total},           {"motion_s", tm.motion},
-                 {"sensing_s", tm.sensing},       {"localization_s", tm.localization},
-                 {"mapping_s", tm.mapping},       {"communication_s", tm.communication},
-                 {"exploration_s", tm.exploration}, {"metrics_s", tm.metrics},
-                 {"per_step_ms", r.steps > 0 ? 1000.0 * tm.total / r.steps : 0.0}};
+  j["timing"] = timing_json(r);
   return j;
 }
 

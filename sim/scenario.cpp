@@ -88,18 +88,10 @@ RobotDetectorOptions read_robot_detector(io::YamlMap det, const RobotDetectorOpt
   return d;
 }
 
-Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
-  const YAML::Node root = io::parse_yaml(text, source);
-  if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
-  io::YamlMap top(root, source);
-  Scenario s;
-  s.base_dir = base_dir;
-  s.map = top.text("map", s.map);
-  if (s.map.empty()) throw InputError(top.where("map") + ": expected a map name or file");
-  s.seed = top.seed("seed", 1);
-  s.steps = int(top.number("steps", s.steps, limits::kSteps));
-  s.period_s = top.number("period", s.period_s, limits::kPeriod);
+namespace {
 
+// The sections of a scenario file, each read into `s` (every key checked, errors name the key).
+void read_robots(io::YamlMap& top, Scenario& s) {
   // robots: a count (packed cluster), `random: N`, or `starts: [[x, y, heading_deg], ...]`.
   if (const auto r = top.node("robots"); r && r->IsScalar()) {
     s.robot_count = int(top.number("robots", 4, limits::kRobots));
@@ -131,33 +123,36 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     s.robot.max_turn_rate_rps = deg2rad(robots.number("max_turn_rate_deg", rad2deg(s.robot.max_turn_rate_rps), limits::kTurnRateDeg));
     robots.finish();
   }
+}
 
-  s.noise = read_motion_noise(top.map("noise"), s.noise);
-  {
-    auto sensors = top.map("sensors");
-    auto range = sensors.map("range");
-    s.range.beams = int(range.number("beams", s.range.beams, limits::kBeams));
-    for (double a : range.numbers("angles_deg")) s.range.angles_rad.push_back(deg2rad(a));
-    if (range.has("angles_deg") && s.range.angles_rad.empty()) throw InputError(range.where("angles_deg") + ": needs at least one angle");
-    s.range.max_range_m = range.number("max_range", s.range.max_range_m, limits::kSensorRange);
-    s.range.noise_m = range.number("noise", s.range.noise_m, limits::kNoiseMetres);
-    range.finish();
-    auto lm = sensors.map("landmarks");
-    s.landmark_sensor.max_range_m = lm.number("max_range", s.landmark_sensor.max_range_m, limits::kDetectorRange);
-    s.landmark_sensor.range_noise_m = lm.number("range_noise", s.landmark_sensor.range_noise_m, limits::kNoiseMetres);
-    s.landmark_sensor.bearing_noise_rad =
-        deg2rad(lm.number("bearing_noise_deg", rad2deg(s.landmark_sensor.bearing_noise_rad), limits::kAngleDeg));
-    s.landmark_sensor.report_ids = lm.boolean("report_ids", s.landmark_sensor.report_ids);
-    lm.finish();
-    s.detector = read_robot_detector(sensors.map("robots"), s.detector);
-    sensors.finish();
-  }
-  {
-    auto lm = top.map("landmarks");
-    for (const auto& row : number_rows(lm, "points", 2, 2, "[x, y]")) s.landmarks.emplace_back(row[0], row[1]);
-    s.landmarks_along_walls = lm.number("along_walls", 0.0, limits::kLandmarksPerMetre);
-    lm.finish();
-  }
+void read_sensors(io::YamlMap& top, Scenario& s) {
+  auto sensors = top.map("sensors");
+  auto range = sensors.map("range");
+  s.range.beams = int(range.number("beams", s.range.beams, limits::kBeams));
+  for (double a : range.numbers("angles_deg")) s.range.angles_rad.push_back(deg2rad(a));
+  if (range.has("angles_deg") && s.range.angles_rad.empty()) throw InputError(range.where("angles_deg") + ": needs at least one angle");
+  s.range.max_range_m = range.number("max_range", s.range.max_range_m, limits::kSensorRange);
+  s.range.noise_m = range.number("noise", s.range.noise_m, limits::kNoiseMetres);
+  range.finish();
+  auto lm = sensors.map("landmarks");
+  s.landmark_sensor.max_range_m = lm.number("max_range", s.landmark_sensor.max_range_m, limits::kDetectorRange);
+  s.landmark_sensor.range_noise_m = lm.number("range_noise", s.landmark_sensor.range_noise_m, limits::kNoiseMetres);
+  s.landmark_sensor.bearing_noise_rad =
+      deg2rad(lm.number("bearing_noise_deg", rad2deg(s.landmark_sensor.bearing_noise_rad), limits::kAngleDeg));
+  s.landmark_sensor.report_ids = lm.boolean("report_ids", s.landmark_sensor.report_ids);
+  lm.finish();
+  s.detector = read_robot_detector(sensors.map("robots"), s.detector);
+  sensors.finish();
+}
+
+void read_landmarks(io::YamlMap& top, Scenario& s) {
+  auto lm = top.map("landmarks");
+  for (const auto& row : number_rows(lm, "points", 2, 2, "[x, y]")) s.landmarks.emplace_back(row[0], row[1]);
+  s.landmarks_along_walls = lm.number("along_walls", 0.0, limits::kLandmarksPerMetre);
+  lm.finish();
+}
+
+void read_localization(io::YamlMap& top, Scenario& s) {
   if (const auto l = top.node("localization"); l && l->IsScalar()) {
     s.localization = top.text("localization", s.localization);
   } else {
@@ -179,30 +174,35 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     }
     loc.finish();
   }
-  {
-    auto comm = top.map("communication");
-    s.communication.range_m = comm.number("range", s.communication.range_m, limits::kCommRange);
-    s.communication.line_of_sight = comm.boolean("line_of_sight", s.communication.line_of_sight);
-    comm.finish();
-  }
-  {
-    auto ex = top.map("exploration");
-    auto& e = s.exploration;
-    e.strategy = ex.choice("strategy", e.strategy, exploration::strategy_names());
-    e.strategy_options.beta = ex.number("beta", e.strategy_options.beta, limits::kWeight);
-    e.strategy_options.directional_weight = ex.number("directional_weight", e.strategy_options.directional_weight, limits::kWeight);
-    e.wave.eight_connected = ex.boolean("eight_connected", e.wave.eight_connected);
-    e.wave.occupancy_weight = ex.number("occupancy_weight", e.wave.occupancy_weight, limits::kWeight);
-    e.stall_steps = int(ex.number("stall_steps", e.stall_steps, limits::kCount));
-    e.targets.piece_radius_m = ex.number("piece_radius", e.targets.piece_radius_m, limits::kLength);
-    e.targets.frontiers.min_region_cells = int(ex.number("min_frontier_cells", e.targets.frontiers.min_region_cells, limits::kCount));
-    e.traversability.safety_margin_m = ex.number("safety_margin", e.traversability.safety_margin_m, limits::kMargin);
-    e.planning_resolution_m = ex.number("planning_resolution", e.planning_resolution_m, limits::kMargin);
-    s.path_planner = ex.choice("path_planner", s.path_planner, path_planner_names());
-    s.planner_time_s = ex.number("planner_time", s.planner_time_s, limits::kPlannerTime);
-    s.planner_iterations = int(ex.number("planner_iterations", s.planner_iterations, limits::kPlannerIterations));
-    ex.finish();
-  }
+}
+
+void read_communication(io::YamlMap& top, Scenario& s) {
+  auto comm = top.map("communication");
+  s.communication.range_m = comm.number("range", s.communication.range_m, limits::kCommRange);
+  s.communication.line_of_sight = comm.boolean("line_of_sight", s.communication.line_of_sight);
+  comm.finish();
+}
+
+void read_exploration(io::YamlMap& top, Scenario& s) {
+  auto ex = top.map("exploration");
+  auto& e = s.exploration;
+  e.strategy = ex.choice("strategy", e.strategy, exploration::strategy_names());
+  e.strategy_options.beta = ex.number("beta", e.strategy_options.beta, limits::kWeight);
+  e.strategy_options.directional_weight = ex.number("directional_weight", e.strategy_options.directional_weight, limits::kWeight);
+  e.wave.eight_connected = ex.boolean("eight_connected", e.wave.eight_connected);
+  e.wave.occupancy_weight = ex.number("occupancy_weight", e.wave.occupancy_weight, limits::kWeight);
+  e.stall_steps = int(ex.number("stall_steps", e.stall_steps, limits::kCount));
+  e.targets.piece_radius_m = ex.number("piece_radius", e.targets.piece_radius_m, limits::kLength);
+  e.targets.frontiers.min_region_cells = int(ex.number("min_frontier_cells", e.targets.frontiers.min_region_cells, limits::kCount));
+  e.traversability.safety_margin_m = ex.number("safety_margin", e.traversability.safety_margin_m, limits::kMargin);
+  e.planning_resolution_m = ex.number("planning_resolution", e.planning_resolution_m, limits::kMargin);
+  s.path_planner = ex.choice("path_planner", s.path_planner, path_planner_names());
+  s.planner_time_s = ex.number("planner_time", s.planner_time_s, limits::kPlannerTime);
+  s.planner_iterations = int(ex.number("planner_iterations", s.planner_iterations, limits::kPlannerIterations));
+  ex.finish();
+}
+
+void read_merging(io::YamlMap& top, Scenario& s) {
   if (const auto m = top.node("merging"); m && m->IsScalar()) {
     s.merging = top.choice("merging", s.merging, merging_names());
   } else {
@@ -213,6 +213,29 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     s.merge_attempt_every = int(merge.number("attempt_every", s.merge_attempt_every, limits::kCount));
     merge.finish();
   }
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
+  const YAML::Node root = io::parse_yaml(text, source);
+  if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
+  io::YamlMap top(root, source);
+  Scenario s;
+  s.base_dir = base_dir;
+  s.map = top.text("map", s.map);
+  if (s.map.empty()) throw InputError(top.where("map") + ": expected a map name or file");
+  s.seed = top.seed("seed", 1);
+  s.steps = int(top.number("steps", s.steps, limits::kSteps));
+  s.period_s = top.number("period", s.period_s, limits::kPeriod);
+  read_robots(top, s);
+  s.noise = read_motion_noise(top.map("noise"), s.noise);
+  read_sensors(top, s);
+  read_landmarks(top, s);
+  read_localization(top, s);
+  read_communication(top, s);
+  read_exploration(top, s);
+  read_merging(top, s);
   s.lookahead_m = top.number("lookahead", s.lookahead_m, limits::kLookahead);
   top.finish();
   validate_scenario(s);

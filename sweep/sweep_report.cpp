@@ -308,95 +308,95 @@ std::string comparison_text(const StrategyComparison& c) {
   return t;
 }
 
-std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records) {
-  std::vector<SweepPlot> plots;
-  if (records.empty()) return plots;
-  const auto maps = maps_of(records);
-  const auto strategies = strategies_of(records);
-  const auto teams = teams_of(records);
-  const auto groups = summarize_groups(records);
-  const std::size_t steps99 = metric_index("steps_to_99");
+namespace {
 
-  for (const auto& map : maps) {
-    // Coverage against step: one panel per team size.
-    std::vector<cv::Mat> panels;
-    for (int team : teams) {
-      std::vector<const RunRecord*> runs;
-      int last = 1;
-      for (const auto& r : records) {
-        if (r.key.map != map || r.key.robots != team) continue;
-        runs.push_back(&r);
-        last = std::max(last, r.steps_to_99 ? *r.steps_to_99 : r.steps);
-      }
-      if (runs.empty()) continue;
-      last = int(std::ceil(last * 1.05));
-      viz::LinePlot plot;
-      plot.title = map + ", " + team_text(team);
-      plot.x = {"step", 0.0, double(last), {}};
-      plot.y = {"coverage of the reachable free space (%)", 0.0, 100.0, {}};
-      for (const auto& strategy : strategies) {
-        std::vector<const RunRecord*> mine;
-        for (const auto* r : runs) {
-          if (r->key.strategy == strategy) mine.push_back(r);
-        }
-        if (mine.empty()) continue;
-        viz::PlotSeries s;
-        s.label = strategy;
-        s.color = strategy_color(strategies, strategy);
-        for (int step = 0; step <= last; ++step) {
-          std::vector<double> v;
-          for (const auto* r : mine) v.push_back(100.0 * coverage_at(*r, step));
-          const SampleSummary sum = summarize(v);
-          s.x.push_back(step);
-          s.y.push_back(sum.mean);
-          s.y_low.push_back(sum.n > 1 ? sum.ci_low : sum.mean);
-          s.y_high.push_back(sum.n > 1 ? sum.ci_high : sum.mean);
-        }
-        plot.series.push_back(std::move(s));
-      }
-      panels.push_back(viz::draw_line_plot(plot, {760, 500}));
+// Coverage against step on `map`: a panel per team size, a curve per strategy with its 95% band.
+cv::Mat coverage_plot(const std::vector<RunRecord>& records, const std::string& map, const std::vector<int>& teams,
+                      const std::vector<std::string>& strategies) {
+  std::vector<cv::Mat> panels;
+  for (int team : teams) {
+    std::vector<const RunRecord*> runs;
+    int last = 1;
+    for (const auto& r : records) {
+      if (r.key.map != map || r.key.robots != team) continue;
+      runs.push_back(&r);
+      last = std::max(last, r.steps_to_99 ? *r.steps_to_99 : r.steps);
     }
-    plots.push_back({"coverage_" + map + ".png", viz::tile_images(panels, 2)});
-
-    // Steps to 99% against team size, with the lower bound.
-    viz::LinePlot time;
-    time.title = map + ": steps to 99% coverage (mean, 95% CI)";
-    time.x = {"robots", std::nullopt, std::nullopt, {}};
-    for (int team : teams) time.x.ticks.push_back(team);
-    time.y = {"steps", 0.0, std::nullopt, {}};
-    time.bands = false;
+    if (runs.empty()) continue;
+    last = int(std::ceil(last * 1.05));
+    viz::LinePlot plot;
+    plot.title = map + ", " + team_text(team);
+    plot.x = {"step", 0.0, double(last), {}};
+    plot.y = {"coverage of the reachable free space (%)", 0.0, 100.0, {}};
     for (const auto& strategy : strategies) {
+      std::vector<const RunRecord*> mine;
+      for (const auto* r : runs) {
+        if (r->key.strategy == strategy) mine.push_back(r);
+      }
+      if (mine.empty()) continue;
       viz::PlotSeries s;
       s.label = strategy;
       s.color = strategy_color(strategies, strategy);
-      s.markers = true;
-      for (const auto& g : groups) {
-        if (g.map != map || g.strategy != strategy || g.metrics[steps99].n == 0) continue;
-        const SampleSummary& m = g.metrics[steps99];
-        s.x.push_back(g.robots);
-        s.y.push_back(m.mean);
-        s.y_low.push_back(m.n > 1 ? m.ci_low : m.mean);
-        s.y_high.push_back(m.n > 1 ? m.ci_high : m.mean);
+      for (int step = 0; step <= last; ++step) {
+        std::vector<double> v;
+        for (const auto* r : mine) v.push_back(100.0 * coverage_at(*r, step));
+        const SampleSummary sum = summarize(v);
+        s.x.push_back(step);
+        s.y.push_back(sum.mean);
+        s.y_low.push_back(sum.n > 1 ? sum.ci_low : sum.mean);
+        s.y_high.push_back(sum.n > 1 ? sum.ci_high : sum.mean);
       }
-      if (!s.x.empty()) time.series.push_back(std::move(s));
+      plot.series.push_back(std::move(s));
     }
-    viz::PlotSeries bound;
-    bound.label = "lower bound";
-    bound.color = {90, 90, 90};
-    for (int team : teams) {
-      int lb = -1;
-      for (const auto& g : groups) {
-        if (g.map == map && g.robots == team) lb = std::max(lb, g.lower_bound_max);
-      }
-      if (lb < 0) continue;
-      bound.x.push_back(team);
-      bound.y.push_back(lb);
-    }
-    time.series.push_back(std::move(bound));
-    plots.push_back({"time_" + map + ".png", viz::draw_line_plot(time)});
+    panels.push_back(viz::draw_line_plot(plot, {760, 500}));
   }
+  return viz::tile_images(panels, 2);
+}
 
-  // Efficiency per strategy, on each map and on all maps.
+// Steps to 99% against team size on `map`, a line per strategy, with the lower bound.
+cv::Mat time_plot(const std::vector<GroupSummary>& groups, const std::string& map, const std::vector<int>& teams,
+                  const std::vector<std::string>& strategies) {
+  const std::size_t steps99 = metric_index("steps_to_99");
+  viz::LinePlot time;
+  time.title = map + ": steps to 99% coverage (mean, 95% CI)";
+  time.x = {"robots", std::nullopt, std::nullopt, {}};
+  for (int team : teams) time.x.ticks.push_back(team);
+  time.y = {"steps", 0.0, std::nullopt, {}};
+  time.bands = false;
+  for (const auto& strategy : strategies) {
+    viz::PlotSeries s;
+    s.label = strategy;
+    s.color = strategy_color(strategies, strategy);
+    s.markers = true;
+    for (const auto& g : groups) {
+      if (g.map != map || g.strategy != strategy || g.metrics[steps99].n == 0) continue;
+      const SampleSummary& m = g.metrics[steps99];
+      s.x.push_back(g.robots);
+      s.y.push_back(m.mean);
+      s.y_low.push_back(m.n > 1 ? m.ci_low : m.mean);
+      s.y_high.push_back(m.n > 1 ? m.ci_high : m.mean);
+    }
+    if (!s.x.empty()) time.series.push_back(std::move(s));
+  }
+  viz::PlotSeries bound;
+  bound.label = "lower bound";
+  bound.color = {90, 90, 90};
+  for (int team : teams) {
+    int lb = -1;
+    for (const auto& g : groups) {
+      if (g.map == map && g.robots == team) lb = std::max(lb, g.lower_bound_max);
+    }
+    if (lb < 0) continue;
+    bound.x.push_back(team);
+    bound.y.push_back(lb);
+  }
+  time.series.push_back(std::move(bound));
+  return viz::draw_line_plot(time);
+}
+
+// Efficiency per strategy, on each map and on all maps.
+cv::Mat efficiency_chart(const std::vector<RunRecord>& records, const std::vector<std::string>& maps,
+                         const std::vector<std::string>& strategies) {
   viz::BarChart bars;
   bars.title = "efficiency = lower bound / steps to 99% (mean over team sizes and seeds, 95% CI)";
   bars.y_label = "efficiency";
@@ -420,7 +420,23 @@ std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records) {
     bars.low.push_back(low);
     bars.high.push_back(high);
   }
-  plots.push_back({"efficiency.png", viz::draw_bar_chart(bars, {std::max(900, 160 * int(bars.groups.size()) + 300), 560})});
+  return viz::draw_bar_chart(bars, {std::max(900, 160 * int(bars.groups.size()) + 300), 560});
+}
+
+}  // namespace
+
+std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records) {
+  std::vector<SweepPlot> plots;
+  if (records.empty()) return plots;
+  const auto maps = maps_of(records);
+  const auto strategies = strategies_of(records);
+  const auto teams = teams_of(records);
+  const auto groups = summarize_groups(records);
+  for (const auto& map : maps) {
+    plots.push_back({"coverage_" + map + ".png", coverage_plot(records, map, teams, strategies)});
+    plots.push_back({"time_" + map + ".png", time_plot(groups, map, teams, strategies)});
+  }
+  plots.push_back({"efficiency.png", efficiency_chart(records, maps, strategies)});
   return plots;
 }
 

@@ -25,8 +25,8 @@ struct Query {
   Eigen::Vector2d start, goal;
 };
 
-const PlannerInfo& info_of(const std::string& name) {
-  const auto& infos = planner_infos();
+PlannerInfo info_of(const std::string& name) {
+  const std::vector<PlannerInfo> infos = planner_infos();
   return *std::find_if(infos.begin(), infos.end(), [&](const PlannerInfo& i) { return i.name == name; });
 }
 
