@@ -29,7 +29,8 @@ namespace {
 
 struct ExploreFlags {
   std::string scenario;
-  std::optional<std::string> map, strategy, localization, comm_range, path_planner, merging;
+  std::optional<std::string> map, strategy, localization, comm_range, path_planner, merging, starts;
+  std::optional<double> min_separation;
   std::string plan_from, plan_to, planner = "astar";
   double plan_time = 1.0;
   std::optional<int> robots, steps, beams;
@@ -52,6 +53,11 @@ sim::Scenario scenario_from(const ExploreFlags& f) {
     s.robot_count = *f.robots;
     if (s.placement == sim::Placement::List) s.placement = sim::Placement::Cluster, s.starts.clear();
   }
+  if (f.starts) {
+    s.placement = *f.starts == "random" ? sim::Placement::Random : sim::Placement::Cluster;
+    s.starts.clear();
+  }
+  if (f.min_separation) s.min_separation_m = *f.min_separation;
   if (f.strategy) s.exploration.strategy = *f.strategy;
   if (f.localization) s.localization = *f.localization;
   if (f.comm_range) s.communication.range_m = *core::parse_in_range(*f.comm_range, sim::limits::kCommRange);
@@ -253,8 +259,15 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--scenario", f->scenario, "Scenario YAML file (see scenarios/); flags below override it")
       ->check(CLI::ExistingFile);
   app->add_option("--map", f->map, "Built-in map name, image or map_server YAML [default: office]");
-  app->add_option("--robots", f->robots, "Number of robots, placed together near the map centre [default: 4]")
+  app->add_option("--robots", f->robots, "Number of robots, placed as --starts says [default: 4]")
       ->check(in_range(sim::limits::kRobots));
+  app->add_option("--starts", f->starts,
+                 "Where robots start: cluster (packed near the map centre) or random (anywhere reachable from the "
+                 "centre, --min-separation apart, random headings) [default: cluster]")
+      ->check(CLI::IsMember({"cluster", "random"}));
+  app->add_option("--min-separation", f->min_separation,
+                  "Least distance between robot centres at the start, metres [default: 0.6; try 4 with --starts random]")
+      ->check(in_range(sim::limits::kSeparation));
   app->add_option("--strategy", f->strategy, "Coordination strategy [default: directional]")
       ->check(CLI::IsMember(exploration::strategy_names()));
   app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]")

@@ -39,6 +39,7 @@ struct MergeCommandOptions {
   std::vector<std::string> maps;
   std::string method = "auto";
   std::string out = "merged.png";
+  std::string picture;
   std::string json;
   double min_confidence = 0.5;
   std::uint64_t seed = 1;
@@ -127,8 +128,21 @@ int run_merge(const MergeCommandOptions& o) {
     throw InputError("merge needs at least two maps, got one: " + o.maps.front());
   }
   merging::check_merge_method(o.method);
-  const std::vector<OutputFile> outputs = {{"--out", o.out}, {"--json", o.json}};
-  if (!o.out.empty()) io::check_picture_path(o.out, "--out");
+  // --out is the picture, or a map file when its name says so (then --picture may add the picture).
+  const bool out_is_map = !o.out.empty() && !io::is_standard_output(o.out) && io::is_map_file_name(o.out);
+  const std::string picture_path = out_is_map ? o.picture : o.out;
+  if (!o.picture.empty() && !out_is_map) {
+    throw InputError("--picture " + o.picture + ": --out " + o.out +
+                     " is already the picture; --picture goes with a map file as --out (.yaml or .pgm)");
+  }
+  std::vector<OutputFile> outputs = {{"--json", o.json}, {out_is_map ? "--picture" : "--out", picture_path}};
+  if (out_is_map) {
+    for (const auto& f : io::map_output_files(o.out)) outputs.push_back({"--out", f});
+  }
+  if (!out_is_map && !o.out.empty() && !io::is_standard_output(o.out) && fs::path(o.out).extension() != ".png") {
+    throw InputError("--out " + o.out + ": give a .png picture, a map file (.yaml with a .pgm beside it, or .pgm), or -");
+  }
+  if (!picture_path.empty()) io::check_picture_path(picture_path, out_is_map ? "--picture" : "--out");
   std::vector<fs::path> inputs;
   for (const auto& m : o.maps) {
     for (auto& f : maps::map_source_files(m)) inputs.push_back(std::move(f));
@@ -198,7 +212,8 @@ int run_merge(const MergeCommandOptions& o) {
   const merging::FusedMap fused = merging::fuse_merged(pointers, merged);
   j["conflict_cells"] = fused.conflict_cells;
   if (!o.json.empty()) write_output(o.json, j.dump(2) + "\n");
-  if (!o.out.empty()) write_picture(o.out, picture(fused, o.maps));
+  if (out_is_map) io::save_map(fused.grid, o.out);
+  if (!picture_path.empty()) write_picture(picture_path, picture(fused, o.maps));
   for (const auto& out : outputs) {
     if (!out.path.empty() && !io::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
   }
@@ -222,14 +237,20 @@ Command add_merge_command(CLI::App& root) {
                 "--json holds `transforms`: per input after the first, map, merged, tx, ty (pixels), theta_deg,\n"
                 "acceptance, confidence, method, via (the input it was aligned to); or merged: false and the reason.\n"
                 "The picture tints each input's cells in its own colour; red cells are free in one map, occupied in\n"
-                "another. Exit codes: 0 all merged, 1 some map not merged, 2 bad input.");
+                "another. A map file (--out merged.yaml) holds the fused map as map_server writes maps (0 occupied,\n"
+                "254 free, 205 unknown), with the first map's resolution and origin: `fleetmap plan --map merged.yaml`\n"
+                "plans on it in the first robot's metres. Exit codes: 0 all merged, 1 some map not merged, 2 bad input.");
   auto o = std::make_shared<MergeCommandOptions>();
   merge->add_option("maps", o->maps, "Two or more maps: PNG/PGM images or map_server YAML files (the first is the reference)")
       ->required();
   merge->add_option("--method", o->method, "Alignment method: auto, overlap or features (see below)")
       ->capture_default_str()
       ->check(CLI::IsMember(merging::merge_method_names()));
-  merge->add_option("--out,-o", o->out, "Merged map picture (PNG; - for the standard output)")->capture_default_str();
+  merge->add_option("--out,-o", o->out,
+                    "Merged map: a picture (.png; - for the standard output) or a map file in the first map's metres "
+                    "(.yaml for map_server with a .pgm beside it, or a bare .pgm) that plan and explore read")
+      ->capture_default_str();
+  merge->add_option("--picture", o->picture, "With a map file as --out: also write the picture here (PNG)");
   merge->add_option("--json", o->json, "Write the transforms and confidences to this JSON; - for the standard output (default: none)");
   merge->add_option("--min-confidence", o->min_confidence, "Refuse merges below this confidence")
       ->capture_default_str()

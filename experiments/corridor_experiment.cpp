@@ -14,7 +14,7 @@
 #include "io/file_io.h"
 #include "io/yaml_reader.h"
 #include "localization/localizer.h"
-#include "mapping/distance_field.h"
+#include "mapping/map_quality.h"
 #include "mapping/range_scan.h"
 #include "merging/fusion.h"
 #include "merging/rendezvous.h"
@@ -366,10 +366,6 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
                                                   merge_rng.normal(0.0, detector.bearing_noise_rad));
   // The truth: the other's frame in the world is its start pose.
   const core::Transform2 true_other_to_master = other_start.as_transform();
-  // Distance to the nearest true wall, per world cell, for scoring.
-  std::vector<std::uint8_t> walls(std::size_t(g.cell_count()));
-  for (int i = 0; i < g.cell_count(); ++i) walls[std::size_t(i)] = result.truth.state_at(i) == mapping::CellState::Occupied;
-  const std::vector<float> wall_distance = mapping::distance_to_blocked(g.width(), g.height(), walls, false);
   result.master_map = master_run.maps.front();
   result.other_map = other_run.maps.front();
   const mapping::OccupancyGrid& master_map = result.master_map;
@@ -385,20 +381,11 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
     m.merged = master_map;
     merging::fuse_into(m.merged, other_map, merging::cells_from_world(master_map.geometry(), other_map.geometry(), t));
     // The other's walls, placed by t, against the true walls.
-    double sum = 0.0;
-    int count = 0, misplaced = 0;
-    for (int y = 0; y < other_map.height(); ++y) {
-      for (int x = 0; x < other_map.width(); ++x) {
-        if (other_map.state_at(other_map.geometry().index({x, y})) != mapping::CellState::Occupied) continue;
-        const auto cell = g.world_to_cell(t.apply(other_map.geometry().cell_center({x, y})));
-        const double dist = cell ? wall_distance[std::size_t(g.index(*cell))] * o.resolution_m : 5.0;
-        sum += dist;
-        misplaced += dist > 0.3;
-        ++count;
-      }
-    }
-    m.mean_wall_distance_m = count ? sum / count : 0.0;
-    m.misplaced_wall_share = count ? double(misplaced) / count : 0.0;
+    mapping::MapQualityOptions quality;
+    quality.wall_tolerance_m = 0.3;
+    const mapping::MapQuality q = mapping::map_quality(other_map, result.truth, t, quality);
+    m.mean_wall_distance_m = q.mean_wall_distance_m;
+    m.misplaced_wall_share = q.misplaced_wall_share;
     result.merges.push_back(std::move(m));
     if (progress) progress(++done, total_work);
   }

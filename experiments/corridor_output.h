@@ -1,5 +1,5 @@
 #pragma once
-// The corridor experiment's outputs (sim/corridor_experiment.h): the seed's Table I as CSV and
+// The corridor experiment's outputs (experiments/corridor_experiment.h): León et al.'s Table I as CSV and
 // Markdown, the maps over the true walls as PNG, the merging-by-detection study as CSV, Markdown
 // and PNG, and every number in corridor.json. Files are written atomically.
 #include <filesystem>

@@ -410,9 +410,40 @@ void write_image(const fs::path& path, const cv::Mat& image) {
 
 void save_map_image(const mapping::OccupancyGrid& grid, const fs::path& path) { write_image(path, grid_to_image(grid)); }
 
-void save_map_yaml(const mapping::OccupancyGrid& grid, const fs::path& yaml_path) {
+namespace {
+
+bool is_yaml_name(const fs::path& path) {
+  const std::string ext = path.extension().string();
+  return ext == ".yaml" || ext == ".yml";
+}
+
+fs::path image_beside(const fs::path& yaml_path) {
   fs::path image_name = yaml_path.stem();
   image_name += ".pgm";
+  return image_name;
+}
+
+}  // namespace
+
+bool is_map_file_name(const fs::path& path) { return is_yaml_name(path) || path.extension() == ".pgm"; }
+
+std::vector<fs::path> map_output_files(const fs::path& path) {
+  if (!is_yaml_name(path)) return {path};
+  return {path, path.parent_path() / image_beside(path)};
+}
+
+void save_map(const mapping::OccupancyGrid& grid, const fs::path& path) {
+  if (is_yaml_name(path)) {
+    save_map_yaml(grid, path);
+  } else if (path.extension() == ".pgm") {
+    save_map_image(grid, path);
+  } else {
+    throw InputError(path.string() + ": maps are written as map_server YAML (.yaml, with a .pgm beside it) or .pgm");
+  }
+}
+
+void save_map_yaml(const mapping::OccupancyGrid& grid, const fs::path& yaml_path) {
+  const fs::path image_name = image_beside(yaml_path);
   save_map_image(grid, yaml_path.parent_path() / image_name);
   MapYaml meta;
   meta.image = image_name;

@@ -79,4 +79,12 @@ void save_map_image(const mapping::OccupancyGrid& grid, const std::filesystem::p
 // Saves `<yaml_path stem>.pgm` beside the YAML and the YAML that map_server loads back.
 void save_map_yaml(const mapping::OccupancyGrid& grid, const std::filesystem::path& yaml_path);
 
+// A map file an output path names: a map_server map (.yaml / .yml, with `<stem>.pgm` beside it) or
+// a bare map image (.pgm, map_saver's 0 / 254 / 205). Other names are not map files.
+bool is_map_file_name(const std::filesystem::path& path);
+// The files save_map(grid, path) writes: the YAML and its image, or the image alone.
+std::vector<std::filesystem::path> map_output_files(const std::filesystem::path& path);
+// Saves the grid as the map file `path` names (see is_map_file_name); throws InputError otherwise.
+void save_map(const mapping::OccupancyGrid& grid, const std::filesystem::path& path);
+
 }  // namespace fleetmap::io

@@ -93,7 +93,7 @@ struct LandmarkMethodChoice {
   AlignmentMethod method = AlignmentMethod::None;
   int overlapping_landmarks = 0;    // candidate matches by signature
   std::optional<core::Transform2> transform;  // other's frame into self's
-  std::string message;              // the seed's report: "Map alignment using data association", ...
+  std::string message;              // the map-alignment paper's report: "Map alignment using data association", ...
   LandmarkAlignment ransac;         // when data association ran
 };
 

@@ -50,6 +50,14 @@ viz::RenderOptions render_options(const std::string& t) {
 
 namespace {
 
+json map_quality_json(const mapping::MapQuality& q) {
+  return {{"known_cells", q.known_cells},
+          {"wrong_cell_share", q.wrong_cell_share},
+          {"wall_cells", q.wall_cells},
+          {"mean_wall_distance_m", q.mean_wall_distance_m},
+          {"misplaced_wall_share", q.misplaced_wall_share}};
+}
+
 // One entry per robot: start, distance, blocked moves, localization quality, localizer counters.
 json per_robot_json(const RunResult& r, const RunTotals& totals) {
   json per_robot = json::array();
@@ -69,6 +77,7 @@ json per_robot_json(const RunResult& r, const RunTotals& totals) {
                   {"nees_band_95", {loc.nees_band.lower, loc.nees_band.upper}},
                   {"nees_inside_band", loc.nees_inside_band},
                   {"dalfonso_mu", loc.dalfonso_mu}};
+    if (i < r.robot_map_quality.size()) robot["map_quality"] = map_quality_json(r.robot_map_quality[i]);
     for (const auto& [name, value] : t.localizer_counters) robot["localizer"][name] = value;
     per_robot.push_back(robot);
   }
@@ -145,6 +154,7 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   j["meetings"] = r.meetings;
   j["reachable_free_cells"] = r.reachable_free_cells;
   j["landmarks"] = r.landmarks.size();
+  j["map_quality"] = map_quality_json(r.map_quality);
   j["per_robot"] = per_robot_json(r, totals);
   j["merges"] = merges_json(r);
   j["merges_made"] = totals.merges_made;
@@ -196,7 +206,9 @@ cv::Mat render_robot(const RunResult& r, int robot, const std::string& map_label
 std::vector<std::string> run_output_files(const Scenario& scenario) {
   std::vector<std::string> names = {"merged.png"};
   const int robots = scenario.placement == Placement::List ? int(scenario.starts.size()) : scenario.robot_count;
-  for (int i = 1; i <= robots; ++i) names.push_back("robot_" + std::to_string(i) + ".png");
+  for (int i = 1; i <= robots; ++i) {
+    for (const char* ext : {".png", ".pgm", ".yaml"}) names.push_back("robot_" + std::to_string(i) + ext);
+  }
   for (const char* n : {"metrics.json", "map.pgm", "map.yaml", "map.bt", "scenario.yaml"}) names.push_back(n);
   return names;
 }
@@ -212,6 +224,10 @@ std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& m
     const fs::path p = dir / ("robot_" + std::to_string(i + 1) + ".png");
     io::write_image(p, render_robot(r, int(i), map_label));
     add(p);
+    // The robot's own map as map_server files, in its own frame: what `fleetmap merge` takes.
+    const fs::path yaml = dir / ("robot_" + std::to_string(i + 1) + ".yaml");
+    io::save_map_yaml(r.robot_maps[i], yaml);
+    for (const auto& f : io::map_output_files(yaml)) add(f);
   }
   io::write_file_atomic(dir / "metrics.json", metrics_json(r, map_label).dump(2) + "\n");
   add(dir / "metrics.json");

@@ -539,6 +539,10 @@ RunResult Simulation::result() const {
   r.landmarks = world_.landmarks();
   r.merged = merged_;
   r.robot_maps = maps_;
+  r.map_quality = mapping::map_quality(merged_, world_.truth());
+  for (int i = 0; i < scenario_.robot_count; ++i) {
+    r.robot_map_quality.push_back(mapping::map_quality(maps_[std::size_t(i)], world_.truth(), r.robot_frames[std::size_t(i)]));
+  }
   r.exploration = explorer_.stats();
   r.timing = timing_;
   return r;

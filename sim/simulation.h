@@ -11,6 +11,8 @@
 #include "core/random.h"
 #include "exploration/team_explorer.h"
 #include "localization/localizer.h"
+#include "mapping/map_quality.h"
+#include "mapping/map_quality.h"
 #include "mapping/occupancy_grid.h"
 #include "sim/communication.h"
 #include "sim/scenario.h"
@@ -74,6 +76,9 @@ struct RunResult {
   std::vector<Eigen::Vector2d> landmarks;
   mapping::OccupancyGrid merged;     // every robot's readings at its estimated pose
   std::vector<mapping::OccupancyGrid> robot_maps;
+  // Against the ground truth: the merged map, and each robot's map placed by its true frame.
+  mapping::MapQuality map_quality;
+  std::vector<mapping::MapQuality> robot_map_quality;
   exploration::TeamExplorer::Stats exploration;
   Timings timing;
 };

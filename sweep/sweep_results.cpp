@@ -166,6 +166,9 @@ const std::vector<Column>& columns() {
       {"blocked_moves", [](R r) { return std::to_string(r.blocked_moves); },
        [](F f, W r) { r.blocked_moves = int(f.integer(0)); }},
       {"position_rmse_m", [](R r) { return fixed(r.position_rmse_m, 6); }, [](F f, W r) { r.position_rmse_m = f.number(); }},
+      {"wrong_cell_share", [](R r) { return fixed(r.wrong_cell_share, 6); }, [](F f, W r) { r.wrong_cell_share = f.number(); }},
+      {"mean_wall_distance_m", [](R r) { return fixed(r.mean_wall_distance_m, 6); },
+       [](F f, W r) { r.mean_wall_distance_m = f.number(); }},
       {"lower_bound_steps", [](R r) { return std::to_string(r.lower_bound_steps); },
        [](F f, W r) { r.lower_bound_steps = int(f.integer(0)); }},
       {"lower_bound_travel_steps", [](R r) { return std::to_string(r.lower_bound_travel_steps); },
@@ -223,6 +226,8 @@ RunRecord make_record(const sim::RunResult& result, const sim::World& world, con
   r.merges_made = totals.merges_made;
   r.blocked_moves = totals.blocked_moves;
   r.position_rmse_m = totals.position_rmse_m;
+  r.wrong_cell_share = result.map_quality.wrong_cell_share;
+  r.mean_wall_distance_m = result.map_quality.mean_wall_distance_m;
 
   std::vector<Eigen::Vector2d> starts;
   for (const auto& t : result.robots) starts.push_back(t.truth.front().position());

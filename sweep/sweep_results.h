@@ -47,7 +47,9 @@ struct RunRecord {
   int merges_made = 0;        // maps brought into a teammate's frame (rendezvous or overlap merging)
   int blocked_moves = 0;
   double position_rmse_m = 0.0;
-  // sim/metrics.h.
+  double wrong_cell_share = 0.0;      // the merged map against the truth (metrics.json map_quality)
+  double mean_wall_distance_m = 0.0;
+  // sweep/lower_bound.h.
   int lower_bound_steps = 0, lower_bound_travel_steps = 0, lower_bound_area_steps = 0;
   std::optional<double> efficiency;  // lower_bound_steps / steps_to_99
   // steps_to_percent[k - 1]: the first step with coverage >= k %, nullopt if never (the coverage curve).

@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "io/map_io.h"
 #include "tests/cli_run.h"
 
 namespace fleetmap::cli {
@@ -20,8 +21,8 @@ TEST(ExploreCommand, WritesEveryOutputAndSaysWhere) {
   TempDir dir;
   const auto r = run_fleetmap("explore --map empty --robots 2 --steps 40 --out run", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* f : {"merged.png", "robot_1.png", "robot_2.png", "metrics.json", "map.pgm", "map.yaml", "map.bt",
-                        "scenario.yaml"}) {
+  for (const char* f : {"merged.png", "robot_1.png", "robot_2.png", "robot_1.yaml", "robot_1.pgm", "robot_2.yaml",
+                        "robot_2.pgm", "metrics.json", "map.pgm", "map.yaml", "map.bt", "scenario.yaml"}) {
     EXPECT_TRUE(std::filesystem::exists(dir / "run" / f)) << f;
   }
   EXPECT_NE(r.out.find("merged map: run/merged.png"), std::string::npos) << r.out;
@@ -42,6 +43,31 @@ TEST(ExploreCommand, WritesEveryOutputAndSaysWhere) {
   // The map files are real maps: they load back.
   const auto back = run_fleetmap("maps show run/map.yaml --out back.png", dir);
   EXPECT_EQ(back.exit_code, 0) << back.err;
+  // Each robot's map too, with a known cell for every cell its picture shows known.
+  const auto robot = io::load_map(dir / "run" / "robot_1.yaml");
+  EXPECT_GT(robot.known_count(), 0);
+}
+
+TEST(ExploreCommand, RandomStartsSpreadTheTeamAndReplay) {
+  TempDir dir;
+  const auto r = run_fleetmap("explore --map office --robots 3 --starts random --min-separation 4 --steps 5 --out run", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto m = metrics(dir / "run");
+  ASSERT_EQ(m["per_robot"].size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      const auto& a = m["per_robot"][i]["start"];
+      const auto& b = m["per_robot"][j]["start"];
+      EXPECT_GE(std::hypot(a[0].get<double>() - b[0].get<double>(), a[1].get<double>() - b[1].get<double>()), 4.0);
+    }
+  }
+  EXPECT_NE(slurp(dir / "run" / "scenario.yaml").find("random: 3"), std::string::npos);
+  const auto again = run_fleetmap("explore --scenario run/scenario.yaml --out again", dir);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(metrics(dir / "again")["per_robot"], m["per_robot"]);
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --starts everywhere --steps 1", dir), "everywhere");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map office --robots 9 --starts random --min-separation 40 --steps 1", dir),
+                        "fit");
 }
 
 TEST(ExploreCommand, SameCommandSameNumbers) {

@@ -14,6 +14,9 @@
 #include "merging/rendezvous.h"
 #include "tests/cli_run.h"
 
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
 namespace fleetmap::cli {
 namespace {
 
@@ -105,6 +108,71 @@ TEST(MergeCommand, ReadsMapServerYaml) {
   const auto r = run_fleetmap("merge a.png b.yaml --json r.json --out m.png", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(slurp(dir / "r.json"))["transforms"][0]["map"], "b.yaml");
+}
+
+// Merge, then plan: a map file as --out is a map_server map in the first input's metres.
+TEST(MergeCommand, WritesAMapFileInTheFirstMapsMetresThatPlanReads) {
+  TempDir dir;
+  write_pair(dir, "a.png", "b.png", 7);
+  dir.write("a.yaml", "image: a.png\nresolution: 0.05\norigin: [1.0, 2.0, 0.0]\n");
+  const auto r = run_fleetmap("merge a.yaml b.png --out out/merged.yaml --picture out/merged.png", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  for (const char* f : {"merged.yaml", "merged.pgm", "merged.png"}) {
+    EXPECT_NE(r.out.find(std::string("wrote out/") + f), std::string::npos) << r.out;
+  }
+  const mapping::OccupancyGrid a = io::load_map(dir / "a.yaml");
+  const mapping::OccupancyGrid merged = io::load_map(dir / "out" / "merged.yaml");
+  EXPECT_DOUBLE_EQ(merged.resolution(), 0.05);
+  EXPECT_GT(merged.known_count(), a.known_count());
+  // Every cell of the reference keeps its place in metres (the fused map adds b's evidence, so a
+  // few cells may change state, not many).
+  std::int64_t same = 0, known = 0;
+  for (int y = 0; y < a.height(); ++y) {
+    for (int x = 0; x < a.width(); ++x) {
+      const auto state = a.state({x, y});
+      if (state == mapping::CellState::Unknown) continue;
+      const auto cell = merged.geometry().world_to_cell(a.geometry().cell_center({x, y}));
+      ASSERT_TRUE(cell.has_value());
+      ++known;
+      same += merged.state(*cell) == state;
+    }
+  }
+  EXPECT_GT(double(same) / double(known), 0.97);
+
+  // Plan between two points of the reference's free space, in its metres, on the merged map.
+  cv::Mat free(a.height(), a.width(), CV_8U);
+  for (int y = 0; y < a.height(); ++y) {
+    for (int x = 0; x < a.width(); ++x) free.at<uchar>(y, x) = a.state({x, y}) == mapping::CellState::Free ? 255 : 0;
+  }
+  cv::Mat clearance;
+  cv::distanceTransform(free, clearance, cv::DIST_L2, 3);
+  cv::Point widest;
+  cv::minMaxLoc(clearance, nullptr, nullptr, nullptr, &widest);
+  const Eigen::Vector2d from = a.geometry().cell_center({widest.x, widest.y});
+  const Eigen::Vector2d to = from + Eigen::Vector2d(0.2, 0.1);
+  const auto p = run_fleetmap(fmt::format("plan --map out/merged.yaml --from {},{} --to {},{} --planner astar --json "
+                                          "path.json",
+                                          from.x(), from.y(), to.x(), to.y()),
+                              dir);
+  ASSERT_EQ(p.exit_code, 0) << p.err << p.out;
+  const auto path = nlohmann::json::parse(slurp(dir / "path.json"));
+  EXPECT_TRUE(path["success"].get<bool>()) << path.dump();
+  EXPECT_NEAR(path["start"][0].get<double>(), from.x(), 1e-6);
+}
+
+TEST(MergeCommand, PictureAndMapFileNamesAreChecked) {
+  TempDir dir;
+  write_pair(dir, "a.png", "b.png", 7);
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge a.png b.png --out m.png --picture p.png", dir), "--picture p.png");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge a.png b.png --out m.txt", dir), "--out m.txt: give a .png picture");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge a.png b.png --out m.yaml --picture p.jpg", dir), "--picture p.jpg");
+  // The map's image beside the YAML may not be an input either.
+  io::save_map_image(io::load_map(dir / "a.png"), dir / "c.pgm");
+  const std::string before = slurp(dir / "c.pgm");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge c.pgm b.png --out c.yaml", dir), "c.pgm");
+  EXPECT_FALSE(std::filesystem::exists(dir / "c.yaml"));
+  EXPECT_EQ(slurp(dir / "c.pgm"), before);
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.png"));
 }
 
 TEST(MergeCommand, HelpStatesTheConventionAndEveryFlagWithItsDefault) {

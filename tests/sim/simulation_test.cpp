@@ -165,6 +165,10 @@ TEST(Simulation, EkfAgainstLandmarksBeatsOdometryAndIsConsistent) {
   s.localization = "ekf";
   const auto ekf = metrics_json(Simulation(s, grid).run(), "warehouse");
   EXPECT_LT(ekf["position_rmse_m"].get<double>(), 0.5 * odometry["position_rmse_m"].get<double>());
+  // A better pose makes a better map: fewer wrong cells and walls nearer the true ones.
+  EXPECT_LT(ekf["map_quality"]["wrong_cell_share"].get<double>(), odometry["map_quality"]["wrong_cell_share"].get<double>());
+  EXPECT_LT(ekf["map_quality"]["mean_wall_distance_m"].get<double>(),
+            odometry["map_quality"]["mean_wall_distance_m"].get<double>());
   for (const auto& robot : ekf["per_robot"]) {
     EXPECT_GT(robot["localizer"]["landmark_updates"].get<double>(), 100.0);
     // The simulator's noise is the filter's model: the run-average NEES lies in its 95% band
