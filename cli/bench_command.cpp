@@ -118,12 +118,11 @@ void check_same_sweep(const fs::path& out, const sweep::Sweep& sweep, const std:
     }
   }
   std::set<sweep::RunKey> ours;
-  for (const auto& r : runs) ours.insert({r.map, r.strategy, r.robots, r.seed});
+  for (const auto& r : runs) ours.insert(sweep::run_key(r));
   for (const auto& r : records) {
     if (ours.count(r.key)) continue;
     throw InputError(where + "holds a run that is not part of this sweep" + std::string(runs.size() < sweep::sweep_runs(sweep).size() ? " (shard)" : "") +
-                     " (" + r.key.map + ", " + r.key.strategy + ", " + std::to_string(r.key.robots) + " robots, seed " +
-                     std::to_string(r.key.seed) + "); resume only with the same sweep and shard, or choose another --out");
+                     " (" + sweep::run_key_text(r.key) + "); resume only with the same sweep and shard, or choose another --out");
   }
 }
 
@@ -179,8 +178,7 @@ int run_combine(const BenchFlags& f) {
     for (auto& r : table.records) {
       if (const auto it = seen.find(r.key); it != seen.end()) {
         if (sweep::record_without_wall_time(records[it->second.first]) != sweep::record_without_wall_time(r)) {
-          throw InputError("--combine: the run " + r.key.map + "/" + r.key.strategy + "/" + std::to_string(r.key.robots) +
-                           " robots/seed " + std::to_string(r.key.seed) + " differs between " + it->second.second.string() +
+          throw InputError("--combine: the run " + sweep::run_key_text(r.key) + " differs between " + it->second.second.string() +
                            " and " + path.string());
         }
         continue;
@@ -269,7 +267,7 @@ int run_bench(const BenchFlags& f) {
   }
   std::vector<sweep::SweepRun> todo;
   for (const auto& r : runs) {
-    if (!done.count({r.map, r.strategy, r.robots, r.seed})) todo.push_back(r);
+    if (!done.count(sweep::run_key(r))) todo.push_back(r);
   }
   folder.claim();
   write_sweep_files(out, sweep);
@@ -322,7 +320,7 @@ Command add_bench_command(CLI::App& root) {
   app->footer(
       "Runs every combination in parallel (--jobs), with a progress bar and ETA on stderr when it is a terminal,\n"
       "and writes into --out: results.csv (a row per run, appended whole and flushed), summary.csv and summary.md\n"
-      "(mean, standard deviation and 95% confidence interval per map x strategy x team size, best marked),\n"
+      "(mean, standard deviation and 95% confidence interval per map x strategy x team size (x --vary values), best marked),\n"
       "coverage_<map>.png, time_<map>.png, efficiency.png, and sweep.yaml. efficiency = lower bound / steps to 99% (README.md, \"Benchmarking\n"
       "strategies\"). Run it again with the same --out after an interruption and it finishes the sweep without\n"
       "redoing finished runs. The same flags give the same rows whatever --jobs (only wall_time_s differs).\n\n"
@@ -331,6 +329,8 @@ Command add_bench_command(CLI::App& root) {
       "  fleetmap bench --sweep scenarios/sweeps/wave_paper.yaml --shard 2/4 --out DIR/shard_2\n"
       "  fleetmap bench --combine DIR/shard_1 DIR/shard_2 DIR/shard_3 DIR/shard_4 --out DIR/all\n"
       "  fleetmap bench --compare coordinated uncoordinated DIR\n"
+      "  fleetmap bench --maps office --strategies coordinated --vary beams=45,360 --seeds 10 --out DIR\n"
+      "  fleetmap bench --compare beams=45 beams=360 DIR\n"
       "  bench/slurm/submit.sh 16 OUT --sweep scenarios/sweeps/wave_paper.yaml     (a Slurm job array)\n\n"
       "Strategies (--strategies):\n" +
       exploration::strategy_help());
@@ -360,6 +360,12 @@ Command add_bench_command(CLI::App& root) {
       ->check(in_range(sim::limits::kCommRange));
   app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]")
       ->check(in_range(sim::limits::kSensorRange));
+  app->add_option("--vary", s.vary,
+                  "A further sweep axis, SETTING=V1,V2,... (repeat for more): a scenario key such as "
+                  "sensors.range.beams or communication.range, or beams, sensor_range, comm_range, localization, merging, "
+                  "path_planner, steps, noise_position; e.g. --vary beams=90,360 --vary comm_range=5,inf")
+      ->expected(1)
+      ->take_all();
   app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")
       ->check(in_range(sweep::kJobsRange));
   app->add_option("--shard", f->shard, "Run only the K-th of N slices of the sweep, K/N (for clusters; see bench/slurm/)");
@@ -368,7 +374,8 @@ Command add_bench_command(CLI::App& root) {
                   "[default: out/bench]");
   app->add_option("--combine", f->combine, "Join the results of these output folders (shards) into --out")->expected(1, -1);
   app->add_option("--compare", f->compare,
-                  "A B DIR: paired comparison of strategies A and B on the runs in DIR (same maps, team sizes and seeds)")
+                  "A B DIR: paired comparison on the runs in DIR of strategies A and B, or of two values of one setting "
+                  "(robots=2 robots=4, beams=90 beams=360: any --vary axis); runs pair when all else is equal")
       ->expected(3);
   app->add_option("--metric", f->metric,
                   "Metric of --compare: steps_to_95, steps_to_99, distance_m, redundancy, bytes_sent, efficiency, coverage")

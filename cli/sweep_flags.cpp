@@ -31,6 +31,10 @@ void apply_sweep_flags(sweep::Sweep& sweep, const SweepFlags& f) {
   }
   if (f.comm_range) sweep.base.communication.range_m = sweep::parse_comm_range(*f.comm_range, "--comm-range");
   if (f.sensor_range) sweep.base.range.max_range_m = *f.sensor_range;
+  if (!f.vary.empty()) {
+    sweep.axes.clear();
+    for (const auto& text : f.vary) sweep.axes.push_back(sweep::parse_axis(text, "--vary " + text));
+  }
 }
 
 sweep::Shard parse_shard(const std::string& text) {

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <cctype>
 #include <set>
+#include <utility>
 
 #include <fmt/format.h>
 #include "core/error.h"
@@ -83,7 +85,150 @@ std::string number_text(double v) {
 }
 
 
+// Short names of common axes and the scenario keys they stand for.
+const std::vector<std::pair<std::string, std::string>>& axis_aliases() {
+  static const std::vector<std::pair<std::string, std::string>> kAliases = {
+      {"beams", "sensors.range.beams"},          {"sensor_range", "sensors.range.max_range"},
+      {"comm_range", "communication.range"},     {"localization", "localization.method"},
+      {"merging", "merging.mode"},               {"path_planner", "exploration.path_planner"},
+      {"steps", "steps"},                        {"noise_position", "noise.position"},
+  };
+  return kAliases;
+}
+
+// Sets the dotted `path` of a YAML mapping to a scalar, making the mappings on the way.
+void set_path(YAML::Node node, const std::vector<std::string>& parts, std::size_t at, const std::string& value,
+              const std::string& what) {
+  if (at + 1 == parts.size()) {
+    node[parts[at]] = value;
+    return;
+  }
+  YAML::Node child = node[parts[at]];
+  if (child.IsDefined() && !child.IsNull() && !child.IsMap()) {
+    throw InputError(what + ": '" + parts[at] + "' is a single setting, not a group of settings");
+  }
+  set_path(child, parts, at + 1, value, what);
+}
+
+// A scenario error about the generated text, without its meaningless line number.
+std::string without_place(const std::string& message, const std::string& source) {
+  if (message.rfind(source + ":", 0) != 0) return message;
+  std::size_t at = source.size() + 1;
+  while (at < message.size() && std::isdigit(static_cast<unsigned char>(message[at]))) ++at;
+  if (at < message.size() && message[at] == ':') ++at;
+  while (at < message.size() && message[at] == ' ') ++at;
+  return message.substr(at);
+}
+
+sim::Scenario with_values(const sim::Scenario& base, const std::vector<SweepAxis>& axes,
+                          const std::vector<std::string>& values) {
+  if (axes.empty()) return base;
+  const std::string what = variant_label(axes, values);
+  YAML::Node root = YAML::Load(sim::scenario_to_yaml(base));
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    std::vector<std::string> parts;
+    std::size_t start = 0;
+    for (std::size_t dot; (dot = axes[i].scenario_key.find('.', start)) != std::string::npos; start = dot + 1) {
+      parts.push_back(axes[i].scenario_key.substr(start, dot - start));
+    }
+    parts.push_back(axes[i].scenario_key.substr(start));
+    set_path(root, parts, 0, values[i], axes[i].name + "=" + values[i]);
+  }
+  YAML::Emitter out;
+  out << root;
+  const std::string source = "@sweep-axis@";
+  try {
+    sim::Scenario s = sim::parse_scenario(out.c_str(), source, base.base_dir);
+    s.map = base.map;
+    sim::validate_scenario(s);
+    return s;
+  } catch (const InputError& e) {
+    throw InputError("axis " + what + ": " + without_place(e.what(), source));
+  }
+}
+
 }  // namespace
+
+SweepAxis make_axis(const std::string& key, const std::vector<std::string>& values, const std::string& what) {
+  SweepAxis axis;
+  axis.name = trim(key);
+  axis.scenario_key = axis.name;
+  for (const auto& [alias, full] : axis_aliases()) {
+    if (alias == axis.name) axis.scenario_key = full;
+  }
+  const std::string& k = axis.scenario_key;
+  if (k.empty() || k.find_first_of(" =,\"'") != std::string::npos || k.front() == '.' || k.back() == '.' ||
+      k.find("..") != std::string::npos) {
+    throw InputError(what + ": '" + key + "' is not a setting; give a scenario key such as sensors.range.beams, or one of " +
+                     [] {
+                       std::string names;
+                       for (const auto& [alias, full] : axis_aliases()) names += (names.empty() ? "" : ", ") + alias;
+                       return names;
+                     }());
+  }
+  if (k == "map" || k == "seed" || k == "robots" || k.rfind("robots.", 0) == 0 || k == "exploration.strategy" ||
+      k == "strategy") {
+    throw InputError(what + ": '" + key + "' is an axis of every sweep already; use maps, robots, strategies or seeds");
+  }
+  if (values.empty()) throw InputError(what + ": '" + key + "' needs at least one value");
+  for (const auto& v : values) {
+    if (v.empty() || v.find_first_of(" \t,\"'=") != std::string::npos) {
+      throw InputError(what + ": value '" + v + "' of '" + key + "': values may not be empty or hold spaces, commas, quotes or =");
+    }
+  }
+  check_unique(values, what);
+  axis.values = values;
+  return axis;
+}
+
+SweepAxis parse_axis(const std::string& text, const std::string& what) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos) {
+    throw InputError(what + ": expected SETTING=VALUE,VALUE,... such as beams=90,360 or communication.range=5,inf, got '" +
+                     text + "'");
+  }
+  return make_axis(text.substr(0, eq), split_list(text.substr(eq + 1), what), what);
+}
+
+std::string variant_label(const std::vector<SweepAxis>& axes, const std::vector<std::string>& values) {
+  std::string label;
+  for (std::size_t i = 0; i < axes.size() && i < values.size(); ++i) {
+    label += (label.empty() ? "" : " ") + axes[i].name + "=" + values[i];
+  }
+  return label;
+}
+
+namespace {
+
+// The "name=value" items of a variant label.
+std::vector<std::string> variant_items(const std::string& variant) {
+  std::vector<std::string> items;
+  std::size_t start = 0;
+  while (start < variant.size()) {
+    const auto space = variant.find(' ', start);
+    items.push_back(variant.substr(start, space == std::string::npos ? std::string::npos : space - start));
+    if (space == std::string::npos) break;
+    start = space + 1;
+  }
+  return items;
+}
+
+}  // namespace
+
+std::optional<std::string> variant_value(const std::string& variant, const std::string& name) {
+  for (const auto& item : variant_items(variant)) {
+    if (item.rfind(name + "=", 0) == 0) return item.substr(name.size() + 1);
+  }
+  return std::nullopt;
+}
+
+std::string variant_without(const std::string& variant, const std::string& name) {
+  std::string out;
+  for (const auto& item : variant_items(variant)) {
+    if (item.rfind(name + "=", 0) != 0) out += (out.empty() ? "" : " ") + item;
+  }
+  return out;
+}
 
 void use_base(Sweep& sweep, sim::Scenario base) {
   if (base.placement == sim::Placement::List) base.placement = sim::Placement::Cluster, base.starts.clear();
@@ -177,6 +322,19 @@ Sweep parse_sweep(const std::string& text, const std::string& source, const fs::
     sweep.base.communication.range_m = parse_comm_range(c->Scalar(), top.where("comm_range"));
   }
   sweep.base.range.max_range_m = top.number("sensor_range", sweep.base.range.max_range_m, sim::limits::kSensorRange);
+  if (const auto vary = top.node("vary")) {
+    if (!vary->IsMap() || vary->size() == 0) {
+      throw InputError(top.where("vary") + ": expected settings with their values, such as {beams: [90, 360]}, got " +
+                       io::describe_node(*vary));
+    }
+    io::YamlMap axes(*vary, source, "vary");
+    for (const auto& item : *vary) {
+      const std::string key = item.first.Scalar();
+      const auto values = list_text(axes, key);
+      sweep.axes.push_back(make_axis(key, split_list(*values, axes.where(key)), axes.where(key)));
+    }
+    axes.finish();
+  }
   top.finish();
   try {
     validate_sweep(sweep);
@@ -222,6 +380,20 @@ void validate_sweep(const Sweep& sweep) {
   probe.robot_count = sweep.robots.front();
   probe.exploration.strategy = sweep.strategies.front();
   sim::validate_scenario(probe);
+  std::vector<std::string> keys;
+  for (const auto& axis : sweep.axes) keys.push_back(axis.scenario_key);
+  check_unique(keys, "vary");
+  // Every value of every axis makes a valid scenario (checked one axis at a time, the others at
+  // their first value), before any run starts.
+  std::vector<std::string> values;
+  for (const auto& axis : sweep.axes) values.push_back(axis.values.front());
+  for (std::size_t i = 0; i < sweep.axes.size(); ++i) {
+    std::vector<std::string> v = values;
+    for (const auto& value : sweep.axes[i].values) {
+      v[i] = value;
+      with_values(probe, sweep.axes, v);
+    }
+  }
 }
 
 std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file) {
@@ -240,16 +412,35 @@ std::string sweep_to_yaml(const Sweep& sweep, const std::string& scenario_file) 
   y += "merging: " + sweep.base.merging + "\n";
   y += "comm_range: " + number_text(sweep.base.communication.range_m) + "\n";
   y += "sensor_range: " + number_text(sweep.base.range.max_range_m) + "\n";
+  if (!sweep.axes.empty()) {
+    y += "vary:\n";
+    for (const auto& axis : sweep.axes) y += "  " + axis.name + ": [" + join(axis.values) + "]\n";
+  }
   return y;
 }
 
 std::vector<SweepRun> sweep_runs(const Sweep& sweep) {
+  // Every combination of the axes' values, the first axis slowest.
+  std::vector<std::vector<std::string>> variants = {{}};
+  for (const auto& axis : sweep.axes) {
+    std::vector<std::vector<std::string>> next;
+    for (const auto& v : variants) {
+      for (const auto& value : axis.values) {
+        next.push_back(v);
+        next.back().push_back(value);
+      }
+    }
+    variants = std::move(next);
+  }
   std::vector<SweepRun> runs;
   for (const auto& map : sweep.maps) {
     for (const auto& strategy : sweep.strategies) {
       for (int robots : sweep.robots) {
-        for (int k = 0; k < sweep.seeds; ++k) {
-          runs.push_back({runs.size(), map_label(map), map, strategy, robots, sweep.first_seed + std::uint64_t(k)});
+        for (const auto& values : variants) {
+          for (int k = 0; k < sweep.seeds; ++k) {
+            runs.push_back({runs.size(), map_label(map), map, strategy, robots, sweep.first_seed + std::uint64_t(k),
+                            values, variant_label(sweep.axes, values)});
+          }
         }
       }
     }
@@ -258,7 +449,8 @@ std::vector<SweepRun> sweep_runs(const Sweep& sweep) {
 }
 
 sim::Scenario run_scenario(const Sweep& sweep, const SweepRun& run) {
-  sim::Scenario s = sweep.base;
+  if (run.values.size() != sweep.axes.size()) throw Error("sweep: a run without a value for every axis");
+  sim::Scenario s = with_values(sweep.base, sweep.axes, run.values);
   s.map = run.map_source;
   s.base_dir.clear();
   s.exploration.strategy = run.strategy;

@@ -18,11 +18,21 @@ namespace fleetmap::sweep {
 inline constexpr core::Range kSeedCountRange{1, 1'000'000, true};
 inline constexpr core::Range kJobsRange{1, 1024, true};
 
+// A further axis of a sweep: one setting of the scenario and the values it takes. The key is a
+// scenario file's key, dotted ("sensors.range.beams", "communication.range"), or a short name
+// (beams, sensor_range, comm_range, localization, merging, path_planner, steps, noise_position).
+struct SweepAxis {
+  std::string name;                 // as given: results name the variant by it
+  std::string scenario_key;         // the dotted key in a scenario file
+  std::vector<std::string> values;  // as written in a scenario file
+};
+
 struct Sweep {
   // Built-in map names or map files (PNG/PGM/map_server YAML); a run's `map` is the label.
   std::vector<std::string> maps = {"empty", "unstructured", "office", "corridor"};
   std::vector<std::string> strategies = exploration::strategy_names();
   std::vector<int> robots = {1, 2, 4, 9};
+  std::vector<SweepAxis> axes;    // more axes: every combination of their values (first slowest)
   int seeds = 20;                 // seeds first_seed, first_seed + 1, ...
   std::uint64_t first_seed = 1;
   // Everything else: steps, sensors, localization, communication, ... Its map, strategy, robot
@@ -42,9 +52,15 @@ std::vector<int> parse_team_sizes(const std::string& text, const std::string& wh
 // Metres >= 0, or "inf".
 double parse_comm_range(const std::string& text, const std::string& what);
 
+// An axis from "key=v1,v2,..." (`what` names the input in errors). The key may not be one of the
+// sweep's own axes (map, seed, robots, strategy); values are distinct, without spaces or quotes.
+SweepAxis parse_axis(const std::string& text, const std::string& what);
+SweepAxis make_axis(const std::string& key, const std::vector<std::string>& values, const std::string& what);
+
 // Parses a sweep file. Keys: maps, strategies, robots, seeds, first_seed, scenario (a scenario file,
-// relative to the sweep file), steps, localization, merging, comm_range, sensor_range. Relative map
-// files are relative to `base_dir` (the sweep file's folder).
+// relative to the sweep file), steps, localization, merging, comm_range, sensor_range, and vary (a
+// mapping from setting to its list of values, each an axis). Relative map files are relative to
+// `base_dir` (the sweep file's folder).
 Sweep parse_sweep(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 Sweep load_sweep(const std::filesystem::path& path);
 // The base scenario of a sweep: listed starts become a cluster of each run's team size.
@@ -63,11 +79,21 @@ struct SweepRun {
   std::string strategy;
   int robots = 1;
   std::uint64_t seed = 1;
+  std::vector<std::string> values;  // one per axis of the sweep
+  std::string variant;              // "name=value name=value", empty without axes
 };
 
-// Every run, in the fixed order map, strategy, team size, seed (seed varies fastest).
+// "beams=90 comm_range=5": the variant label of one value per axis.
+std::string variant_label(const std::vector<SweepAxis>& axes, const std::vector<std::string>& values);
+// The value `name` takes in a variant label, or nullopt.
+std::optional<std::string> variant_value(const std::string& variant, const std::string& name);
+// The label without `name=...`.
+std::string variant_without(const std::string& variant, const std::string& name);
+
+// Every run, in the fixed order map, strategy, team size, axes, seed (seed varies fastest).
 std::vector<SweepRun> sweep_runs(const Sweep& sweep);
-// The scenario of one run: the base with map, strategy, robot count and seed replaced.
+// The scenario of one run: the base with each axis's setting, then map, strategy, robot count and
+// seed replaced. Throws InputError naming the axis and value when the scenario refuses a value.
 sim::Scenario run_scenario(const Sweep& sweep, const SweepRun& run);
 
 // K-th of N slices (1 <= K <= N): runs whose index % N == K - 1, so every shard gets a similar mix.

@@ -52,6 +52,10 @@ std::vector<std::string> maps_of(const std::vector<RunRecord>& r) {
 std::vector<std::string> strategies_of(const std::vector<RunRecord>& r) {
   return distinct<std::string>(r, [](const RunRecord& x) { return x.key.strategy; });
 }
+// Strategies, each with its variants of the sweep's further axes: the curves of the plots.
+std::vector<std::string> series_of(const std::vector<RunRecord>& r) {
+  return distinct<std::string>(r, [](const RunRecord& x) { return series_label(x.key); });
+}
 std::vector<int> teams_of(const std::vector<RunRecord>& r) {
   auto t = distinct<int>(r, [](const RunRecord& x) { return x.key.robots; });
   std::sort(t.begin(), t.end());
@@ -103,16 +107,17 @@ std::vector<GroupSummary> summarize_groups(const std::vector<RunRecord>& records
     std::vector<std::vector<double>> values;
   };
   std::vector<Group> groups;
-  std::map<std::tuple<std::string, std::string, int>, std::size_t> index;
+  std::map<std::tuple<std::string, std::string, std::string, int>, std::size_t> index;
   const auto& metrics = report_metrics();
   for (const auto& r : records) {
-    const auto key = std::make_tuple(r.key.map, r.key.strategy, r.key.robots);
+    const auto key = std::make_tuple(r.key.map, r.key.strategy, r.key.variant, r.key.robots);
     auto it = index.find(key);
     if (it == index.end()) {
       it = index.emplace(key, groups.size()).first;
       Group g;
       g.summary.map = r.key.map;
       g.summary.strategy = r.key.strategy;
+      g.summary.variant = r.key.variant;
       g.summary.robots = r.key.robots;
       g.summary.lower_bound_min = g.summary.lower_bound_max = r.lower_bound_steps;
       g.values.resize(metrics.size());
@@ -135,13 +140,13 @@ std::vector<GroupSummary> summarize_groups(const std::vector<RunRecord>& records
 }
 
 std::string summary_csv(const std::vector<GroupSummary>& groups) {
-  std::string text = "map,strategy,robots,runs,lower_bound_steps_min,lower_bound_steps_max";
+  std::string text = "map,strategy,variant,robots,runs,lower_bound_steps_min,lower_bound_steps_max";
   for (const auto& m : report_metrics()) {
     for (const char* part : {"_n", "_mean", "_sd", "_ci95_low", "_ci95_high"}) text += "," + m.name + part;
   }
   text += "\n";
   for (const auto& g : groups) {
-    text += g.map + "," + g.strategy + "," + std::to_string(g.robots) + "," + std::to_string(g.runs) + "," +
+    text += g.map + "," + g.strategy + "," + g.variant + "," + std::to_string(g.robots) + "," + std::to_string(g.runs) + "," +
             std::to_string(g.lower_bound_min) + "," + std::to_string(g.lower_bound_max);
     for (const auto& s : g.metrics) {
       text += "," + std::to_string(s.n) + "," + csv_number(s.mean) + "," + csv_number(s.sd) + "," + csv_number(s.ci_low) +
@@ -167,7 +172,9 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
       "localization {}, merging {}, communication range {}, sensor range {:g} m, step limit {} (settings {})",
       first.localization, first.merging, std::isinf(first.comm_range_m) ? "unlimited" : number(first.comm_range_m, 1) + " m",
       first.sensor_range_m, first.step_limit, first.settings);
-  md += std::to_string(records.size()) + " runs: maps " + join(maps) + "; strategies " + join(strategies) +
+  const auto variants = distinct<std::string>(records, [](const RunRecord& r) { return r.key.variant; });
+  const std::string varied = variants.size() > 1 || !variants.front().empty() ? "; variants " + join(variants) : "";
+  md += std::to_string(records.size()) + " runs: maps " + join(maps) + "; strategies " + join(strategies) + varied +
         "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) + (seeds.size() == 1 ? " seed. " : " seeds. ") + settings + ".\n\n";
   md += "Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
         "reached the level. **Bold**: the best strategy in the column for that map and team size (lowest; highest for "
@@ -206,7 +213,7 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
         }
       }
       for (const auto* g : rows) {
-        md += "| " + g->strategy + " | " + std::to_string(g->runs) + " |";
+        md += "| " + g->series() + " | " + std::to_string(g->runs) + " |";
         for (std::size_t m = 0; m < metrics.size(); ++m) {
           const SampleSummary& s = g->metrics[m];
           std::string cell = "—";
@@ -226,30 +233,85 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
   return md;
 }
 
-StrategyComparison compare_strategies(const std::vector<RunRecord>& records, const std::string& a, const std::string& b,
-                                      const std::string& metric_name) {
-  const ReportMetric& metric = find_report_metric(metric_name, "metric");
-  const auto strategies = strategies_of(records);
-  for (const auto& s : {a, b}) {
-    if (std::find(strategies.begin(), strategies.end(), s) == strategies.end()) {
-      throw InputError("no runs of strategy '" + s + "' in the results (strategies there: " +
-                       (strategies.empty() ? std::string("none") : join(strategies)) + ")");
-    }
+namespace {
+
+struct AxisValue {
+  std::string axis, value;
+};
+
+// "coordinated" is a strategy; "beams=90" a value of a setting.
+AxisValue compared_value(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos) return {"strategy", text};
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+std::optional<std::string> value_on(const RunRecord& r, const std::string& axis) {
+  if (axis == "strategy") return r.key.strategy;
+  if (axis == "robots") return std::to_string(r.key.robots);
+  if (axis == "map") return r.key.map;
+  return variant_value(r.key.variant, axis);
+}
+
+// The run's key without the compared setting: runs with equal partner keys pair.
+RunKey partner_key(const RunRecord& r, const std::string& axis) {
+  RunKey k = r.key;
+  if (axis == "strategy") k.strategy.clear();
+  else if (axis == "robots") k.robots = 0;
+  else if (axis == "map") k.map.clear();
+  else k.variant = variant_without(k.variant, axis);
+  return k;
+}
+
+std::string values_present(const std::vector<RunRecord>& records, const std::string& axis) {
+  std::vector<std::string> values;
+  for (const auto& r : records) {
+    const auto v = value_on(r, axis);
+    if (v && std::find(values.begin(), values.end(), *v) == values.end()) values.push_back(*v);
   }
-  if (a == b) throw InputError("give two different strategies, got '" + a + "' twice");
+  return values.empty() ? std::string("none") : join(values);
+}
+
+}  // namespace
+
+StrategyComparison compare_strategies(const std::vector<RunRecord>& records, const std::string& a_text,
+                                      const std::string& b_text, const std::string& metric_name) {
+  const ReportMetric& metric = find_report_metric(metric_name, "metric");
+  const AxisValue a = compared_value(a_text), b = compared_value(b_text);
+  if (a.axis != b.axis) {
+    throw InputError("compare two values of one setting, got '" + a_text + "' (" + a.axis + ") and '" + b_text + "' (" +
+                     b.axis + ")");
+  }
+  const std::string& axis = a.axis;
+  for (const auto& x : {a, b}) {
+    const bool present = std::any_of(records.begin(), records.end(), [&](const RunRecord& r) { return value_on(r, axis) == x.value; });
+    if (present) continue;
+    if (axis == "strategy") {
+      throw InputError("no runs of strategy '" + x.value + "' in the results (strategies there: " +
+                       values_present(records, axis) + ")");
+    }
+    throw InputError("no runs with " + axis + "=" + x.value + " in the results (" + axis + " there: " +
+                     values_present(records, axis) + "; settings to compare: strategy names, robots=N, map=NAME, or an "
+                     "axis the sweep varied)");
+  }
+  if (a.value == b.value) {
+    throw InputError(axis == "strategy" ? "give two different strategies, got '" + a.value + "' twice"
+                                        : "give two different values of " + axis + ", got '" + a.value + "' twice");
+  }
   StrategyComparison c;
-  c.a = a;
-  c.b = b;
+  c.axis = axis;
+  c.a = a_text;
+  c.b = b_text;
   c.metric = metric.name;
   c.higher_is_better = metric.higher_is_better;
-  // (map, robots, seed) -> values of a and b.
-  std::map<std::tuple<std::string, int, std::uint64_t>, std::pair<std::optional<double>, std::optional<double>>> pairs;
+  std::map<RunKey, std::pair<std::optional<double>, std::optional<double>>> pairs;
   int runs = 0;
   for (const auto& r : records) {
-    if (r.key.strategy != a && r.key.strategy != b) continue;
+    const auto v = value_on(r, axis);
+    if (v != a.value && v != b.value) continue;
     ++runs;
-    auto& p = pairs[{r.key.map, r.key.robots, r.key.seed}];
-    (r.key.strategy == a ? p.first : p.second) = metric.value(r);
+    auto& p = pairs[partner_key(r, axis)];
+    (v == a.value ? p.first : p.second) = metric.value(r);
   }
   struct Sample {
     std::vector<double> a, b;
@@ -261,21 +323,29 @@ StrategyComparison compare_strategies(const std::vector<RunRecord>& records, con
   for (const auto& [key, p] : pairs) {
     if (!p.first || !p.second) continue;
     paired += 2;
-    for (Sample* s : {&by_group[{std::get<0>(key), std::get<1>(key)}], &by_map[std::get<0>(key)], &all}) {
+    for (Sample* s : {&by_group[{key.map, key.robots}], &by_map[key.map], &all}) {
       s->a.push_back(*p.first);
       s->b.push_back(*p.second);
     }
   }
   c.unpaired = runs - paired;
-  for (const auto& map : maps_of(records)) {
-    for (int team : teams_of(records)) {
-      if (const auto it = by_group.find({map, team}); it != by_group.end()) {
-        c.rows.push_back({map, team, compare_paired(it->second.a, it->second.b)});
+  // Rows per map and team size, then per map, then over everything (a compared map or team size
+  // has no rows of its own).
+  const std::vector<std::string> maps = axis == "map" ? std::vector<std::string>{""} : maps_of(records);
+  const std::vector<int> teams = axis == "robots" ? std::vector<int>{0} : teams_of(records);
+  if (axis != "map" && axis != "robots") {
+    for (const auto& map : maps) {
+      for (int team : teams) {
+        if (const auto it = by_group.find({map, team}); it != by_group.end()) {
+          c.rows.push_back({map, team, compare_paired(it->second.a, it->second.b)});
+        }
       }
     }
   }
-  for (const auto& map : maps_of(records)) {
-    if (const auto it = by_map.find(map); it != by_map.end()) c.rows.push_back({map, 0, compare_paired(it->second.a, it->second.b)});
+  if (axis != "map") {
+    for (const auto& map : maps) {
+      if (const auto it = by_map.find(map); it != by_map.end()) c.rows.push_back({map, 0, compare_paired(it->second.a, it->second.b)});
+    }
   }
   c.rows.push_back({"all", 0, compare_paired(all.a, all.b)});
   return c;
@@ -284,7 +354,11 @@ StrategyComparison compare_strategies(const std::vector<RunRecord>& records, con
 std::string comparison_text(const StrategyComparison& c) {
   const ReportMetric& metric = find_report_metric(c.metric, "metric");
   const int d = std::max(metric.decimals, 2);
-  std::string t = "Paired comparison of " + c.metric + ": " + c.a + " - " + c.b + " over runs with the same map, team size and seed\n";
+  const std::string alike = c.axis == "strategy" ? "the same map, team size and seed"
+                            : c.axis == "robots" ? "the same map, strategy, seed and other settings"
+                            : c.axis == "map"    ? "the same strategy, team size, seed and other settings"
+                                                 : "the same map, strategy, team size, seed and other settings";
+  std::string t = "Paired comparison of " + c.metric + ": " + c.a + " - " + c.b + " over runs with " + alike + "\n";
   t += "(negative: " + c.a + "'s value is lower; " + (c.higher_is_better ? "higher" : "lower") +
        " is better. The interval is the 95% confidence interval of the mean difference, p the two-sided paired t test)\n\n";
   t += "| map | robots | pairs | mean difference | 95% CI | p | " + c.a + " better | " + c.b + " better | ties |\n";
@@ -303,7 +377,7 @@ std::string comparison_text(const StrategyComparison& c) {
   }
   if (c.unpaired > 0) {
     t += "\n" + std::to_string(c.unpaired) + " runs had no partner with a value of " + c.metric +
-         " (the other strategy's run is missing, or a level was never reached) and were left out.\n";
+         " (the partner run is missing, or a level was never reached) and were left out.\n";
   }
   return t;
 }
@@ -331,7 +405,7 @@ cv::Mat coverage_plot(const std::vector<RunRecord>& records, const std::string& 
     for (const auto& strategy : strategies) {
       std::vector<const RunRecord*> mine;
       for (const auto* r : runs) {
-        if (r->key.strategy == strategy) mine.push_back(r);
+        if (series_label(r->key) == strategy) mine.push_back(r);
       }
       if (mine.empty()) continue;
       viz::PlotSeries s;
@@ -369,7 +443,7 @@ cv::Mat time_plot(const std::vector<GroupSummary>& groups, const std::string& ma
     s.color = strategy_color(strategies, strategy);
     s.markers = true;
     for (const auto& g : groups) {
-      if (g.map != map || g.strategy != strategy || g.metrics[steps99].n == 0) continue;
+      if (g.map != map || g.series() != strategy || g.metrics[steps99].n == 0) continue;
       const SampleSummary& m = g.metrics[steps99];
       s.x.push_back(g.robots);
       s.y.push_back(m.mean);
@@ -409,7 +483,9 @@ cv::Mat efficiency_chart(const std::vector<RunRecord>& records, const std::vecto
     for (std::size_t g = 0; g < bars.groups.size(); ++g) {
       std::vector<double> v;
       for (const auto& r : records) {
-        if (r.key.strategy == strategy && (g == maps.size() || r.key.map == maps[g]) && r.efficiency) v.push_back(*r.efficiency);
+        if (series_label(r.key) == strategy && (g == maps.size() || r.key.map == maps[g]) && r.efficiency) {
+          v.push_back(*r.efficiency);
+        }
       }
       const SampleSummary s = summarize(v);
       mean.push_back(s.mean);
@@ -429,7 +505,7 @@ std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records) {
   std::vector<SweepPlot> plots;
   if (records.empty()) return plots;
   const auto maps = maps_of(records);
-  const auto strategies = strategies_of(records);
+  const auto strategies = series_of(records);
   const auto teams = teams_of(records);
   const auto groups = summarize_groups(records);
   for (const auto& map : maps) {

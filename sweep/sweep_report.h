@@ -32,13 +32,15 @@ const ReportMetric& find_report_metric(const std::string& name, const std::strin
 
 struct GroupSummary {
   std::string map, strategy;
+  std::string variant;  // the sweep's further axes, "" without
   int robots = 0;
+  std::string series() const { return variant.empty() ? strategy : strategy + " " + variant; }
   int runs = 0;
   std::vector<SampleSummary> metrics;  // in the order of report_metrics()
   int lower_bound_min = 0, lower_bound_max = 0;  // lower_bound_steps over the group's runs
 };
 
-// Groups in the order their first record appears (records in sweep order give the sweep's order).
+// Groups (map x strategy x variant x team size) in the order their first record appears (records in sweep order give the sweep's order).
 std::vector<GroupSummary> summarize_groups(const std::vector<RunRecord>& records);
 
 std::string summary_csv(const std::vector<GroupSummary>& groups);
@@ -51,14 +53,18 @@ struct PairedRow {
 };
 
 struct StrategyComparison {
-  std::string a, b, metric;
+  std::string axis;  // what differs between the paired runs: "strategy", "robots", "map" or an axis of the sweep
+  std::string a, b, metric;  // a and b: values of that axis
   bool higher_is_better = false;
   std::vector<PairedRow> rows;  // per map x team size, then per map, then overall
   int unpaired = 0;             // runs of a or b without a partner holding the metric
 };
 
-// Pairs runs of strategies a and b with the same map, team size and seed; differences are a - b.
-// Throws InputError when a strategy has no runs (naming the strategies present) or a == b.
+// Pairs runs that differ only in one setting and takes the differences a - b. `a` and `b` are two
+// strategies ("coordinated"), or two values of one setting written SETTING=VALUE: "robots=4",
+// "map=office", or an axis of the sweep ("beams=90", "comm_range=inf"). Runs pair when everything
+// else (map, strategy, team size, the other axes, seed) is equal. Throws InputError when a value has
+// no runs (naming the values present), the two name different settings, or a == b.
 StrategyComparison compare_strategies(const std::vector<RunRecord>& records, const std::string& a, const std::string& b,
                                       const std::string& metric);
 // A readable table of the comparison.

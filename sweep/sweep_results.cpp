@@ -146,6 +146,7 @@ const std::vector<Column>& columns() {
       {"strategy", [](R r) { return r.key.strategy; }, [](F f, W r) { r.key.strategy = f.text(); }},
       {"robots", [](R r) { return std::to_string(r.key.robots); }, [](F f, W r) { r.key.robots = int(f.integer(1)); }},
       {"seed", [](R r) { return std::to_string(r.key.seed); }, [](F f, W r) { r.key.seed = f.unsigned_integer(); }},
+      {"variant", [](R r) { return r.key.variant; }, [](F f, W r) { r.key.variant = f.text(); }},
       {"localization", [](R r) { return r.localization; }, [](F f, W r) { r.localization = f.text(); }},
       {"merging", [](R r) { return r.merging; }, [](F f, W r) { r.merging = f.text(); }},
       {"comm_range_m", [](R r) { return std::isinf(r.comm_range_m) ? std::string("inf") : fixed(r.comm_range_m, 3); },
@@ -202,12 +203,23 @@ std::string errno_text() { return std::strerror(errno); }
 
 }  // namespace
 
+std::string run_key_text(const RunKey& key) {
+  return fmt::format("{}, {}, {} robot{}, seed {}{}", key.map, key.strategy, key.robots, key.robots == 1 ? "" : "s", key.seed,
+                     key.variant.empty() ? "" : " (" + key.variant + ")");
+}
+
+std::string series_label(const RunKey& key) {
+  return key.variant.empty() ? key.strategy : key.strategy + " " + key.variant;
+}
+
+RunKey run_key(const SweepRun& run) { return {run.map, run.strategy, run.robots, run.seed, run.variant}; }
+
 RunRecord make_record(const sim::RunResult& result, const sim::World& world, const std::string& map_label,
-                      const std::string& settings, double wall_time_s) {
+                      const std::string& settings, double wall_time_s, const std::string& variant) {
   const sim::Scenario& s = result.scenario;
   const sim::RunTotals totals = sim::run_totals(result);
   RunRecord r;
-  r.key = {map_label, s.exploration.strategy, s.robot_count, s.seed};
+  r.key = {map_label, s.exploration.strategy, s.robot_count, s.seed, variant};
   r.localization = s.localization;
   r.merging = s.merging;
   r.comm_range_m = s.communication.range_m;
@@ -324,8 +336,7 @@ void check_settings(const std::vector<RunRecord>& records, const std::string& se
   for (std::size_t i = 0; i < records.size(); ++i) {
     const auto& r = records[i];
     if (r.settings == settings) continue;
-    throw InputError(path.string() + ": the run " + r.key.map + "/" + r.key.strategy + "/" + std::to_string(r.key.robots) +
-                     " robots/seed " + std::to_string(r.key.seed) + " is from a sweep with other settings (settings " +
+    throw InputError(path.string() + ": the run " + run_key_text(r.key) + " is from a sweep with other settings (settings " +
                      r.settings + ", this sweep " + settings + "; its localization " + r.localization + ", step limit " +
                      std::to_string(r.step_limit) + "): use another output folder, or the same settings");
   }
@@ -387,7 +398,7 @@ void ResultsAppender::append(const RunRecord& record) {
 
 void sort_records(std::vector<RunRecord>& records, const std::vector<SweepRun>& runs) {
   std::map<RunKey, std::size_t> order;
-  for (const auto& r : runs) order.emplace(RunKey{r.map, r.strategy, r.robots, r.seed}, r.index);
+  for (const auto& r : runs) order.emplace(run_key(r), r.index);
   const auto rank = [&](const RunRecord& r) {
     const auto it = order.find(r.key);
     return it == order.end() ? std::numeric_limits<std::size_t>::max() : it->second;

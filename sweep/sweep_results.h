@@ -20,8 +20,16 @@ struct RunKey {
   std::string map, strategy;
   int robots = 0;
   std::uint64_t seed = 0;
+  std::string variant;  // the sweep's further axes: "beams=90 comm_range=5" (sweep::variant_label)
   auto operator<=>(const RunKey&) const = default;
 };
+
+// The key of a run of a sweep.
+RunKey run_key(const SweepRun& run);
+// "office, coordinated, 2 robots, seed 3 (beams=90)": a run in messages.
+std::string run_key_text(const RunKey& key);
+// How reports name the runs of one strategy and variant: "coordinated", "coordinated beams=90".
+std::string series_label(const RunKey& key);
 
 // The number of coverage levels kept per run: the first step at each whole percent 1..100.
 inline constexpr int kCoverageLevels = 100;
@@ -59,7 +67,7 @@ struct RunRecord {
 
 // The record of a finished run; the lower bound is computed from the run's truth and starts.
 RunRecord make_record(const sim::RunResult& result, const sim::World& world, const std::string& map_label,
-                      const std::string& settings, double wall_time_s);
+                      const std::string& settings, double wall_time_s, const std::string& variant = "");
 // Coverage of a record after `step` (step function of steps_to_percent; the final coverage after the run).
 double coverage_at(const RunRecord& record, int step);
 

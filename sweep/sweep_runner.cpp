@@ -24,7 +24,7 @@ RunRecord run_one(const Sweep& sweep, const SweepRun& run, const mapping::Occupa
   const auto t0 = std::chrono::steady_clock::now();
   sim::Simulation simulation(run_scenario(sweep, run), truth);
   const sim::RunResult result = simulation.run();
-  RunRecord record = make_record(result, sim::World(truth, {}), run.map, settings_id(sweep.base), 0.0);
+  RunRecord record = make_record(result, sim::World(truth, {}), run.map, settings_id(sweep.base), 0.0, run.variant);
   record.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return record;
 }
@@ -34,7 +34,8 @@ void check_placements(const Sweep& sweep, const SweepMaps& maps) {
     const std::string label = map_label(source);
     const sim::World world(map_of(maps, label), {});
     for (int robots : sweep.robots) {
-      const SweepRun probe{0, label, source, sweep.strategies.front(), robots, sweep.first_seed};
+      SweepRun probe{0, label, source, sweep.strategies.front(), robots, sweep.first_seed};
+      for (const auto& axis : sweep.axes) probe.values.push_back(axis.values.front());
       const sim::Scenario s = run_scenario(sweep, probe);
       core::Random rng = core::Random(s.seed).fork(1);
       try {

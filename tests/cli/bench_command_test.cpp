@@ -311,6 +311,41 @@ TEST(BenchCommand, MergingModeReachesEveryRun) {
   EXPECT_NE(slurp(b / "m" / "summary.md").find("merging rendezvous"), std::string::npos);
 }
 
+// Any setting as a further axis: every combination runs, rows name their variant, the summary and
+// --compare use it, and resume recognises the runs.
+TEST(BenchCommand, VaryAnySettingAndCompareItsValues) {
+  BenchDir b;
+  const std::string sweep = "--maps hall.yaml --strategies uncoordinated --robots 1 --seeds 2 --steps 200 "
+                            "--vary beams=8,360 --vary sensor_range=2,4";
+  const auto r = b.bench(sweep + " --out v");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CsvTable t = read_csv(b / "v" / "results.csv");
+  ASSERT_EQ(t.rows.size(), 2u * 2u * 2u);
+  std::set<std::string> variants;
+  for (const auto& row : t.rows) variants.insert(row.at("variant"));
+  EXPECT_EQ(variants, (std::set<std::string>{"beams=8 sensor_range=2", "beams=8 sensor_range=4", "beams=360 sensor_range=2",
+                                             "beams=360 sensor_range=4"}));
+  for (const auto& row : t.rows) {
+    EXPECT_EQ(row.at("sensor_range_m"), row.at("variant").find("sensor_range=2") != std::string::npos ? "2.000" : "4.000");
+  }
+  EXPECT_NE(slurp(b / "v" / "summary.md").find("| uncoordinated beams=360 sensor_range=4 | 2 |"), std::string::npos);
+  EXPECT_NE(slurp(b / "v" / "sweep.yaml").find("vary:\n  beams: [8, 360]\n  sensor_range: [2, 4]\n"), std::string::npos);
+  // Resuming the very same sweep runs nothing again.
+  const auto again = b.bench(sweep + " --out v");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(count_lines(b / "v" / "results.csv"), 1 + 8);
+  const auto c = b.bench("--compare sensor_range=2 sensor_range=4 v --metric coverage");
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_NE(c.out.find("sensor_range=2 - sensor_range=4"), std::string::npos) << c.out;
+  EXPECT_NE(c.out.find("| all | all | 4 |"), std::string::npos) << c.out;
+  EXPECT_ONE_LINE_ERROR(b.bench("--compare beams=8 sensor_range=2 v"), "one setting");
+  EXPECT_ONE_LINE_ERROR(b.bench("--compare beams=9 beams=8 v"), "no runs with beams=9");
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml --vary beams --out x"), "--vary beams: expected SETTING=VALUE");
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml --vary beams=0 --out x"), "axis beams=0");
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml --vary robots=1,2 --out x"), "already");
+  EXPECT_FALSE(std::filesystem::exists(b / "x"));
+}
+
 TEST(BenchCommand, ReadySweepFilesRun) {
   // The seed-003 sweep file, cut down by flags to one short run per strategy on one map.
   BenchDir b;
@@ -349,7 +384,7 @@ TEST(BenchCommand, AResultsFolderIsResumedOnlyByTheVerySameSweep) {
   foreign.replace(foreign.find(",1,1,"), 5, ",1,9,");  // seed 9 is not in the sweep
   b.dir.write("out/results.csv", results + foreign + "\n");
   EXPECT_ONE_LINE_ERROR(b.bench("--maps x/r.png --seeds 2" + sweep + " --out out"),
-                        "holds a run that is not part of this sweep (r, uncoordinated, 1 robots, seed 9)");
+                        "holds a run that is not part of this sweep (r, uncoordinated, 1 robot, seed 9)");
   // A shard's folder is resumed by that shard only.
   ASSERT_EQ(b.bench("--maps x/r.png --seeds 2" + sweep + " --shard 1/2 --out s1").exit_code, 0);
   EXPECT_ONE_LINE_ERROR(b.bench("--maps x/r.png --seeds 2" + sweep + " --shard 2/2 --out s1"),

@@ -81,10 +81,10 @@ TEST(SweepReport, SummaryCsvHasARowPerGroup) {
   std::istringstream in(csv);
   std::string header, row;
   std::getline(in, header);
-  EXPECT_EQ(header.rfind("map,strategy,robots,runs,", 0), 0u);
+  EXPECT_EQ(header.rfind("map,strategy,variant,robots,runs,", 0), 0u);
   EXPECT_NE(header.find("steps_to_99_mean,steps_to_99_sd,steps_to_99_ci95_low,steps_to_99_ci95_high"), std::string::npos);
   std::getline(in, row);
-  EXPECT_EQ(row.rfind("office,fast,2,3,50,50,", 0), 0u) << row;
+  EXPECT_EQ(row.rfind("office,fast,,2,3,50,50,", 0), 0u) << row;
   EXPECT_NE(row.find(",3,102,1,"), std::string::npos) << row;  // steps_to_99: n, mean, sd
   int rows = 1;
   while (std::getline(in, row)) ++rows;
@@ -130,6 +130,42 @@ TEST(SweepReport, PairedComparisonOfTwoStrategies) {
   expect_input_error([&] { compare_strategies(records, "fast", "nowhere", "steps_to_99"); }, {"nowhere", "fast, slow"});
   expect_input_error([&] { compare_strategies(records, "fast", "fast", "steps_to_99"); }, {"two different"});
   expect_input_error([&] { compare_strategies(records, "fast", "slow", "speed"); }, {"metric: unknown metric", "'speed'", "steps_to_99"});
+}
+
+// Runs that differ in a setting of the sweep's further axes, or in team size, pair like strategies.
+TEST(SweepReport, PairedComparisonOverAnyAxis) {
+  std::vector<RunRecord> records;
+  for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+    for (int robots : {2, 4}) {
+      for (const char* strategy : {"fast", "slow"}) {
+        for (int beams : {90, 360}) {
+          RunRecord r = record("office", strategy, robots, seed, 400 / robots + (beams == 90 ? 30 : 0) + int(seed), 10.0);
+          r.key.variant = "beams=" + std::to_string(beams) + " comm_range=inf";
+          records.push_back(r);
+        }
+      }
+    }
+  }
+  const StrategyComparison beams = compare_strategies(records, "beams=90", "beams=360", "steps_to_99");
+  EXPECT_EQ(beams.axis, "beams");
+  EXPECT_EQ(beams.rows.back().comparison.difference.n, 4 * 2 * 2);
+  EXPECT_DOUBLE_EQ(beams.rows.back().comparison.difference.mean, 30.0);
+  EXPECT_EQ(beams.unpaired, 0);
+  const StrategyComparison teams = compare_strategies(records, "robots=2", "robots=4", "steps_to_99");
+  EXPECT_DOUBLE_EQ(teams.rows.back().comparison.difference.mean, 100.0);
+  for (const auto& row : teams.rows) EXPECT_EQ(row.robots, 0);  // no row per team size when teams are compared
+  EXPECT_NE(comparison_text(teams).find("same map, strategy, seed and other settings"), std::string::npos);
+  // Strategies still pair within one variant.
+  EXPECT_EQ(compare_strategies(records, "fast", "slow", "steps_to_99").rows.back().comparison.difference.n, 16);
+  expect_input_error([&] { compare_strategies(records, "beams=90", "robots=2", "steps_to_99"); }, {"one setting"});
+  expect_input_error([&] { compare_strategies(records, "beams=45", "beams=360", "steps_to_99"); },
+                     {"no runs with beams=45", "beams there: 90, 360"});
+  // Summary rows and plot curves are per strategy and variant.
+  const auto groups = summarize_groups(records);
+  EXPECT_EQ(groups.size(), 2u * 2u * 2u);
+  EXPECT_EQ(groups.front().series(), "fast beams=90 comm_range=inf");
+  EXPECT_NE(summary_markdown(records, groups).find("| slow beams=360 comm_range=inf | 4 |"), std::string::npos);
+  EXPECT_NE(summary_csv(groups).find("office,fast,beams=90 comm_range=inf,2,4,"), std::string::npos);
 }
 
 TEST(SweepReport, PlotsForEveryMapAndEfficiency) {

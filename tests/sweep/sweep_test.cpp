@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 #include "core/error.h"
@@ -196,6 +197,89 @@ TEST(Sweep, AMapNameTooLongForTheFileSystemIsJustAName) {
   const std::string name = "maps/" + std::string(5000, 'x') + ".png";
   const Sweep s = parse_sweep("maps: [\"" + name + "\"]\n", "long.yaml", "/nonexistent");
   EXPECT_NE(sweep_to_yaml(s, "").find(std::string(5000, 'x')), std::string::npos);
+}
+
+}  // namespace
+}  // namespace fleetmap::sweep
+
+namespace fleetmap::sweep {
+namespace {
+
+using fleetmap::testing::expect_input_error;
+using fleetmap::testing::TempDir;
+
+TEST(SweepAxes, AnyScenarioSettingIsAnAxisInEveryCombination) {
+  Sweep s;
+  s.maps = {"office"};
+  s.strategies = {"coordinated"};
+  s.robots = {2};
+  s.seeds = 2;
+  s.axes = {parse_axis("beams=45,360", "--vary"), parse_axis("communication.range=5,inf", "--vary")};
+  EXPECT_EQ(s.axes[0].scenario_key, "sensors.range.beams");
+  validate_sweep(s);
+  const auto runs = sweep_runs(s);
+  ASSERT_EQ(runs.size(), 2u * 2u * 2u);
+  // The first axis slowest, the seed fastest.
+  EXPECT_EQ(runs[0].variant, "beams=45 communication.range=5");
+  EXPECT_EQ(runs[1].variant, "beams=45 communication.range=5");
+  EXPECT_EQ(runs[2].variant, "beams=45 communication.range=inf");
+  EXPECT_EQ(runs[4].variant, "beams=360 communication.range=5");
+  const sim::Scenario a = run_scenario(s, runs[0]);
+  EXPECT_EQ(a.range.beams, 45);
+  EXPECT_DOUBLE_EQ(a.communication.range_m, 5.0);
+  EXPECT_EQ(a.exploration.strategy, "coordinated");
+  EXPECT_EQ(a.robot_count, 2);
+  const sim::Scenario b = run_scenario(s, runs[6]);
+  EXPECT_EQ(b.range.beams, 360);
+  EXPECT_TRUE(std::isinf(b.communication.range_m));
+  // Everything else is the base's.
+  EXPECT_EQ(b.steps, s.base.steps);
+  EXPECT_EQ(b.localization, s.base.localization);
+}
+
+TEST(SweepAxes, BadAxesAreRefusedBeforeAnyRun) {
+  Sweep s;
+  s.maps = {"office"};
+  expect_input_error([] { parse_axis("beams", "--vary beams"); }, {"--vary beams", "SETTING=VALUE"});
+  expect_input_error([] { parse_axis("robots=2,4", "--vary"); }, {"'robots' is an axis of every sweep already"});
+  expect_input_error([] { parse_axis("strategy=market", "--vary"); }, {"already"});
+  expect_input_error([] { parse_axis("beams=90,90", "--vary"); }, {"'90' is listed twice"});
+  expect_input_error([] { parse_axis("beams=90,", "--vary"); }, {"empty item"});
+  // A value the scenario refuses, or a key it does not know, names the axis and the key.
+  s.axes = {parse_axis("beams=90,0", "--vary")};
+  expect_input_error([&] { validate_sweep(s); }, {"axis beams=0", "sensors.range.beams", "1 to 100000"});
+  s.axes = {parse_axis("sensors.range.beam=90", "--vary")};
+  expect_input_error([&] { validate_sweep(s); }, {"axis sensors.range.beam=90", "beam"});
+  s.axes = {parse_axis("localization=odometry,magic", "--vary")};
+  expect_input_error([&] { validate_sweep(s); }, {"axis localization=magic", "magic"});
+  s.axes = {parse_axis("beams=90", "--vary"), parse_axis("sensors.range.beams=45", "--vary")};
+  expect_input_error([&] { validate_sweep(s); }, {"vary", "listed twice"});
+}
+
+TEST(SweepAxes, SweepFileVaryAndItsWrittenCopy) {
+  TempDir dir;
+  const Sweep s = load_sweep(dir.write("s.yaml",
+                                       "maps: [office]\nstrategies: [market]\nrobots: [3]\nseeds: 1\n"
+                                       "vary:\n  merging: [known, rendezvous]\n  noise_position: '0.01,0.05'\n"));
+  ASSERT_EQ(s.axes.size(), 2u);
+  EXPECT_EQ(s.axes[0].values, (std::vector<std::string>{"known", "rendezvous"}));
+  EXPECT_EQ(s.axes[1].scenario_key, "noise.position");
+  const Sweep back = load_sweep(dir.write("back.yaml", sweep_to_yaml(s, "")));
+  const auto a = sweep_runs(s), b = sweep_runs(back);
+  ASSERT_EQ(a.size(), 4u);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].variant, b[i].variant);
+  EXPECT_DOUBLE_EQ(run_scenario(s, a[3]).noise.position_m, 0.05);
+  EXPECT_EQ(run_scenario(s, a[3]).merging, "rendezvous");
+  expect_input_error([&] { load_sweep(dir.write("bad.yaml", "vary: [beams]\n")); }, {"bad.yaml:1", "vary"});
+  expect_input_error([&] { load_sweep(dir.write("bad2.yaml", "vary:\n  beams: {a: 1}\n")); }, {"bad2.yaml:2", "vary.beams"});
+}
+
+TEST(SweepAxes, VariantLabels) {
+  EXPECT_EQ(variant_value("beams=90 comm_range=inf", "comm_range"), "inf");
+  EXPECT_EQ(variant_value("beams=90 comm_range=inf", "beam"), std::nullopt);
+  EXPECT_EQ(variant_without("beams=90 comm_range=inf", "beams"), "comm_range=inf");
+  EXPECT_EQ(variant_without("beams=90", "beams"), "");
 }
 
 }  // namespace
