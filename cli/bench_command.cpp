@@ -20,6 +20,7 @@
 #include "cli/validators.h"
 #include "core/error.h"
 #include "io/file_io.h"
+#include "io/map_io.h"
 #include "exploration/strategy.h"
 #include "localization/localizer.h"
 #include "maps/builtin_maps.h"
@@ -246,7 +247,9 @@ int run_bench(const BenchFlags& f) {
   sweep::SweepMaps maps;
   for (const auto& source : sweep.maps) {
     try {
-      maps.emplace(sweep::map_label(source), maps::load_map_source(source));
+      io::MapLoadOptions load;
+      load.default_resolution = sweep.base.map_resolution_m;
+      maps.emplace(sweep::map_label(source), maps::load_map_source(source, load));
     } catch (const InputError& e) {
       throw InputError(std::string(f.sweep.maps || f.sweep_file.empty() ? "--maps" : f.sweep_file + ": maps") + ": " + e.what());
     }

@@ -15,8 +15,10 @@
 #include "exploration/strategy.h"
 #include "localization/localizer.h"
 #include "io/file_io.h"
+#include "io/map_io.h"
 #include "maps/builtin_maps.h"
 #include "planning/planner.h"
+#include "sim/run_metrics.h"
 #include "sim/run_output.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"
@@ -30,7 +32,7 @@ namespace {
 struct ExploreFlags {
   std::string scenario;
   std::optional<std::string> map, strategy, localization, comm_range, path_planner, merging, starts;
-  std::optional<double> min_separation;
+  std::optional<double> min_separation, resolution;
   std::string plan_from, plan_to, planner = "astar";
   double plan_time = 1.0;
   std::optional<int> robots, steps, beams;
@@ -49,6 +51,7 @@ sim::Scenario scenario_from(const ExploreFlags& f) {
   sim::Scenario s;
   if (!f.scenario.empty()) s = sim::load_scenario(f.scenario);
   if (f.map) s.map = *f.map, s.base_dir.clear();
+  if (f.resolution) s.map_resolution_m = *f.resolution;
   if (f.robots) {
     s.robot_count = *f.robots;
     if (s.placement == sim::Placement::List) s.placement = sim::Placement::Cluster, s.starts.clear();
@@ -86,19 +89,27 @@ void print_summary(const sim::RunResult& result, const std::string& label) {
   const auto& sc = result.scenario;
   double distance = 0.0;
   for (const auto& t : result.robots) distance += t.distance_m;
-  const auto step_text = [](const std::optional<int>& v) { return v ? "step " + std::to_string(*v) : std::string("never"); };
+  const auto level_text = [](const char* level, const std::optional<int>& v) {
+    return v ? fmt::format("{} at step {}", level, *v) : fmt::format("{} never reached", level);
+  };
   const std::string range = std::isinf(sc.communication.range_m) ? "unlimited"
                             : sc.communication.range_m == 0.0  ? "only at rendezvous"
                                                                : fmt::format("{} m", sc.communication.range_m);
   fmt::print("{}: {}, strategy {}, localization {}, communication {}, seed {}\n", label,
              counted(sc.placement == sim::Placement::List ? long(sc.starts.size()) : sc.robot_count, "robot"),
              sc.exploration.strategy, sc.localization, range, sc.seed);
-  fmt::print("explored {} of the reachable free space in {} ({}); 95% reached at {}, 99% at {}\n",
-             format_percent(result.coverage.back()), counted(result.steps, "step"),
-             result.finished ? "no reachable frontier left" : "step limit reached", step_text(result.steps_to_95),
-             step_text(result.steps_to_99));
+  fmt::print("explored {} of the reachable free space in {} ({}); {}, {}\n", format_percent(result.coverage.back()),
+             counted(result.steps, "step"), result.finished ? "no reachable frontier left" : "step limit reached",
+             level_text("95%", result.steps_to_95), level_text("99%", result.steps_to_99));
   fmt::print("travelled {:.1f} m in all, redundancy {:.2f}, {} bytes sent in {}, {:.2f} s\n", distance,
              result.redundancy, result.bytes_sent, counted(result.meetings, "meeting"), result.timing.total);
+  // How well the robots knew where they were, and what that did to the map.
+  const sim::RunTotals totals = sim::run_totals(result);
+  const auto& q = result.map_quality;
+  fmt::print("{}map against the truth: {:.2f}% of its known cells wrong, walls {:.3f} m from the true walls on average\n",
+             sc.localization == "ideal" ? ""
+                                        : fmt::format("localization error (RMSE over robots) {:.3f} m; ", totals.position_rmse_m),
+             100.0 * q.wrong_cell_share, q.mean_wall_distance_m);
   if (sc.merging != "known") {
     int made = 0;
     double worst_deg = 0.0, worst_m = 0.0;
@@ -171,6 +182,7 @@ int run_explore(const ExploreFlags& f) {
 
   io::MapLoadOptions load;
   load.max_cells = f.max_cells;
+  load.default_resolution = s.map_resolution_m;
   auto truth = maps::load_map_source(s.map, load);
   bool any_free = false;
   for (int i = 0; i < truth.width() * truth.height() && !any_free; ++i) any_free = truth.state_at(i) == mapping::CellState::Free;
@@ -259,6 +271,9 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--scenario", f->scenario, "Scenario YAML file (see scenarios/); flags below override it")
       ->check(CLI::ExistingFile);
   app->add_option("--map", f->map, "Built-in map name, image or map_server YAML [default: office]");
+  app->add_option("--resolution", f->resolution,
+                  "Metres per cell of a bare image map (PNG/PGM without YAML; a map_server YAML has its own) [default: 0.05]")
+      ->check(in_range(io::kResolutionRange));
   app->add_option("--robots", f->robots, "Number of robots, placed as --starts says [default: 4]")
       ->check(in_range(sim::limits::kRobots));
   app->add_option("--starts", f->starts,
@@ -272,7 +287,7 @@ Command add_explore_command(CLI::App& root) {
       ->check(CLI::IsMember(exploration::strategy_names()));
   app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]")
       ->check(CLI::IsMember(localization::localizer_names()));
-  app->add_option("--merging", f->merging, "known, rendezvous or overlap (see above) [default: known]")
+  app->add_option("--merging", f->merging, "known, rendezvous or overlap (see below) [default: known]")
       ->check(CLI::IsMember(sim::merging_names()));
   app->add_option("--comm-range", f->comm_range,
                   "Communication range in metres; 0 = only when robots see each other; inf = always [default: inf]")

@@ -123,6 +123,17 @@ MeanStd mean_std(const std::vector<double>& v) {
   return out;
 }
 
+namespace {
+
+// Text inside a Markdown table cell: a '|' would end the cell.
+std::string markdown_cell(const std::string& text) {
+  std::string out;
+  for (char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
+}  // namespace
+
 std::string slam_table_markdown(const SlamSetup& setup, const SlamCampaign& c, bool paper_columns) {
   const auto cols = columns(setup, c);
   std::ostringstream md;
@@ -134,7 +145,7 @@ std::string slam_table_markdown(const SlamSetup& setup, const SlamCampaign& c, b
   for (std::size_t i = 0; i < cols.size(); ++i) md << "---|";
   md << "\n";
   for (const auto& m : metrics()) {
-    md << "| " << m.label << " |";
+    md << "| " << markdown_cell(m.label) << " |";
     for (const auto& col : cols) {
       const MeanStd s = mean_std(values(*col.runs, col.name, m));
       md << " " << (s.count ? fmt(m.format, s.mean) + " ± " + fmt(m.format, s.std) : std::string("n/a")) << " |";

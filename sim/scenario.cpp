@@ -10,6 +10,7 @@
 #include "core/angle.h"
 #include "core/error.h"
 #include "io/file_io.h"
+#include "io/map_io.h"
 #include "io/yaml_reader.h"
 #include "exploration/strategy.h"
 #include "maps/builtin_maps.h"
@@ -225,6 +226,7 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
   s.base_dir = base_dir;
   s.map = top.text("map", s.map);
   if (s.map.empty()) throw InputError(top.where("map") + ": expected a map name or file");
+  s.map_resolution_m = top.number("map_resolution", s.map_resolution_m, io::kResolutionRange);
   s.seed = top.seed("seed", 1);
   s.steps = int(top.number("steps", s.steps, limits::kSteps));
   s.period_s = top.number("period", s.period_s, limits::kPeriod);
@@ -294,6 +296,7 @@ void validate_scenario(const Scenario& s) {
   check("merging.min_confidence", s.merge_min_confidence, limits::kConfidence);
   check("merging.attempt_every", s.merge_attempt_every, limits::kCount);
   check("lookahead", s.lookahead_m, limits::kLookahead);
+  check("map_resolution", s.map_resolution_m, io::kResolutionRange);
   const auto check_name = [](const std::string& key, const std::string& value, const std::vector<std::string>& valid) {
     if (std::find(valid.begin(), valid.end(), value) != valid.end()) return;
     std::string names;
@@ -338,7 +341,7 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
   }
   std::ostringstream y;
   y << "# fleetmap scenario\n";
-  y << "map: " << io::yaml_quoted(map) << "\n";
+  y << "map: " << io::yaml_quoted(map) << "\nmap_resolution: " << fmt(s.map_resolution_m) << "\n";
   y << "seed: " << s.seed << "\nsteps: " << s.steps << "\nperiod: " << fmt(s.period_s) << "\n";
   y << "robots:\n";
   switch (s.placement) {

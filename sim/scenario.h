@@ -60,6 +60,7 @@ inline constexpr Range kLookahead{0, 1e6};
 struct Scenario {
   std::string map = "office";       // built-in name, or a PNG/PGM/YAML path
   std::filesystem::path base_dir;   // relative map paths are resolved here (the scenario's folder)
+  double map_resolution_m = 0.05;   // metres per cell of a bare image map (a map_server YAML has its own)
   std::uint64_t seed = 1;
   int steps = 2000;                 // step limit
   double period_s = 1.0;            // sampling period T

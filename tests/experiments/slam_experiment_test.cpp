@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <algorithm>
 
 #include "experiments/slam_output.h"
@@ -121,6 +123,23 @@ TEST(SlamExperiment, OutputsTableAndFigures) {
   EXPECT_NE(md.find("| index | r1 | r2 | r3 | r3 alone |"), std::string::npos) << md;
   EXPECT_NE(md.find("mu, D'Alfonso et al. Table 1 | 1.66e-06"), std::string::npos) << md;
   EXPECT_NE(md.find("times as many"), std::string::npos) << md;
+  // Every row of the table has as many cells as its header (a '|' inside a cell is escaped).
+  const auto cells = [](const std::string& line) {
+    int n = 0;
+    for (std::size_t i = 0; i < line.size(); ++i) n += line[i] == '|' && (i == 0 || line[i - 1] != '\\');
+    return n;
+  };
+  std::istringstream lines(md);
+  std::string line;
+  int header = -1, rows = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("|", 0) != 0) continue;
+    if (header < 0) header = cells(line);
+    EXPECT_EQ(cells(line), header) << line;
+    ++rows;
+  }
+  EXPECT_GT(rows, 9);
+  EXPECT_NE(md.find("P(k\\|k-1)"), std::string::npos);
   const std::string csv = slam_table_csv(setup, c);
   EXPECT_NE(csv.find("nu_m,r3,alone,"), std::string::npos);
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 9 * 4);
