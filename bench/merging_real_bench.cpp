@@ -67,10 +67,12 @@ struct Args {
   fs::path cache = fs::path(FLEETMAP_BINARY_DIR) / "merging_real_cache";
   std::string csv;
   fs::path dump;             // writes each pair's maps here (a_<k>.png, b_<k>.png) when given
+  std::vector<int> only;     // run only these pair numbers (as in the CSV)
   int pairs = 40;            // 300 x 300 pairs per overlap
   int campus_pairs = 10;     // 1000 x 1000 pairs per overlap
   int unrelated = 200;       // pairs of windows of different plans
   int large_pairs = 4;       // 4000 x 4000 pairs (time)
+  int two_robots = 10;       // 300 x 300 pairs per overlap with a and b from two robots' maps of one plan
   std::vector<double> overlaps = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
   std::string method = "auto";
   double min_confidence = merging::MergeOptions{}.min_confidence;
@@ -81,8 +83,8 @@ struct Args {
 
 [[noreturn]] void usage(const std::string& problem) {
   std::cerr << "fleetmap_bench_merging_real: " << problem << "\n"
-            << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--dump DIR] [--pairs N]\n"
-            << "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--overlaps 0.1,0.5,...]\n"
+            << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
+            << "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
             << "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S]\n";
   std::exit(2);
 }
@@ -106,10 +108,19 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--cache") a.cache = value();
     else if (k == "--csv") a.csv = value();
     else if (k == "--dump") a.dump = value();
+    else if (k == "--only") {
+      const std::string list = value();
+      for (std::size_t p = 0; p <= list.size();) {
+        const std::size_t q = std::min(list.find(',', p), list.size());
+        a.only.push_back(int(number(list.substr(p, q - p))));
+        p = q + 1;
+      }
+    }
     else if (k == "--pairs") a.pairs = int(number(value()));
     else if (k == "--campus-pairs") a.campus_pairs = int(number(value()));
     else if (k == "--unrelated") a.unrelated = int(number(value()));
     else if (k == "--large-pairs") a.large_pairs = int(number(value()));
+    else if (k == "--two-robots") a.two_robots = int(number(value()));
     else if (k == "--method") a.method = value();
     else if (k == "--min-confidence") a.min_confidence = number(value());
     else if (k == "--no-peer") a.peer = false;
@@ -212,9 +223,11 @@ struct PlanMap {
 
 constexpr const char* kCacheVersion = "v2";
 
-PlanMap build_plan_map(const fs::path& plan_yaml, int index, const fs::path& cache) {
+// `robot` 0 and 1: two robots exploring the same plan alone, from different starts with different
+// noise (the second map of a plan, for pairs of two robots' maps).
+PlanMap build_plan_map(const fs::path& plan_yaml, int index, int robot, const fs::path& cache) {
   PlanMap p{plan_yaml.stem().string(), {}, mapping::OccupancyGrid(core::GridGeometry(0.05, 1, 1)), 0.0, 0.0};
-  const fs::path stem = cache / fmt::format("{}-{}", p.id, kCacheVersion);
+  const fs::path stem = cache / fmt::format("{}-{}{}", p.id, kCacheVersion, robot == 0 ? "" : "-r2");
   mapping::OccupancyGrid truth = io::load_map(plan_yaml);
   p.recipe = recipe_for(index, truth.count(mapping::CellState::Free));
   if (fs::exists(stem.string() + ".yaml") && fs::exists(stem.string() + ".txt")) {
@@ -226,12 +239,12 @@ PlanMap build_plan_map(const fs::path& plan_yaml, int index, const fs::path& cac
   if (p.recipe.resolution < truth.resolution() - 1e-9) truth = refine_grid(truth, int(std::lround(truth.resolution() / p.recipe.resolution)));
   // The explorer stops at once when sparse far beams leave no frontier it can use (seen with
   // 180 beams on 0.025 m cells): such a plan is explored again with twice the beams.
-  core::Random start_random(9000 + std::uint64_t(index));
+  core::Random start_random(9000 + std::uint64_t(index) + 1000 * std::uint64_t(robot));
   const core::Pose2 start = start_in_largest_room(truth, start_random);
   for (;;) {
     sim::Scenario s;
     s.map = plan_yaml.string();
-    s.seed = std::uint64_t(index) + 1;
+    s.seed = std::uint64_t(index) + 1 + 1000 * std::uint64_t(robot);
     s.robot_count = 1;
     s.placement = sim::Placement::List;
     s.starts = {start};
@@ -369,7 +382,24 @@ struct Pair {
   double overlap = 0.0;  // 0 for unrelated
   mapping::OccupancyGrid a, b;
   std::optional<core::Transform2> truth;
+  // Where a success must land (mean displacement under 2 cells): the truth, or for two robots'
+  // maps the best fit of the two maps next to the truth (each map is off the world by its own
+  // drift, up to several cells): the common refinement started at the truth.
+  std::optional<core::Transform2> reference;
 };
+
+// The fit of b to a next to `truth`: fleetmap's refinement from the truth, coarse to fine from cells
+// of 4 x 4 fine cells.
+core::Transform2 fit_near(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b, const core::Transform2& truth) {
+  const merging::KnownPart ka(a), kb(b);
+  const merging::PreparedGrid pa(ka.grid()), pb(kb.grid());
+  const Eigen::Vector2d oa = ka.origin().cast<double>(), ob = kb.origin().cast<double>();
+  // In the cuts' cells: cut_a = T (cut_b + ob) + t - oa.
+  const core::Transform2 cut(truth.translation() + truth.rotation_matrix() * ob - oa, truth.rotation());
+  merging::MergeResult r;
+  r.transform = merging::refine_alignment(pa, pb, cut, 2).b_to_a;
+  return merging::uncut(r, ka, kb).transform;
+}
 
 struct Outcome {
   bool merged = false;
@@ -397,12 +427,14 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
   o.merged = r.merged;
   o.confidence = r.confidence;
   if (p.truth && r.candidates > 0) {
-    o.error = merging::mean_displacement(r.transform, *p.truth, p.b);
+    o.error = merging::mean_displacement(r.transform, p.reference.value_or(*p.truth), p.b);
     o.found = o.error < kSuccessCells;
   }
-  o.detail = fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};{}",
+  const merging::Acceptance acc = merging::acceptance_index(p.a, p.b, r.transform);
+  o.detail = fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};{}",
                          r.method, r.quality.agreement, r.acceptance, r.quality.constraint, r.distinctiveness,
-                         r.quality.matched, r.quality.contradicted, r.reason);
+                         r.quality.matched, r.quality.contradicted, r.quality.tested, r.quality.overlap_radius,
+                         acc.common(), acc.disagree, r.quality.residual_rms, r.reason);
   return o;
 }
 
@@ -416,7 +448,7 @@ Outcome run_peer(const Pair& p) {
   o.merged = r.merged;
   o.confidence = r.confidence;
   if (p.truth && r.b_to_a) {
-    o.error = merging::mean_displacement(*r.b_to_a, *p.truth, p.b);
+    o.error = merging::mean_displacement(*r.b_to_a, p.reference.value_or(*p.truth), p.b);
     o.found = o.error < kSuccessCells;
   }
   o.detail = fmt::format("matches={};inliers={}", r.matches, r.inliers);
@@ -474,10 +506,11 @@ int main(int argc, char** argv) {
       if (e.path().extension() == ".yaml") plans.push_back(e.path());
     std::sort(plans.begin(), plans.end());
     if (plans.size() < 2) usage("--plans: " + args.plans.string() + " holds fewer than two map_server YAML plans");
-    std::vector<PlanMap> maps;
+    std::vector<PlanMap> maps, second;
     for (std::size_t i = 0; i < plans.size(); ++i) {
       std::cerr << fmt::format("\rmaps: {}/{} {}      ", i + 1, plans.size(), plans[i].stem().string()) << std::flush;
-      maps.push_back(build_plan_map(plans[i], int(i), args.cache));
+      maps.push_back(build_plan_map(plans[i], int(i), 0, args.cache));
+      if (args.two_robots > 0) second.push_back(build_plan_map(plans[i], int(i), 1, args.cache));
     }
     std::cerr << "\n";
 
@@ -498,10 +531,33 @@ int main(int argc, char** argv) {
           try {
             merging::CropPair c = merging::make_crop_pair(m.map, crop, random);
             clutter_pair(c.a, c.b, random);
-            pairs.push_back(std::make_unique<Pair>(Pair{"house300", m.id, f, std::move(c.a), std::move(c.b), c.b_to_a}));
+            pairs.push_back(std::make_unique<Pair>(Pair{"house300", m.id, f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
             break;
           } catch (const Error&) {
             // This plan has no such windows (too small for this overlap): the next one.
+          }
+        }
+      }
+    }
+    // The same windows, a from one robot's map and b from another robot's map of the plan: both
+    // maps are in the plan's frame, so the truth is the windows' transform (up to each map's drift).
+    std::size_t next_two = 0;
+    for (const double f : args.overlaps) {
+      crop.overlap = f;
+      for (int k = 0; k < args.two_robots; ++k) {
+        for (std::size_t tries = 0; tries < maps.size(); ++tries) {
+          const std::size_t i = next_two++ % maps.size();
+          try {
+            merging::CropPair c = merging::make_crop_pair(maps[i].map, crop, random);
+            mapping::OccupancyGrid b = merging::resample_grid(second[i].map, c.b_to_source, crop.width, crop.height);
+            clutter_pair(c.a, b, random);
+            const core::Transform2 reference = fit_near(c.a, b, c.b_to_a);
+            // Farther than 1 m from the truth, the fit found another place: no reference for this window.
+            if (merging::mean_displacement(reference, c.b_to_a, b) > 1.0 / b.resolution()) continue;
+            pairs.push_back(std::make_unique<Pair>(
+                Pair{"house300x2", maps[i].id, f, std::move(c.a), std::move(b), c.b_to_a, reference}));
+            break;
+          } catch (const Error&) {
           }
         }
       }
@@ -519,7 +575,7 @@ int main(int argc, char** argv) {
           merging::CropPair cj = merging::make_crop_pair(maps[j].map, single, random);
           clutter_pair(ci.a, cj.b, random);
           pairs.push_back(std::make_unique<Pair>(
-              Pair{"unrelated", maps[i].id + "/" + maps[j].id, 0.0, std::move(ci.a), std::move(cj.b), std::nullopt}));
+              Pair{"unrelated", maps[i].id + "/" + maps[j].id, 0.0, std::move(ci.a), std::move(cj.b), std::nullopt, {}}));
           break;
         } catch (const Error&) {
         }
@@ -535,7 +591,7 @@ int main(int argc, char** argv) {
       for (int k = 0; k < args.campus_pairs; ++k) {
         merging::CropPair c = merging::make_crop_pair(campus, campus_crop, random);
         clutter_pair(c.a, c.b, random);
-        pairs.push_back(std::make_unique<Pair>(Pair{"campus1000", "campus", f, std::move(c.a), std::move(c.b), c.b_to_a}));
+        pairs.push_back(std::make_unique<Pair>(Pair{"campus1000", "campus", f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
       }
     }
     if (args.large_pairs > 0) {
@@ -546,7 +602,7 @@ int main(int argc, char** argv) {
       for (int k = 0; k < args.large_pairs; ++k) {
         big.overlap = k % 2 ? 0.2 : 0.5;
         merging::CropPair c = merging::make_crop_pair(fine, big, random);
-        pairs.push_back(std::make_unique<Pair>(Pair{"campus4000", "campus", big.overlap, std::move(c.a), std::move(c.b), c.b_to_a}));
+        pairs.push_back(std::make_unique<Pair>(Pair{"campus4000", "campus", big.overlap, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
       }
     }
 
@@ -558,6 +614,7 @@ int main(int argc, char** argv) {
     }
     for (std::size_t i = 0; i < pairs.size(); ++i) {
       const Pair& p = *pairs[i];
+      if (!args.only.empty() && std::find(args.only.begin(), args.only.end(), int(i)) == args.only.end()) continue;
       std::cerr << fmt::format("\rpairs: {}/{} {} {}%      ", i + 1, pairs.size(), p.set, overlap_percent(p.overlap))
                 << std::flush;
       if (!args.dump.empty()) {
@@ -594,7 +651,7 @@ int main(int argc, char** argv) {
       }
       return out;
     };
-    for (const std::string set : {"house300", "campus1000", "campus4000"}) {
+    for (const std::string set : {"house300", "house300x2", "campus1000", "campus4000"}) {
       std::vector<double> fs_;
       for (const auto& r : records)
         if (r.pair->set == set && std::find(fs_.begin(), fs_.end(), r.pair->overlap) == fs_.end()) fs_.push_back(r.pair->overlap);

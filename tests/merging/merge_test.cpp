@@ -85,7 +85,9 @@ TEST_P(MethodOnDisjointMaps, NoOverlapIsNeverMerged) {
     for (int i = 0; i < 2; ++i) {
       const CropPair pair = make_crop_pair(source, o, random);
       const MergeResult r = align_maps(pair.a, pair.b, options);
-      EXPECT_FALSE(r.merged) << map << " disjoint pair " << i << " confidence " << r.confidence;
+      EXPECT_FALSE(r.merged) << map << " disjoint pair " << i << " confidence " << r.confidence << " evidence " << r.evidence
+                             << " constraint " << r.quality.constraint << " residual " << r.quality.residual_rms
+                             << " distinctiveness " << r.distinctiveness;
     }
   }
   const auto office = testing::source_map("office"), cave = testing::source_map("cave");
