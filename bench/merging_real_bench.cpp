@@ -689,7 +689,7 @@ int main(int argc, char** argv) {
     // Reliability: of the answers with confidence in a bin, the share that is right; and at each
     // threshold, what a user gets.
     {
-      std::cout << "### fleetmap's confidence (every pair above: house300, campus1000, unrelated)\n\n"
+      std::cout << "### fleetmap's confidence (every pair above but campus4000)\n\n"
                 << "| confidence | answers | right | share right | accepted at >= c: answers, share right, share of all right answers |\n|---|---|---|---|---|\n";
       int total_right = 0;
       for (const auto& r : records) total_right += r.pair->set != "campus4000" && r.fleetmap.found;

@@ -120,7 +120,7 @@ const std::vector<MergeMethod>& merge_methods() {
        "grid overlap search (wave-algorithm paper, Birk & Carpin 2006): Hough-spectrum rotations (Carpin 2008), FFT "
        "correlation of walls for translations, coarse to fine; a rotation sweep when the spectra find nothing",
        {propose_overlap, propose_overlap_sweep}},
-      {"features", "ORB and AKAZE keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
+      {"features", "ORB keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
        {propose_features}},
   };
   return kMethods;
