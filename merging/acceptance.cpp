@@ -34,7 +34,8 @@ Acceptance acceptance_index(const mapping::OccupancyGrid& a, const mapping::Occu
 namespace {
 
 struct Tally {
-  int matched = 0, contradicted = 0;
+  int tested = 0, matched = 0, near = 0, contradicted = 0;
+  double squared_residuals = 0.0;  // of the matched and the near walls
   std::unordered_set<std::int64_t> blocks;   // 4 x 4 blocks of the source map already counted
   std::vector<Eigen::Vector2d> positions;    // matched walls, in a's frame
   std::vector<Eigen::Matrix2d> structures;   // their local structure, in a's frame
@@ -52,15 +53,25 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
     const int x = nearest_cell(p.x()), y = nearest_cell(p.y());
     if (x < 0 || y < 0 || x >= target.width() || y >= target.height() || !target.known(x, y)) continue;
     const float d = target.distance_at(p.x(), p.y(), 1e4f);
+    out.tested += !w.clutter;
+    // Walls near the other map's walls but farther than a match (parallel walls a cell or two
+    // apart) widen the residual: they are how a wrong answer that lines walls up only roughly
+    // differs from a right one.
+    if (!w.clutter && d > options.match_distance && d < options.contradiction_distance) {
+      ++out.near;
+      out.squared_residuals += double(d) * d;
+    }
     if (d <= options.match_distance) {
+      if (!seen_from_same_side(target, p, r * w.normal)) continue;
       ++out.matched;
+      out.squared_residuals += double(d) * d;
       // Neighbouring wall cells say the same thing: one sample per 4 x 4 block of the source.
       const std::int64_t key = (std::int64_t(int(w.position.x()) / 4) << 32) ^ std::int64_t(int(w.position.y()) / 4) ^
                                (from_b ? std::int64_t(1) << 62 : 0);
       if (!out.blocks.insert(key).second) continue;
       out.positions.push_back(to_a.apply(p.cast<double>()));
       out.structures.push_back(ra * w.structure.cast<double>() * ra.transpose());
-    } else if (d >= options.contradiction_distance && target.is_free(x, y)) {
+    } else if (!w.clutter && d >= options.contradiction_distance && target.is_free(x, y)) {
       ++out.contradicted;
     }
   }
@@ -80,6 +91,8 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   tally(b, a, b_to_a, core::Transform2::identity(), true, options, t);
   tally(a, b, b_to_a.inverse(), b_to_a, false, options, t);
   AlignmentQuality q;
+  q.tested = t.tested;
+  q.residual_rms = t.matched > 0 ? std::sqrt(t.squared_residuals / (t.matched + t.near)) : 0.0;
   q.matched = t.matched;
   q.contradicted = t.contradicted;
   q.score = t.matched - options.contradiction_weight * t.contradicted;

@@ -29,14 +29,16 @@ struct QualityOptions {
   double contradiction_distance = 3.0;  // cells: a wall cell on the other map's free space this far
                                         // from its walls contradicts it
   // score = matched - weight * contradicted: an answer whose walls agree less than
-  // weight / (1 + weight) (10: 91%) scores below zero, however large its overlap.
-  double contradiction_weight = 20.0;
+  // weight / (1 + weight) (3: 75%) scores below zero, however large its overlap. Moderate: two
+  // robots' maps of one building disagree on a few percent of their walls (drift, doors, glass).
+  double contradiction_weight = 3.0;
 };
 
 // How well the walls of two maps fit under a transform, counted both ways (b's walls in a, and
 // a's walls in b) over the cells that land on known cells of the other map.
 struct AlignmentQuality {
-  int matched = 0;       // wall cells near a wall of the other map
+  int tested = 0;        // wall cells (not clutter) that land on known cells of the other map
+  int matched = 0;       // wall cells near a wall of the other map, seen from the same side
   int contradicted = 0;  // wall cells, and interior cells of filled obstacles (every second row and
                          // column), on the other map's free space far from its walls
   double score = 0.0;      // matched - contradiction_weight * contradicted
@@ -45,6 +47,9 @@ struct AlignmentQuality {
   // how many wall cells' worth pin the weakest direction down. A straight wall alone, or one
   // round obstacle, leaves a direction free and gives ~0.
   double constraint = 0.0;
+  // RMS distance to the other map's walls of the walls that land within contradiction_distance of
+  // them (matched, or near: a cell or two off), in cells.
+  double residual_rms = 0.0;
   double overlap_radius = 0.0;  // RMS distance of the matched walls from their centroid, in cells
   Eigen::Vector2d overlap_centre = Eigen::Vector2d::Zero();  // that centroid, in a's cells
 };

@@ -39,12 +39,41 @@ TransformError transform_error(const core::Transform2& estimate, const core::Tra
           (estimate.apply(reference) - truth.apply(reference)).norm()};
 }
 
+double mean_displacement(const Eigen::Matrix<double, 2, 3>& estimate, const core::Transform2& truth,
+                         const mapping::OccupancyGrid& b) {
+  // The difference of two affine maps is affine: D q = (A - R) q + (s - t).
+  Eigen::Matrix<double, 2, 3> d = estimate;
+  d.leftCols<2>() -= truth.rotation_matrix();
+  d.col(2) -= truth.translation();
+  double sum = 0.0;
+  std::int64_t n = 0;
+  for (int y = 0; y < b.height(); ++y) {
+    const int row = y * b.width();
+    const Eigen::Vector2d start = d.col(1) * double(y) + d.col(2);
+    for (int x = 0; x < b.width(); ++x) {
+      if (b.state_at(row + x) == mapping::CellState::Unknown) continue;
+      sum += (start + d.col(0) * double(x)).norm();
+      ++n;
+    }
+  }
+  return n > 0 ? sum / double(n) : 0.0;
+}
+
+double mean_displacement(const core::Transform2& estimate, const core::Transform2& truth,
+                         const mapping::OccupancyGrid& b) {
+  Eigen::Matrix<double, 2, 3> m;
+  m << estimate.rotation_matrix(), estimate.translation();
+  return mean_displacement(m, truth, b);
+}
+
 mapping::OccupancyGrid resample_grid(const mapping::OccupancyGrid& grid, const core::Transform2& frame_to_grid,
                                      int width, int height) {
   mapping::OccupancyGrid out(core::GridGeometry(grid.resolution(), width, height), grid.options());
+  const Eigen::Matrix2d r = frame_to_grid.rotation_matrix();
+  const Eigen::Vector2d t = frame_to_grid.translation();
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
-      const Eigen::Vector2d p = frame_to_grid.apply(Eigen::Vector2d(x, y));
+      const Eigen::Vector2d p = r * Eigen::Vector2d(x, y) + t;
       const core::Cell c{int(std::lround(p.x())), int(std::lround(p.y()))};
       if (grid.contains(c)) out.set_log_odds({x, y}, grid.log_odds(c));
     }
@@ -125,6 +154,84 @@ Windows choose_windows(int source_width, int source_height, const CropPairOption
               std::to_string(options.overlap) + " fit the map after " + std::to_string(options.max_tries) + " tries");
 }
 
+// As choose_windows, with the overlap measured on the source's known cells (OverlapMeasure::Known).
+Windows choose_known_windows(const mapping::OccupancyGrid& source, const CropPairOptions& options,
+                             core::Random& random) {
+  const int w = options.width, h = options.height;
+  if (w <= 0 || h <= 0 || options.overlap <= 0.0) {
+    throw Error("crop pair: overlap of known cells needs crops of positive size and an overlap above 0");
+  }
+  // The known cells, thinned to about 100,000 on a regular lattice (each stands for stride^2 cells).
+  const std::int64_t known = source.known_count();
+  const int stride = std::max(1, int(std::sqrt(double(known) / 1e5)));
+  std::vector<Eigen::Vector2d> pts;
+  for (int y = 0; y < source.height(); y += stride) {
+    for (int x = 0; x < source.width(); x += stride) {
+      if (source.state_at(y * source.width() + x) != mapping::CellState::Unknown) pts.emplace_back(x, y);
+    }
+  }
+  const double min_count = options.min_known * double(w) * h / (double(stride) * stride);
+  const auto inside = [w, h](const Eigen::Vector2d& q) {
+    return q.x() >= -0.5 && q.y() >= -0.5 && q.x() < w - 0.5 && q.y() < h - 0.5;
+  };
+  std::vector<char> in_a(pts.size());
+  for (int attempt = 0; attempt < options.max_tries; ++attempt) {
+    Windows out;
+    out.a_to_source = core::Transform2(random.uniform_int(-w / 2, std::max(-w / 2, source.width() - w / 2)),
+                                       random.uniform_int(-h / 2, std::max(-h / 2, source.height() - h / 2)), 0.0);
+    const Eigen::Vector2d to_a = -out.a_to_source.translation();  // a is not turned
+    double count_a = 0.0;
+    for (std::size_t i = 0; i < pts.size(); ++i) count_a += in_a[i] = inside(pts[i] + to_a);
+    if (count_a < std::max(1.0, min_count)) continue;
+    const double phi = core::deg2rad(random.uniform(-options.max_rotation_deg, options.max_rotation_deg));
+    const double dir = random.uniform(-std::numbers::pi, std::numbers::pi);
+    const Eigen::Vector2d u(std::cos(dir), std::sin(dir));
+    const Eigen::Vector2d centre((w - 1) / 2.0, (h - 1) / 2.0);
+    const Eigen::Vector2d centre_a = out.a_to_source.apply(centre);
+    const auto b_frame = [&](double dist) {
+      const core::Transform2 rot(0.0, 0.0, phi);
+      return core::Transform2(centre_a + dist * u - rot.apply(centre), phi);
+    };
+    struct Shares {
+      double overlap = 0.0, count_b = 0.0;
+      Eigen::Vector2d centre_b = Eigen::Vector2d::Zero();
+    };
+    const auto shares_at = [&](double dist) {
+      const core::Transform2 to_b = b_frame(dist).inverse();
+      const Eigen::Matrix2d r = to_b.rotation_matrix();
+      const Eigen::Vector2d t = to_b.translation();
+      Shares s;
+      double common = 0.0;
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const Eigen::Vector2d q = r * pts[i] + t;
+        if (!inside(q)) continue;
+        s.count_b += 1.0;
+        if (in_a[i]) common += 1.0, s.centre_b += q;
+      }
+      s.overlap = s.count_b > 0.0 ? common / std::min(count_a, s.count_b) : 0.0;
+      s.centre_b = common > 0.0 ? Eigen::Vector2d(s.centre_b / common) : centre;
+      return s;
+    };
+    // The shared part shrinks, not always monotonically, as b moves away: bisect for a crossing.
+    double lo = 0.0, hi = 2.0 * std::hypot(w, h);
+    if (shares_at(lo).overlap < options.overlap) continue;
+    for (int i = 0; i < 40; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (shares_at(mid).overlap >= options.overlap ? lo : hi) = mid;
+    }
+    const Shares s = shares_at(lo);
+    if (s.count_b < std::max(1.0, min_count) || std::abs(s.overlap - options.overlap) > 0.02) continue;
+    out.b_to_source = b_frame(lo);
+    out.overlap = s.overlap;
+    out.overlap_centre_b = s.centre_b;
+    return out;
+  }
+  throw Error("crop pair: no crops of " + std::to_string(w) + "x" + std::to_string(h) + " with " +
+              std::to_string(options.overlap) + " of their known cells in common and " +
+              std::to_string(options.min_known) + " of their area known fit the map after " +
+              std::to_string(options.max_tries) + " tries");
+}
+
 CropPair pair_from(const Windows& win) {
   CropPair pair;
   pair.a_to_source = win.a_to_source;
@@ -146,7 +253,9 @@ cv::Point fixed_point(const Eigen::Vector2d& p) {
 }  // namespace
 
 CropPair make_crop_pair(const mapping::OccupancyGrid& source, const CropPairOptions& options, core::Random& random) {
-  const Windows win = choose_windows(source.width(), source.height(), options, random);
+  const Windows win = options.measure == OverlapMeasure::Known
+                          ? choose_known_windows(source, options, random)
+                          : choose_windows(source.width(), source.height(), options, random);
   CropPair pair = pair_from(win);
   pair.a = resample_grid(source, pair.a_to_source, options.width, options.height);
   pair.b = resample_grid(source, pair.b_to_source, options.width, options.height);

@@ -22,6 +22,20 @@ struct TransformError {
 TransformError transform_error(const core::Transform2& estimate, const core::Transform2& truth,
                                const Eigen::Vector2d& reference);
 
+// The mean distance, in cells, between where `estimate` and `truth` put b's known cells: the
+// error a user sees on the merged map, whatever b's origin. `estimate` may be any 2 x 3 affine map
+// (a feature method may fit a similarity); 0 when b has no known cell.
+double mean_displacement(const Eigen::Matrix<double, 2, 3>& estimate, const core::Transform2& truth,
+                         const mapping::OccupancyGrid& b);
+double mean_displacement(const core::Transform2& estimate, const core::Transform2& truth,
+                         const mapping::OccupancyGrid& b);
+
+// How CropPairOptions::overlap is measured.
+enum class OverlapMeasure {
+  Area,   // the windows' areas (clipped to the source)
+  Known,  // the source's known cells: the cells known in both crops over the smaller crop's known cells
+};
+
 struct CropPairOptions {
   int width = 120;                 // both crops, cells
   int height = 120;
@@ -30,6 +44,12 @@ struct CropPairOptions {
   double min_inside = 0.9;         // each crop keeps at least this fraction of its area on the source map
   double gap = 4.0;                // cells between disjoint crops (overlap 0)
   int max_tries = 500;
+  // Known: crops may reach beyond the source (unknown there); min_inside is not used, and each crop
+  // must hold at least min_known of its area in known cells. Maps robots build have unknown
+  // outside and between rooms, so the share of the windows' area says little about what two views
+  // have in common; overlap 0 is not supported.
+  OverlapMeasure measure = OverlapMeasure::Area;
+  double min_known = 0.0;
 };
 
 // Two views of one map: `a` is an axis-aligned window of the source, `b` a window of the same size

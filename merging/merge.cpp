@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
 #include "core/angle.h"
 #include "core/error.h"
+#include "merging/evaluation.h"
 
 namespace fleetmap::merging {
 
@@ -21,6 +25,7 @@ std::vector<Hypothesis> propose_overlap_sweep(const PreparedGrid& a, const Prepa
                                               core::Random&) {
   OverlapSearchOptions sweep = options.overlap;
   sweep.sweep_step_deg = options.sweep_step_deg;
+  sweep.search_cells = options.sweep_search_cells;
   return overlap_hypotheses(a, b, sweep);
 }
 
@@ -56,6 +61,32 @@ void prune(std::vector<Candidate>& c, const PreparedGrid& b, const ConfidenceOpt
 
 double clamp01(double v) { return std::clamp(v, 0.0, 1.0); }
 
+// b's cells that b_to_a lays on known cells of a, grown by `margin` cells; the rest unknown.
+mapping::OccupancyGrid common_part(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
+                                   const core::Transform2& b_to_a, int margin) {
+  cv::Mat mask = cv::Mat::zeros(b.height(), b.width(), CV_8U);
+  const Eigen::Matrix2d r = b_to_a.rotation_matrix();
+  const Eigen::Vector2d t = b_to_a.translation();
+  for (int y = 0; y < b.height(); ++y) {
+    auto* m = mask.ptr<std::uint8_t>(y);
+    for (int x = 0; x < b.width(); ++x) {
+      if (b.state_at(y * b.width() + x) == mapping::CellState::Unknown) continue;
+      const Eigen::Vector2d p = r * Eigen::Vector2d(x, y) + t;
+      const int ax = nearest_cell(p.x()), ay = nearest_cell(p.y());
+      if (ax >= 0 && ay >= 0 && ax < a.width() && ay < a.height() && a.state_at(ay * a.width() + ax) != mapping::CellState::Unknown)
+        m[x] = 255;
+    }
+  }
+  if (margin > 0) cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * margin + 1, 2 * margin + 1}));
+  mapping::OccupancyGrid out(b.geometry(), b.options());
+  for (int y = 0; y < b.height(); ++y) {
+    const auto* m = mask.ptr<std::uint8_t>(y);
+    for (int x = 0; x < b.width(); ++x)
+      if (m[x]) out.set_log_odds({x, y}, b.log_odds_at(y * b.width() + x));
+  }
+  return out;
+}
+
 // Coarse to fine: every candidate joins at its level; after each level near-duplicates go and only
 // the best few go on.
 std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGrid& b,
@@ -89,7 +120,7 @@ const std::vector<MergeMethod>& merge_methods() {
        "grid overlap search (wave-algorithm paper, Birk & Carpin 2006): Hough-spectrum rotations (Carpin 2008), FFT "
        "correlation of walls for translations, coarse to fine; a rotation sweep when the spectra find nothing",
        {propose_overlap, propose_overlap_sweep}},
-      {"features", "ORB and AKAZE keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
+      {"features", "ORB keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
        {propose_features}},
   };
   return kMethods;
@@ -128,6 +159,25 @@ void check_merge_method(const std::string& name) {
   throw InputError("unknown merge method '" + name + "' (valid: " + list + ")");
 }
 
+namespace {
+
+using Placements = std::vector<std::pair<AlignmentQuality, core::Transform2>>;
+
+// `known` and the placements of b in a found by the overlap search at the four quarter turns of
+// `answer`, each refined and scored.
+Placements other_placements(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& answer,
+                            const MergeOptions& options, Placements known) {
+  std::vector<double> turns;
+  for (int k = 0; k < 4; ++k) turns.push_back(answer.rotation() + k * std::numbers::pi / 2.0);
+  OverlapSearchOptions probe = options.overlap;
+  probe.translation_peaks = 4;
+  for (const auto& c : refine_candidates(a, b, overlap_hypotheses_at(a, b, turns, probe), options))
+    known.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, options.quality), c.fit.b_to_a);
+  return known;
+}
+
+}  // namespace
+
 MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vector<Hypothesis>& candidates,
                    const MergeOptions& options) {
   MergeResult result;
@@ -147,48 +197,81 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   result.quality = best_q;
   result.acceptance = acceptance_index(a.grid(), b.grid(), result.transform).omega();
 
-  // Whatever the method, look for other placements where maps with symmetric or repeated
-  // structure fit too: b turned a quarter, a half and three quarters from the answer, and every
-  // translation at the answer's own rotation (only when the answer could be merged at all).
   const auto& co = options.confidence;
   const double agree_factor = clamp01((best_q.agreement - co.zero_agreement) / (co.full_agreement - co.zero_agreement));
-  const double support_factor = clamp01(best_q.constraint / co.full_constraint);
   const double acceptance_factor =
       clamp01((result.acceptance - co.zero_acceptance) / (co.full_acceptance - co.zero_acceptance));
-  std::vector<std::pair<AlignmentQuality, core::Transform2>> others;
-  for (std::size_t i = 1; i < scored.size(); ++i) others.emplace_back(scored[i].first, scored[i].second->fit.b_to_a);
-  if (options.probe_symmetries && agree_factor * acceptance_factor * support_factor >= options.min_confidence) {
-    std::vector<double> turns;
-    for (int k = 0; k < 4; ++k) turns.push_back(result.transform.rotation() + k * std::numbers::pi / 2.0);
-    OverlapSearchOptions probe = options.overlap;
-    probe.translation_peaks = 4;
-    const auto probes = refine_candidates(a, b, overlap_hypotheses_at(a, b, turns, probe), options);
-    for (const auto& c : probes) others.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, options.quality), c.fit.b_to_a);
-  }
-  // The best plausible alternative answer, if any.
-  const Eigen::Vector2d at_b = result.transform.inverse().apply(best_q.overlap_centre);
+  const double chance_rms = options.quality.contradiction_distance / std::sqrt(3.0);
+  const double fit_weight =
+      best_q.matched > 0 ? std::max(0.0, std::log(chance_rms / std::max(best_q.residual_rms, 0.05))) : 0.0;
+  result.evidence = best_q.constraint * fit_weight;
+  const auto support = [&](double evidence) { return 1.0 - std::exp2(-evidence / co.half_evidence); };
+
+  // The best plausible different answer among `others` (placements of `from` in a), relative to
+  // the answer's score `best` there: 1 - S2 / S1.
   const double rate = std::max(co.min_contradiction_rate,
                                (best_q.contradicted + 1.0) / (best_q.matched + best_q.contradicted + 2.0));
-  double second = 0.0;
-  for (const auto& [q, t] : others) {
-    if (same_answer(t, result.transform, at_b, co)) continue;
-    const double n = q.matched + q.contradicted;
-    const double z = (q.contradicted - rate * n) / std::sqrt(rate * n + 1.0);
-    const double plausible = q.score * clamp01((4.0 - z) / 2.0);
-    if (plausible > second) {
-      second = plausible;
-      result.alternative = t;
+  const auto distinctiveness = [&](const Placements& others,
+                                   const AlignmentQuality& best, const core::Transform2& answer) {
+    const Eigen::Vector2d at = answer.inverse().apply(best.overlap_centre);
+    double second = 0.0;
+    std::optional<core::Transform2> alternative;
+    for (const auto& [q, t] : others) {
+      if (same_answer(t, answer, at, co)) continue;
+      const double n = q.matched + q.contradicted;
+      const double z = (q.contradicted - rate * n) / std::sqrt(rate * n + 1.0);
+      const double plausible = q.score * clamp01((4.0 - z) / 2.0);
+      if (plausible > second) second = plausible, alternative = t;
+    }
+    return std::pair(best.score > 0.0 ? clamp01(1.0 - second / best.score) : 0.0, alternative);
+  };
+  Placements others;
+  for (std::size_t i = 1; i < scored.size(); ++i) others.emplace_back(scored[i].first, scored[i].second->fit.b_to_a);
+  std::tie(result.distinctiveness, result.alternative) = distinctiveness(others, best_q, result.transform);
+
+  // Symmetric or repeated places (only when the answer could be merged at all): other placements
+  // of b in a, turned by quarter turns from the answer, at every translation. Twice: all of b (a
+  // quarter-turned placement elsewhere, on a row of identical rooms), and only the part of b that
+  // the answer lays on a's known cells, which is all the evidence there is: rows of identical
+  // rooms, or a symmetric room, fit elsewhere nearly as well, and the rest of b, lying on a's
+  // unknown, cannot tell them apart.
+  if (options.probe_symmetries && agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence) {
+    std::tie(result.distinctiveness, result.alternative) =
+        distinctiveness(other_placements(a, b, result.transform, options, others), best_q, result.transform);
+    const mapping::OccupancyGrid common = common_part(a.grid(), b.grid(), result.transform, 3);
+    const KnownPart cut(common);
+    const PreparedGrid pc(cut.grid(), options.prepare);
+    // When the answer lays nearly all of b on a's known cells, the probe of all of b said it all.
+    if (!pc.walls().empty() && pc.walls().size() < 0.8 * b.walls().size()) {
+      const Eigen::Vector2d o = cut.origin().cast<double>();
+      const core::Transform2 answer(result.transform.translation() + result.transform.rotation_matrix() * o,
+                                    result.transform.rotation());  // the cut's cells into a's
+      const AlignmentQuality own = evaluate_alignment(a, pc, answer, options.quality);
+      const auto [d, alternative] = distinctiveness(other_placements(a, pc, answer, options, {}), own, answer);
+      if (d < result.distinctiveness) {
+        result.distinctiveness = d;
+        // Back to b's cells: the cut's cell q is b's cell q + o.
+        if (alternative) result.alternative = core::Transform2(alternative->translation() - alternative->rotation_matrix() * o,
+                                                                alternative->rotation());
+      }
     }
   }
-  result.distinctiveness = best_q.score > 0.0 ? clamp01(1.0 - second / best_q.score) : 0.0;
-  result.confidence = agree_factor * acceptance_factor * support_factor * result.distinctiveness;
+  const double support_factor = support(result.evidence * result.distinctiveness);
+  result.confidence = agree_factor * acceptance_factor * support_factor;
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {
+    // The weakest factor says why, in words.
+    std::string why;
+    if (agree_factor < 0.5) why = "the walls of one map cross the other's free space";
+    else if (acceptance_factor < 0.5) why = "the maps disagree on the cells they share (free in one, occupied in the other)";
+    else if (result.distinctiveness < 0.5) why = "another placement fits nearly as well (repeated or symmetric places)";
+    else if (best_q.constraint < co.half_evidence) why = "the common walls leave the placement free to slide or turn (a bare room, a corridor, one wall)";
+    else why = "too little of the common walls fits better than chance";
     result.reason = fmt::format(
-        "no reliable overlap: confidence {:.2f} < {:.2f} (wall agreement {:.2f}, acceptance {:.2f}, constraint {:.1f}, "
-        "distinctiveness {:.2f})",
-        result.confidence, options.min_confidence, best_q.agreement, result.acceptance, best_q.constraint,
-        result.distinctiveness);
+        "no reliable overlap: {}; confidence {:.2f} < {:.2f} (wall agreement {:.2f}, acceptance {:.2f}, evidence {:.1f} "
+        "from constraint {:.1f} at {:.2f} cells, distinctiveness {:.2f})",
+        why, result.confidence, options.min_confidence, best_q.agreement, result.acceptance, result.evidence,
+        best_q.constraint, best_q.residual_rms, result.distinctiveness);
   }
   return result;
 }
@@ -235,10 +318,45 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
   return best;
 }
 
+KnownPart::KnownPart(const mapping::OccupancyGrid& grid, int margin) : full_(&grid) {
+  int x0 = grid.width(), y0 = grid.height(), x1 = -1, y1 = -1;
+  for (int y = 0; y < grid.height(); ++y) {
+    const int row = y * grid.width();
+    int first = -1, last = -1;
+    for (int x = 0; x < grid.width(); ++x) {
+      if (grid.state_at(row + x) == mapping::CellState::Unknown) continue;
+      if (first < 0) first = x;
+      last = x;
+    }
+    if (first < 0) continue;
+    x0 = std::min(x0, first), x1 = std::max(x1, last), y0 = std::min(y0, y), y1 = std::max(y1, y);
+  }
+  if (x1 < 0) return;  // nothing known: keep the map as it is
+  x0 = std::max(0, x0 - margin), y0 = std::max(0, y0 - margin);
+  x1 = std::min(grid.width() - 1, x1 + margin), y1 = std::min(grid.height() - 1, y1 + margin);
+  // Copying costs more than it saves unless the cut is clearly smaller.
+  if (double(x1 - x0 + 1) * double(y1 - y0 + 1) > 0.8 * double(grid.width()) * double(grid.height())) return;
+  origin_ = Eigen::Vector2i(x0, y0);
+  cut_ = crop_grid(grid, x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+}
+
+MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b) {
+  const Eigen::Vector2d oa = a.origin().cast<double>(), ob = b.origin().cast<double>();
+  // full_a = cut_a + oa, full_b = cut_b + ob: full_a = T (full_b - ob) + oa.
+  const auto move = [&](const core::Transform2& t) {
+    return core::Transform2(t.translation() + oa - t.rotation_matrix() * ob, t.rotation());
+  };
+  result.transform = move(result.transform);
+  if (result.alternative) result.alternative = move(*result.alternative);
+  result.quality.overlap_centre += oa;
+  return result;
+}
+
 MergeResult align_maps(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b, const MergeOptions& options) {
   check_merge_method(options.method);
-  const PreparedGrid pa(a, options.prepare), pb(b, options.prepare);
-  return align_prepared(pa, pb, options);
+  const KnownPart ka(a), kb(b);
+  const PreparedGrid pa(ka.grid(), options.prepare), pb(kb.grid(), options.prepare);
+  return uncut(align_prepared(pa, pb, options), ka, kb);
 }
 
 }  // namespace fleetmap::merging

@@ -26,26 +26,36 @@
 
 namespace fleetmap::merging {
 
-// confidence = agreement factor * acceptance factor * support factor * distinctiveness, each in [0, 1]:
+// confidence = agreement factor * acceptance factor * (1 - 2^(-evidence * distinctiveness / half_evidence)):
 // - agreement factor: the share of matched walls among matched + contradicting walls, mapped
-//   linearly from zero_agreement (0) to full_agreement (1);
+//   linearly from zero_agreement (0) to full_agreement (1). Two robots' maps of one building
+//   disagree on a few percent of their walls (drift, doors, glass); clutter never contradicts;
 // - acceptance factor: the wave-algorithm paper's omega over all cells known in both maps, mapped linearly from
-//   zero_acceptance (0) to full_acceptance (1). Right answers agree on nearly every common cell;
-//   two unrelated maps laid edge to edge along a wall fit their walls but not the cells beside them;
-// - support factor: AlignmentQuality::constraint / full_constraint, at most 1 (a straight wall or a
-//   single round obstacle leaves a direction free and gives 0);
+//   zero_acceptance (0) to full_acceptance (1): two maps laid edge to edge along a wall fit their
+//   walls but not the cells beside them;
+// - evidence: how many independent wall pieces pin the answer's weakest direction
+//   (AlignmentQuality::constraint), each weighted by how much better than chance it fits:
+//   ln(chance_rms / residual_rms), where residual_rms is the RMS distance of the walls that land
+//   within the contradiction distance d of the other map's walls and chance_rms the same for walls
+//   placed by chance (uniform within d: d / sqrt(3)). Walls of identical maps coincide to a third
+//   of a cell (weight ~1.7); two robots' maps with drift to 0.6-1 cell (~1), and then need more
+//   walls in common; a chance fit of similar rooms lines walls up only roughly. So the bar rises
+//   with the maps' noise instead of being a constant;
 // - distinctiveness: 1 - S2 / S1, with S1 the best candidate's score and S2 the best score of a
 //   plausible different answer (rotation off by more than distinct_rotation_deg, or displacement at
 //   the overlap centre above distinct_distance cells). Repeated or symmetric places give ~0.
 //   A different answer is plausible when its contradictions are what the best answer's own rate
 //   (at least min_contradiction_rate) predicts: with z = (c - rate n) / sqrt(rate n + 1) over its n
 //   tested walls, it counts fully for z <= 2 and not at all for z >= 4.
+// half_evidence: the evidence (times distinctiveness) at which the last factor is 0.5, set on the
+// development benchmark of robot-built maps (bench/merging_real_bench.cpp) so that the default
+// min_confidence accepts no wrong answer there; bench/README.md shows the reliability table.
 struct ConfidenceOptions {
-  double zero_agreement = 0.8;
+  double zero_agreement = 0.85;
   double full_agreement = 0.95;
-  double zero_acceptance = 0.8;
-  double full_acceptance = 0.92;
-  double full_constraint = 40.0;
+  double zero_acceptance = 0.93;
+  double full_acceptance = 0.98;
+  double half_evidence = 22.0;
   double distinct_distance = 4.0;
   double distinct_rotation_deg = 2.0;
   double min_contradiction_rate = 0.005;
@@ -62,6 +72,7 @@ struct MergeOptions {
   int fine_candidates = 4;       // candidates taken to full resolution
   int first_level_iterations = 4;  // refinement steps at the level where the candidates enter
   double sweep_step_deg = 4.0;   // `overlap`'s second pass: rotation sweep step
+  int sweep_search_cells = 64;   // ... on a level this coarse (OverlapSearchOptions::search_cells)
   // Before merging, search for other placements (b turned by quarter turns from the answer, all
   // translations) so that symmetric or repeated places lower the distinctiveness whatever method
   // proposed the answer.
@@ -81,6 +92,7 @@ struct MergeResult {
   double acceptance = 0.0;        // omega of the wave-algorithm paper, at `transform`
   double confidence = 0.0;        // in [0, 1]
   double distinctiveness = 0.0;
+  double evidence = 0.0;          // see ConfidenceOptions
   AlignmentQuality quality;
   // The best plausible different answer (what makes distinctiveness low), when there is one.
   std::optional<core::Transform2> alternative;
@@ -108,6 +120,24 @@ std::vector<std::string> merge_method_names();
 std::string merge_method_help();
 // Throws InputError naming the valid names unless `name` is one of merge_method_names().
 void check_merge_method(const std::string& name);
+
+// A map cut to the box of its known cells (with a margin), so that the search does not pay for
+// the unknown around what a robot saw (a robot's map is often allocated far larger).
+class KnownPart {
+ public:
+  explicit KnownPart(const mapping::OccupancyGrid& grid, int margin = 2);
+  const mapping::OccupancyGrid& grid() const { return cut_ ? *cut_ : *full_; }
+  // The cut's cell (0, 0) in the full map's cells.
+  const Eigen::Vector2i& origin() const { return origin_; }
+
+ private:
+  const mapping::OccupancyGrid* full_;
+  std::optional<mapping::OccupancyGrid> cut_;
+  Eigen::Vector2i origin_ = Eigen::Vector2i::Zero();
+};
+
+// A result between two cuts, expressed between the full maps' cells.
+MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b);
 
 // Aligns b to a. Never throws for hard inputs (no walls, no overlap): the result says why it did
 // not merge. Throws InputError for an unknown method name.

@@ -17,12 +17,17 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
   out.method.assign(std::size_t(n), "");
   out.reason.assign(std::size_t(n), "");
   if (n == 0) return out;
+  std::vector<std::unique_ptr<KnownPart>> parts;
   std::vector<std::unique_ptr<PreparedGrid>> prepared;
-  for (const auto* g : grids) prepared.push_back(std::make_unique<PreparedGrid>(*g, options.prepare));
+  for (const auto* g : grids) {
+    parts.push_back(std::make_unique<KnownPart>(*g));
+    prepared.push_back(std::make_unique<PreparedGrid>(parts.back()->grid(), options.prepare));
+  }
   const int total = n * (n - 1) / 2;
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
-      out.pairs.push_back({i, j, align_prepared(*prepared[std::size_t(i)], *prepared[std::size_t(j)], options)});
+      const auto si = std::size_t(i), sj = std::size_t(j);
+      out.pairs.push_back({i, j, uncut(align_prepared(*prepared[si], *prepared[sj], options), *parts[si], *parts[sj])});
       if (progress) progress(int(out.pairs.size()), total);
     }
   }

@@ -15,10 +15,11 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-int common_level(const PreparedGrid& a, const PreparedGrid& b, int cells, int max_factor) {
+int common_level(const PreparedGrid& a, const PreparedGrid& b, int cells, double max_cell_m) {
   const int top = std::min(a.level_count(), b.level_count()) - 1;
   int level = std::min(top, std::max(a.level_for_size(cells), b.level_for_size(cells)));
-  while (level > 0 && a.level(level).factor > max_factor) --level;
+  const double resolution = std::max(a.grid().resolution(), b.grid().resolution());
+  while (level > 0 && a.level(level).factor * resolution > max_cell_m + 1e-9) --level;
   return level;
 }
 
@@ -100,22 +101,24 @@ std::vector<Hypothesis> overlap_hypotheses(const PreparedGrid& a, const Prepared
 std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const PreparedGrid& b,
                                               const std::vector<double>& rotations,
                                               const OverlapSearchOptions& options) {
-  const int level = common_level(a, b, options.search_cells, options.max_factor);
+  const int level = common_level(a, b, options.search_cells, options.max_search_cell_m);
   const GridLevel& la = a.level(level);
   const GridLevel& lb = b.level(level);
   const double w = options.contradiction_weight;
 
-  // a's side of the score, transformed once: walls near walls count for, occupied cells on clear
-  // free space against.
-  const cv::Mat walls_a = as_float(la.walls), occupied_a = as_float(la.occupied);
-  cv::Mat walls_a_near;
-  cv::dilate(walls_a, walls_a_near, cv::Mat::ones(3, 3, CV_8U));
-  const cv::Mat walls_b = as_float(lb.walls), occupied_b = as_float(lb.occupied), clear_b = clear_free(lb);
+  // a's side of the score, transformed once: the free side of walls near the free side of walls
+  // counts for (walls seen from the same side: two rooms laid edge to edge along a wall do not
+  // fit), occupied cells on clear free space against.
+  // Clutter never counts against (it may have moved between the two visits).
+  const cv::Mat occupied_a = as_float(la.occupied & ~la.clutter);
+  cv::Mat band_a_near;
+  cv::dilate(as_float(la.free_band), band_a_near, cv::Mat::ones(3, 3, CV_8U));
+  const cv::Mat band_b = as_float(lb.free_band), occupied_b = as_float(lb.occupied & ~lb.clutter), clear_b = clear_free(lb);
 
   // b turned by any angle fits a D x D canvas centred on b's centre.
   const int d = int(std::ceil(std::hypot(double(lb.width()), double(lb.height())))) + 2;
   const cv::Size size(cv::getOptimalDFTSize(la.width() + d), cv::getOptimalDFTSize(la.height() + d));
-  const cv::Mat g_walls = padded_dft(walls_a_near, size);
+  const cv::Mat g_band = padded_dft(band_a_near, size);
   const cv::Mat g_clear = padded_dft(clear_free(la), size);
   const cv::Mat g_occupied = padded_dft(occupied_a, size);
   const Eigen::Vector2d centre_b((lb.width() - 1) / 2.0, (lb.height() - 1) / 2.0);
@@ -123,18 +126,18 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
   const int radius = std::max(1, options.peak_separation);
 
   std::vector<Hypothesis> out;
-  cv::Mat turned_walls, turned_occupied, turned_clear, product, product2, s;
+  cv::Mat turned_band, turned_occupied, turned_clear, product, product2, s;
   for (double theta : rotations) {
     const core::Transform2 rot(0.0, 0.0, theta);
     const Eigen::Vector2d shift = centre_canvas - rot.apply(centre_b);
     const Eigen::Matrix2d r = rot.rotation_matrix();
     const cv::Mat m = (cv::Mat_<double>(2, 3) << r(0, 0), r(0, 1), shift.x(), r(1, 0), r(1, 1), shift.y());
-    cv::warpAffine(walls_b, turned_walls, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+    cv::warpAffine(band_b, turned_band, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
     cv::warpAffine(occupied_b, turned_occupied, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
     cv::warpAffine(clear_b, turned_clear, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-    // S(t) = sum_q walls_b(q) walls_a_near(q + t)
+    // S(t) = sum_q band_b(q) band_a_near(q + t)
     //        - w sum_q [occupied_b(q) clear_a(q + t) + clear_b(q) occupied_a(q + t)], all t at once.
-    cv::mulSpectrums(g_walls, padded_dft(turned_walls, size), product, 0, true);
+    cv::mulSpectrums(g_band, padded_dft(turned_band, size), product, 0, true);
     cv::mulSpectrums(g_clear, padded_dft(turned_occupied, size), product2, 0, true);
     product -= w * product2;
     cv::mulSpectrums(g_occupied, padded_dft(turned_clear, size), product2, 0, true);

@@ -11,15 +11,15 @@
 namespace fleetmap::merging {
 
 struct OverlapSearchOptions {
-  int search_cells = 160;      // the translation search runs on the finest level whose larger side is at most this
-  // ... but never coarser than this many fine cells per cell: rooms must stay a few cells wide
-  // (8 cells of 5 cm are 40 cm), however large the map.
-  int max_factor = 8;
+  int search_cells = 96;       // the translation search runs on the finest level whose larger side is at most this
+  // ... but never on cells larger than this (metres, from the grid's resolution): rooms and doors
+  // must stay a few cells wide, however large the map.
+  double max_search_cell_m = 0.8;
   int angle_bins = 360;        // spectrum resolution over [0, pi)
   int spectrum_peaks = 4;      // correlation peaks kept; each gives the rotations theta and theta + pi
-  int translation_peaks = 6;   // correlation maxima kept per rotation (repeated places give several)
-  int peak_separation = 4;     // cells of the search level between kept maxima
-  double contradiction_weight = 1.0;  // walls on clear free space count against a translation this much
+  int translation_peaks = 8;   // correlation maxima kept per rotation (repeated places give several)
+  int peak_separation = 3;     // cells of the search level between kept maxima
+  double contradiction_weight = 3.0;  // walls on clear free space count against a translation this much
   // Besides the spectral candidates, rotations every `sweep_step_deg` (0: none). Costs time; the
   // method's second pass uses it when the spectral candidates find nothing reliable (maps without
   // dominant straight walls have flat spectra).

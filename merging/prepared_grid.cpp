@@ -9,6 +9,32 @@ namespace fleetmap::merging {
 
 namespace {
 
+// Clutter: occupied cells of components (joined across gaps of `gap` cells) whose bounding box is at
+// most `size` cells on its longer side.
+cv::Mat find_clutter(const cv::Mat& occupied, int gap, int size) {
+  cv::Mat joined;  // a new matrix: dilating into a header of `occupied` would write into it
+  if (gap > 0) cv::dilate(occupied, joined, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * gap + 1, 2 * gap + 1}));
+  else joined = occupied;
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(joined, labels, stats, centroids, 8, CV_32S);
+  std::vector<std::uint8_t> small(std::size_t(std::max(n, 1)), 0);
+  bool any = false;
+  for (int i = 1; i < n; ++i) {
+    // The dilation grew the box by `gap` on each side.
+    const int extent = std::max(stats.at<int>(i, cv::CC_STAT_WIDTH), stats.at<int>(i, cv::CC_STAT_HEIGHT)) - 2 * gap;
+    if (extent <= size) small[std::size_t(i)] = 255, any = true;
+  }
+  cv::Mat clutter = cv::Mat::zeros(occupied.size(), CV_8U);
+  if (!any) return clutter;
+  for (int y = 0; y < occupied.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    const auto* o = occupied.ptr<std::uint8_t>(y);
+    auto* c = clutter.ptr<std::uint8_t>(y);
+    for (int x = 0; x < occupied.cols; ++x) c[x] = o[x] ? small[std::size_t(l[x])] : 0;
+  }
+  return clutter;
+}
+
 // Max pooling by 2: occupied if any fine cell is; free if any is free and none is occupied.
 void downsample(const cv::Mat& occ, const cv::Mat& fre, cv::Mat& occ_out, cv::Mat& free_out) {
   const int w = (occ.cols + 1) / 2, h = (occ.rows + 1) / 2;
@@ -27,7 +53,32 @@ void downsample(const cv::Mat& occ, const cv::Mat& fre, cv::Mat& occ_out, cv::Ma
   free_out.setTo(0, occ_out);
 }
 
+// The unit direction toward the free cells within 2 cells of (x, y) (the mean of their directions,
+// each weighted 1 / distance), zero where free space lies on opposite sides or nowhere near.
+Eigen::Vector2f free_direction(const cv::Mat& free, int x, int y) {
+  constexpr int kR = 2;
+  Eigen::Vector2f sum = Eigen::Vector2f::Zero();
+  float weight = 0.0f;
+  for (int dy = -kR; dy <= kR; ++dy) {
+    const int yy = y + dy;
+    if (yy < 0 || yy >= free.rows) continue;
+    const auto* row = free.ptr<std::uint8_t>(yy);
+    for (int dx = -kR; dx <= kR; ++dx) {
+      const int xx = x + dx;
+      if (xx < 0 || xx >= free.cols || (dx == 0 && dy == 0) || row[xx] == 0) continue;
+      const float d2 = float(dx * dx + dy * dy);
+      sum += Eigen::Vector2f(float(dx), float(dy)) / d2;
+      weight += 1.0f / std::sqrt(d2);
+    }
+  }
+  // Free space on one side only gives |sum| near weight; on two opposite sides, near 0.
+  const float n = sum.norm();
+  return weight > 0.0f && n >= 0.5f * weight ? Eigen::Vector2f(sum / n) : Eigen::Vector2f::Zero();
+}
+
+// `level.clutter` must be set (or empty: none).
 void finish_level(GridLevel& level, const PrepareOptions& options) {
+  if (level.clutter.empty()) level.clutter = cv::Mat::zeros(level.occupied.size(), CV_8U);
   // Walls: occupied cells touching free space (8-neighbourhood).
   cv::Mat free_near;
   cv::dilate(level.free, free_near, cv::Mat::ones(3, 3, CV_8U));
@@ -55,7 +106,16 @@ void finish_level(GridLevel& level, const PrepareOptions& options) {
   std::vector<cv::Point> pts;
   cv::findNonZero(level.walls, pts);
   sample(pts, level.wall_points);
-  cv::Mat interior = level.occupied & ~level.walls;
+  cv::Mat occupied_near;
+  cv::dilate(level.occupied, occupied_near, cv::Mat::ones(3, 3, CV_8U));
+  level.free_band = level.free & occupied_near;
+  level.wall_normals.clear();
+  level.wall_clutter.clear();
+  for (const auto& p : level.wall_points) {
+    level.wall_normals.push_back(free_direction(level.free, int(p.x()), int(p.y())));
+    level.wall_clutter.push_back(level.clutter.at<std::uint8_t>(int(p.y()), int(p.x())) != 0);
+  }
+  cv::Mat interior = level.occupied & ~level.walls & ~level.clutter;
   pts.clear();
   cv::findNonZero(interior, pts);
   std::vector<cv::Point> even;
@@ -128,12 +188,22 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
       }
     }
   }
+  const double resolution = grid.resolution() > 0.0 ? grid.resolution() : 0.05;
+  // Gaps of two cells at least: a thin wall turned and resampled on another grid breaks every few cells.
+  base.clutter = find_clutter(base.occupied, std::max(2, int(std::lround(options.clutter_gap_m / resolution))),
+                              int(std::lround(options.clutter_size_m / resolution)));
   finish_level(base, options);
   levels_.push_back(std::move(base));
   while (std::max(levels_.back().width(), levels_.back().height()) / 2 >= options.min_level_size) {
     GridLevel next;
     next.factor = levels_.back().factor * 2;
-    downsample(levels_.back().occupied, levels_.back().free, next.occupied, next.free);
+    const GridLevel& prev = levels_.back();
+    downsample(prev.occupied, prev.free, next.occupied, next.free);
+    // A coarse cell is clutter when its occupied fine cells all are.
+    cv::Mat pooled_clutter, pooled_structure, unused;
+    downsample(prev.clutter, prev.free, pooled_clutter, unused);
+    downsample(prev.occupied & ~prev.clutter, prev.free, pooled_structure, unused);
+    next.clutter = pooled_clutter & ~pooled_structure;
     finish_level(next, options);
     levels_.push_back(std::move(next));
   }
@@ -164,6 +234,8 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
         syy / n - (sy / n) * (sy / n);
     const double trace = c.trace();
     if (trace > 1e-9) w.structure = (Eigen::Matrix2d::Identity() - c / trace).cast<float>();
+    w.normal = free_direction(l0.free, p.x, p.y);
+    w.clutter = l0.clutter.at<std::uint8_t>(p.y, p.x) != 0;
     walls_.push_back(w);
   }
 }

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -26,6 +27,16 @@ struct GridLevel {
   cv::Mat walls;               // occupied cells with a free 8-neighbour
   cv::Mat wall_distance;       // CV_32F: distance in cells from each cell centre to the nearest wall cell
   std::vector<Eigen::Vector2f> wall_points;  // centres of the wall cells (subsampled on big maps)
+  // For each wall point, the unit direction toward the free space it was seen from (zero where
+  // free space lies on several sides): two maps agree on a wall only when they saw it from the
+  // same side. Without it, two maps of neighbouring rooms laid edge to edge along their common
+  // wall would fit as well as the right answer.
+  std::vector<Eigen::Vector2f> wall_normals;
+  cv::Mat free_band;           // free cells next to a wall (8-neighbourhood): the walls' seen side
+  // Occupied cells of small obstacles standing alone (PrepareOptions::clutter_size_m): people,
+  // chairs, what moves between two visits. They may match the other map but never contradict it.
+  cv::Mat clutter;
+  std::vector<std::uint8_t> wall_clutter;  // per wall point: 1 when it is clutter
   // Centres of occupied cells that are not walls (inside filled obstacles), every second row and
   // column: on the other map's clear free space they contradict an alignment too.
   std::vector<Eigen::Vector2f> interior_points;
@@ -51,14 +62,36 @@ inline int nearest_cell(double v) { return v >= -0.5 ? int(v + 0.5) : -1; }
 struct WallPoint {
   Eigen::Vector2f position = Eigen::Vector2f::Zero();
   Eigen::Matrix2f structure = Eigen::Matrix2f::Identity() * 0.5f;
+  Eigen::Vector2f normal = Eigen::Vector2f::Zero();  // toward the side it was seen from (GridLevel::wall_normals)
+  bool clutter = false;                              // part of a small obstacle (GridLevel::clutter)
 };
+
+// Whether a wall point of one map, moved to `p` with its normal turned to `n`, was seen from the
+// side where `target` has free space: some cell of the 3 x 3 block `distance` cells along the
+// normal is free there (a block, not a cell: far beams leave unknown gaps between free rays). A
+// point without a normal passes.
+inline bool seen_from_same_side(const GridLevel& target, const Eigen::Vector2f& p, const Eigen::Vector2f& n,
+                                float distance = 2.0f) {
+  if (n.x() == 0.0f && n.y() == 0.0f) return true;
+  const Eigen::Vector2f q = p + distance * n;
+  const int cx = nearest_cell(q.x()), cy = nearest_cell(q.y());
+  for (int y = std::max(0, cy - 1); y <= std::min(target.height() - 1, cy + 1); ++y)
+    for (int x = std::max(0, cx - 1); x <= std::min(target.width() - 1, cx + 1); ++x)
+      if (target.is_free(x, y)) return true;
+  return false;
+}
 
 struct PrepareOptions {
   // Occupied specks smaller than this (8-connected cells) are noise: left out as unknown. Both
   // robots see a real obstacle; a speck seen by one only would count against a right alignment.
   int min_obstacle_cells = 3;
   int min_level_size = 24;         // stop the pyramid when the larger side would drop below this
-  int max_refine_points = 6000;    // wall points kept per level for refinement (evenly subsampled)
+  int max_refine_points = 3000;    // wall points kept per level for refinement (evenly subsampled)
+  // Clutter: obstacles whose occupied cells, joined across gaps of up to clutter_gap_m (at least 2
+  // cells: the dotted walls of far or grazing beams, thin walls resampled on a turned grid), span
+  // at most clutter_size_m. Metres, from the grid's resolution.
+  double clutter_size_m = 0.5;
+  double clutter_gap_m = 0.1;
 };
 
 // Keeps a reference to `grid`, which must outlive it.

@@ -21,15 +21,16 @@ void collect(const GridLevel& from, const GridLevel& to, const core::Transform2&
   const Eigen::Matrix2f r = t.rotation_matrix().cast<float>();
   const Eigen::Vector2f tr = t.translation().cast<float>();
   constexpr float kFar = 1e4f;
-  for (const auto& w : from.wall_points) {
-    const Eigen::Vector2f p = r * w + tr;
+  for (std::size_t i = 0; i < from.wall_points.size(); ++i) {
+    const Eigen::Vector2f p = r * from.wall_points[i] + tr;
     const int x = nearest_cell(p.x()), y = nearest_cell(p.y());
     if (x < 0 || y < 0 || x >= to.width() || y >= to.height() || !to.known(x, y)) continue;
     float gx = 0.0f, gy = 0.0f;
     const float d = to.distance_gradient_at(p.x(), p.y(), kFar, gx, gy);
+    if (d >= 2.5f && !from.wall_clutter[i] && to.is_free(x, y)) ++outliers;
+    // A wall of the other map seen from the other side attracts nothing.
+    if (d > cutoff || !seen_from_same_side(to, p, r * from.wall_normals[i])) continue;
     if (d <= 1.0f) ++inliers;
-    else if (d >= 2.5f && to.is_free(x, y)) ++outliers;
-    if (d > cutoff) continue;
     Residual res;
     res.position = to_a.apply(p.cast<double>());
     res.gradient = Eigen::Vector2d(gx, gy);

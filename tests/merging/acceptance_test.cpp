@@ -64,5 +64,19 @@ TEST(AlignmentQuality, AStraightWallLeavesADirectionFree) {
   EXPECT_NEAR(q.constraint, 0.0, 1.0);
 }
 
+// Two rooms on either side of one wall: laid edge to edge along it, each map's wall lies on the
+// other's wall, but one robot saw it from the left and the other from the right. That is no match
+// (else neighbouring rooms would fit each other as well as the right answer does).
+TEST(AlignmentQuality, WallsSeenFromOppositeSidesDoNotMatch) {
+  std::vector<std::string> left(30, std::string(30, '?')), right = left;
+  for (auto& r : left) r.replace(0, 15, std::string(14, '.') + "#");
+  for (auto& r : right) r.replace(14, 16, "#" + std::string(15, '.'));
+  const PreparedGrid a(grid_from_text(left)), b(grid_from_text(right)), same(grid_from_text(left));
+  const AlignmentQuality opposite = evaluate_alignment(a, b, core::Transform2::identity());
+  const AlignmentQuality seen_alike = evaluate_alignment(a, same, core::Transform2::identity());
+  EXPECT_GT(seen_alike.matched, 40);  // the 30-cell wall, from both maps
+  EXPECT_EQ(opposite.matched, 0);
+}
+
 }  // namespace
 }  // namespace fleetmap::merging

@@ -4,6 +4,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "merging/acceptance.h"
 #include "tests/merging/merging_test_support.h"
 
 namespace fleetmap::merging {
@@ -13,7 +14,9 @@ using testing::grid_from_text;
 
 TEST(PreparedGrid, WallsAreOccupiedCellsNextToFreeOnes) {
   const auto g = grid_from_text({".....", ".###.", ".###.", ".###.", "....."});
-  const PreparedGrid p(g);
+  PrepareOptions no_clutter;  // the block is small enough to be clutter: here it is structure
+  no_clutter.clutter_size_m = 0.0;
+  const PreparedGrid p(g, no_clutter);
   // The 3 x 3 block has 8 boundary cells; its centre is interior.
   EXPECT_EQ(p.walls().size(), 8u);
   EXPECT_EQ(p.level(0).interior_points.size(), 1u);  // (2, 2): both coordinates even
@@ -30,6 +33,33 @@ TEST(PreparedGrid, SpecksAreNoise) {
   PrepareOptions keep;
   keep.min_obstacle_cells = 1;
   EXPECT_EQ(PreparedGrid(grid_from_text(rows), keep).walls().size(), 13u);
+}
+
+// A chair or a person (a blob of 0.15 m standing alone) is clutter; a wall, and a blob touching
+// it, are not. Clutter walls never contradict the other map: it may have moved between visits.
+TEST(PreparedGrid, SmallLoneObstaclesAreClutterAndNeverContradict) {
+  std::vector<std::string> rows(40, std::string(40, '.'));
+  rows[30] = std::string(40, '#');                          // a wall, 2 m long
+  for (int r = 10; r < 13; ++r) rows[std::size_t(r)].replace(10, 3, "###");  // a chair in the open
+  for (int r = 27; r < 30; ++r) rows[std::size_t(r)].replace(25, 3, "###");  // a cupboard against the wall
+  const auto with = grid_from_text(rows);
+  const PreparedGrid p(with);
+  const GridLevel& l0 = p.level(0);
+  const auto clutter_at = [&](int x, int row) { return l0.clutter.at<std::uint8_t>(39 - row, x) != 0; };
+  EXPECT_TRUE(clutter_at(11, 11));
+  EXPECT_FALSE(clutter_at(5, 30));
+  EXPECT_FALSE(clutter_at(26, 28));
+  // The same room without the chair: the chair lies on its clear free space.
+  for (int r = 10; r < 13; ++r) rows[std::size_t(r)].replace(10, 3, "...");
+  const PreparedGrid empty(grid_from_text(rows));
+  const AlignmentQuality q = evaluate_alignment(empty, p, core::Transform2::identity());
+  EXPECT_EQ(q.contradicted, 0);
+  EXPECT_GT(q.matched, 60);
+  // Without the clutter rule the chair contradicts.
+  PrepareOptions no_clutter;
+  no_clutter.clutter_size_m = 0.0;
+  const PreparedGrid strict(with, no_clutter);
+  EXPECT_GT(evaluate_alignment(empty, strict, core::Transform2::identity()).contradicted, 0);
 }
 
 TEST(PreparedGrid, PyramidKeepsThinWalls) {

@@ -1,0 +1,717 @@
+// Merging maps that robots built: fleetmap's `merge` beside the feature-based peer of the ROS
+// `multirobot_map_merge` package, on the same pairs, as a program that prints markdown for
+// bench/README.md (and, with --csv, one row per pair and method).
+//
+// The maps: one simulated robot explores each of the floor plans of HouseExpo (Li et al. 2019,
+// ../shared/datasets/houseexpo) with visible odometry noise, a noisy laser of 180 to 720 beams
+// (ray fans at range) and `scan-matching` or `rbpf` localization, so its map has the thin broken
+// walls, speckle and drift of a real one; the maps are cached in --cache. Plans too small to fill
+// a 300-cell window at 0.05 m are explored at 0.025 m. The built-in `campus` (1200 x 1200 at
+// 0.1 m) gives the 1000 x 1000 windows, and campus at 0.025 m the 4000 x 4000 ones.
+//
+// The pairs (the protocol of the ROS comparison): window `a` is axis-aligned; window `b`, of the
+// same size, is turned by a uniform random angle and shifted until the stated share of the known
+// cells of the smaller of the two lies in both (merging::OverlapMeasure::Known). Each window then
+// gets its own clutter (specks and small blobs on free space: people, chairs moved between the
+// two visits). Unrelated pairs: windows of two different plans. Success: merged, and b's known
+// cells lie on average within 2 cells of where the truth puts them (the error reported). A wrong
+// merge is any other merge.
+//
+// The peer, as `multirobot_map_merge` (Horner 2016) does it with OpenCV: the grid's raw
+// occupancy values as an image (free 0, occupied 100, unknown 255), ORB (1500 features, scale
+// 1.3, 5 levels: its OrbFeaturesFinder), nearest two descriptors with Lowe's ratio test both ways
+// (match_conf 0.3: ratio 0.7; BestOf2NearestMatcher), cv::estimateAffinePartial2D with RANSAC
+// (3 pixels), and the confidence inliers / (8 + 0.3 matches) of Brown & Lowe 2007, accepted at
+// 1.0 (its `estimation_confidence` default). Its rule that zeroes a confidence above 3 (images
+// too alike, from panorama stitching) is left out, in the peer's favour.
+//
+// Times are the thread's CPU time per pair (alignment only; windows are cut outside the timing),
+// with OpenCV held to one thread.
+#include <fmt/format.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/angle.h"
+#include "core/error.h"
+#include "core/random.h"
+#include "maps/builtin_maps.h"
+#include "io/map_io.h"
+#include "merging/evaluation.h"
+#include "merging/merge.h"
+#include "sim/simulation.h"
+
+namespace {
+
+using namespace fleetmap;
+namespace fs = std::filesystem;
+
+// --- options -------------------------------------------------------------------------------
+
+struct Args {
+  fs::path plans = fs::path(FLEETMAP_SOURCE_DIR) / ".." / "shared" / "datasets" / "houseexpo";
+  fs::path cache = fs::path(FLEETMAP_BINARY_DIR) / "merging_real_cache";
+  std::string csv;
+  fs::path dump;             // writes each pair's maps here (a_<k>.png, b_<k>.png) when given
+  std::vector<int> only;     // run only these pair numbers (as in the CSV)
+  int pairs = 40;            // 300 x 300 pairs per overlap
+  int campus_pairs = 10;     // 1000 x 1000 pairs per overlap
+  int unrelated = 200;       // pairs of windows of different plans
+  int large_pairs = 4;       // 4000 x 4000 pairs (time)
+  int two_robots = 10;       // 300 x 300 pairs per overlap with a and b from two robots' maps of one plan
+  std::vector<double> overlaps = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
+  std::string method = "auto";
+  double min_confidence = merging::MergeOptions{}.min_confidence;
+  bool peer = true;
+  double clutter = 1.0;      // scales the clutter rates (0: none)
+  std::uint64_t seed = 1;
+};
+
+[[noreturn]] void usage(const std::string& problem) {
+  std::cerr << "fleetmap_bench_merging_real: " << problem << "\n"
+            << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
+            << "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
+            << "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S]\n";
+  std::exit(2);
+}
+
+Args parse_args(int argc, char** argv) {
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    const std::string k = argv[i];
+    const auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usage(k + " needs a value");
+      return argv[++i];
+    };
+    const auto number = [&](const std::string& v) {
+      try {
+        return std::stod(v);
+      } catch (const std::exception&) {
+        usage(k + ": '" + v + "' is not a number");
+      }
+    };
+    if (k == "--plans") a.plans = value();
+    else if (k == "--cache") a.cache = value();
+    else if (k == "--csv") a.csv = value();
+    else if (k == "--dump") a.dump = value();
+    else if (k == "--only") {
+      const std::string list = value();
+      for (std::size_t p = 0; p <= list.size();) {
+        const std::size_t q = std::min(list.find(',', p), list.size());
+        a.only.push_back(int(number(list.substr(p, q - p))));
+        p = q + 1;
+      }
+    }
+    else if (k == "--pairs") a.pairs = int(number(value()));
+    else if (k == "--campus-pairs") a.campus_pairs = int(number(value()));
+    else if (k == "--unrelated") a.unrelated = int(number(value()));
+    else if (k == "--large-pairs") a.large_pairs = int(number(value()));
+    else if (k == "--two-robots") a.two_robots = int(number(value()));
+    else if (k == "--method") a.method = value();
+    else if (k == "--min-confidence") a.min_confidence = number(value());
+    else if (k == "--no-peer") a.peer = false;
+    else if (k == "--clutter") a.clutter = number(value());
+    else if (k == "--seed") a.seed = std::uint64_t(number(value()));
+    else if (k == "--overlaps") {
+      a.overlaps.clear();
+      std::string list = value();
+      for (std::size_t p = 0; p <= list.size();) {
+        const std::size_t q = std::min(list.find(',', p), list.size());
+        a.overlaps.push_back(number(list.substr(p, q - p)));
+        p = q + 1;
+      }
+    } else usage("unknown option " + k);
+  }
+  return a;
+}
+
+double thread_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// --- robot-built maps ---------------------------------------------------------------------
+
+// How one plan is explored: drawn from the plan's index, so the set is the same on every run.
+struct MapRecipe {
+  double resolution = 0.05;
+  int beams = 360;
+  double max_range = 8.0;
+  double range_noise = 0.02;
+  double motion_noise = 0.02;       // m per step
+  double heading_noise_deg = 1.0;   // per step
+  std::string localization = "scan-matching";
+  std::string text() const {
+    return fmt::format("{} m cells, {} beams to {} m (sigma {:.3f} m), odometry noise {:.3f} m / {:.2f} deg per step, {}",
+                       resolution, beams, max_range, range_noise, motion_noise, heading_noise_deg, localization);
+  }
+};
+
+MapRecipe recipe_for(int index, std::int64_t free_cells) {
+  core::Random r(7000 + std::uint64_t(index));
+  MapRecipe m;
+  // A window of 300 cells at 0.05 m is 15 m: small flats are explored at 0.025 m so that windows
+  // still show rooms, as a finer SLAM grid would.
+  m.resolution = free_cells >= 40000 ? 0.05 : 0.025;
+  const int beams[] = {180, 360, 720};
+  m.beams = beams[r.uniform_int(0, 2)];
+  m.max_range = r.bernoulli(0.5) ? 4.0 : 8.0;
+  m.range_noise = r.uniform(0.01, 0.04);
+  m.motion_noise = r.uniform(0.01, 0.03);
+  m.heading_noise_deg = r.uniform(0.5, 1.5);
+  m.localization = index % 5 == 4 ? "rbpf" : "scan-matching";
+  return m;
+}
+
+// Every cell split into factor x factor cells.
+mapping::OccupancyGrid refine_grid(const mapping::OccupancyGrid& g, int factor) {
+  const auto& geo = g.geometry();
+  mapping::OccupancyGrid out(core::GridGeometry(geo.resolution() / factor, geo.width() * factor, geo.height() * factor,
+                                                geo.origin()),
+                             g.options());
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) out.set_log_odds({x, y}, g.log_odds({x / factor, y / factor}));
+  return out;
+}
+
+// A start in the largest free region of the plan, at least 0.4 m from walls (a random start may
+// fall in a closet-sized pocket between walls), drawn with `random`.
+core::Pose2 start_in_largest_room(const mapping::OccupancyGrid& truth, core::Random& random) {
+  cv::Mat free(truth.height(), truth.width(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < truth.height(); ++y)
+    for (int x = 0; x < truth.width(); ++x)
+      if (truth.state({x, y}) == mapping::CellState::Free) free.at<std::uint8_t>(y, x) = 255;
+  cv::Mat labels, stats, centroids, clearance;
+  const int n = cv::connectedComponentsWithStats(free, labels, stats, centroids, 4, CV_32S);
+  int best = 1;
+  for (int i = 2; i < n; ++i)
+    if (stats.at<int>(i, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = i;
+  cv::distanceTransform(free, clearance, cv::DIST_L2, 3);
+  std::vector<core::Cell> cells;
+  const double min_clearance = 0.4 / truth.resolution();
+  for (int y = 0; y < truth.height(); ++y)
+    for (int x = 0; x < truth.width(); ++x)
+      if (labels.at<int>(y, x) == best && clearance.at<float>(y, x) >= min_clearance) cells.push_back({x, y});
+  if (cells.empty()) throw Error("no free place 0.4 m from walls for a robot to start");
+  const core::Cell c = cells[std::size_t(random.uniform_int(0, int(cells.size()) - 1))];
+  const Eigen::Vector2d p = truth.geometry().cell_center(c);
+  return {p.x(), p.y(), random.uniform(-std::numbers::pi, std::numbers::pi)};
+}
+
+struct PlanMap {
+  std::string id;
+  MapRecipe recipe;
+  mapping::OccupancyGrid map;
+  double position_rmse_m = 0.0;
+  double coverage = 0.0;
+};
+
+constexpr const char* kCacheVersion = "v2";
+
+// `robot` 0 and 1: two robots exploring the same plan alone, from different starts with different
+// noise (the second map of a plan, for pairs of two robots' maps).
+PlanMap build_plan_map(const fs::path& plan_yaml, int index, int robot, const fs::path& cache) {
+  PlanMap p{plan_yaml.stem().string(), {}, mapping::OccupancyGrid(core::GridGeometry(0.05, 1, 1)), 0.0, 0.0};
+  const fs::path stem = cache / fmt::format("{}-{}{}", p.id, kCacheVersion, robot == 0 ? "" : "-r2");
+  mapping::OccupancyGrid truth = io::load_map(plan_yaml);
+  p.recipe = recipe_for(index, truth.count(mapping::CellState::Free));
+  if (fs::exists(stem.string() + ".yaml") && fs::exists(stem.string() + ".txt")) {
+    p.map = io::load_map(stem.string() + ".yaml");
+    std::ifstream in(stem.string() + ".txt");
+    in >> p.position_rmse_m >> p.coverage >> p.recipe.beams;
+    return p;
+  }
+  if (p.recipe.resolution < truth.resolution() - 1e-9) truth = refine_grid(truth, int(std::lround(truth.resolution() / p.recipe.resolution)));
+  // The explorer stops at once when sparse far beams leave no frontier it can use (seen with
+  // 180 beams on 0.025 m cells): such a plan is explored again with twice the beams.
+  core::Random start_random(9000 + std::uint64_t(index) + 1000 * std::uint64_t(robot));
+  const core::Pose2 start = start_in_largest_room(truth, start_random);
+  for (;;) {
+    sim::Scenario s;
+    s.map = plan_yaml.string();
+    s.seed = std::uint64_t(index) + 1 + 1000 * std::uint64_t(robot);
+    s.robot_count = 1;
+    s.placement = sim::Placement::List;
+    s.starts = {start};
+    s.noise.position_m = p.recipe.motion_noise;
+    s.noise.heading_rad = core::deg2rad(p.recipe.heading_noise_deg);
+    s.range.beams = p.recipe.beams;
+    s.range.max_range_m = p.recipe.max_range;
+    s.range.noise_m = p.recipe.range_noise;
+    s.localization = p.recipe.localization;
+    s.localization_options.rbpf_particles = 15;
+    s.steps = 1500;
+    sim::Simulation simulation(s, truth);
+    const sim::RunResult r = simulation.run();
+    p.map = r.robot_maps.front();
+    const auto& t = r.robots.front();
+    double se = 0.0;
+    for (std::size_t k = 0; k < t.truth.size(); ++k) se += (t.truth[k].position() - t.estimate[k].position()).squaredNorm();
+    p.position_rmse_m = t.truth.empty() ? 0.0 : std::sqrt(se / double(t.truth.size()));
+    p.coverage = r.coverage.empty() ? 0.0 : r.coverage.back();
+    if (p.coverage >= 0.8 || p.recipe.beams >= 1440) break;
+    p.recipe.beams *= 2;
+  }
+  fs::create_directories(cache);
+  io::save_map_yaml(p.map, stem.string() + ".yaml");
+  std::ofstream(stem.string() + ".txt") << p.position_rmse_m << " " << p.coverage << " " << p.recipe.beams << "\n";
+  return p;
+}
+
+// --- clutter --------------------------------------------------------------------------------
+
+// What changes between two visits and what a laser sees wrongly: occupied specks on free space
+// (rate per free cell) and small blobs (a person's legs, a chair: 2-9 cells) on free space.
+void add_clutter(mapping::OccupancyGrid& g, double speck_rate, double blobs_per_1000_free, core::Random& random) {
+  std::vector<core::Cell> free;
+  for (int y = 0; y < g.height(); ++y)
+    for (int x = 0; x < g.width(); ++x)
+      if (g.state({x, y}) == mapping::CellState::Free) free.push_back({x, y});
+  if (free.empty()) return;
+  for (const auto& c : free)
+    if (random.bernoulli(speck_rate)) g.set_state(c, mapping::CellState::Occupied);
+  const int blobs = int(std::lround(blobs_per_1000_free * double(free.size()) / 1000.0));
+  for (int i = 0; i < blobs; ++i) {
+    const core::Cell c = free[std::size_t(random.uniform_int(0, int(free.size()) - 1))];
+    if (random.bernoulli(0.5)) {  // a disc
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (std::abs(dx) + std::abs(dy) <= 1 && g.contains({c.x + dx, c.y + dy})) g.set_state({c.x + dx, c.y + dy}, mapping::CellState::Occupied);
+    } else {  // a short bar
+      const double a = random.uniform(0.0, std::numbers::pi);
+      const int len = random.uniform_int(2, 8);
+      for (int k = 0; k < len; ++k) {
+        const core::Cell q{int(std::lround(c.x + k * std::cos(a))), int(std::lround(c.y + k * std::sin(a)))};
+        if (g.contains(q)) g.set_state(q, mapping::CellState::Occupied);
+      }
+    }
+  }
+}
+
+double clutter_scale = 1.0;
+
+void clutter_pair(mapping::OccupancyGrid& a, mapping::OccupancyGrid& b, core::Random& random) {
+  for (auto* g : {&a, &b})
+    add_clutter(*g, clutter_scale * random.uniform(0.0, 0.0005), clutter_scale * random.uniform(0.0, 0.2), random);
+}
+
+// --- the peer --------------------------------------------------------------------------------
+
+struct PeerResult {
+  bool merged = false;
+  std::optional<Eigen::Matrix<double, 2, 3>> b_to_a;
+  double confidence = 0.0;
+  int matches = 0, inliers = 0;
+};
+
+cv::Mat ros_image(const mapping::OccupancyGrid& g) {
+  // nav_msgs/OccupancyGrid data as the ROS merger reads it: -1 unknown (255 as bytes), 0 free, 100 occupied.
+  cv::Mat img(g.height(), g.width(), CV_8U);
+  for (int y = 0; y < g.height(); ++y) {
+    auto* row = img.ptr<std::uint8_t>(y);
+    for (int x = 0; x < g.width(); ++x) {
+      const auto s = g.state_at(y * g.width() + x);
+      row[x] = s == mapping::CellState::Unknown ? 255 : s == mapping::CellState::Free ? 0 : 100;
+    }
+  }
+  return img;
+}
+
+PeerResult orb_peer(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b) {
+  PeerResult out;
+  const auto orb = cv::ORB::create(1500, 1.3f, 5);
+  std::vector<cv::KeyPoint> ka, kb;
+  cv::Mat da, db;
+  orb->detectAndCompute(ros_image(a), cv::noArray(), ka, da);
+  orb->detectAndCompute(ros_image(b), cv::noArray(), kb, db);
+  if (da.empty() || db.empty()) return out;
+  cv::BFMatcher matcher(cv::NORM_HAMMING);
+  std::vector<std::pair<int, int>> pairs;  // (b, a)
+  constexpr float kRatio = 0.7f;           // 1 - match_conf
+  std::vector<std::vector<cv::DMatch>> knn;
+  matcher.knnMatch(db, da, knn, 2);
+  for (const auto& m : knn)
+    if (m.size() == 2 && m[0].distance < kRatio * m[1].distance) pairs.emplace_back(m[0].queryIdx, m[0].trainIdx);
+  knn.clear();
+  matcher.knnMatch(da, db, knn, 2);
+  for (const auto& m : knn) {
+    if (m.size() < 2 || !(m[0].distance < kRatio * m[1].distance)) continue;
+    const std::pair<int, int> p(m[0].trainIdx, m[0].queryIdx);
+    if (std::find(pairs.begin(), pairs.end(), p) == pairs.end()) pairs.push_back(p);
+  }
+  out.matches = int(pairs.size());
+  if (out.matches < 6) return out;
+  std::vector<cv::Point2f> src, dst;
+  for (const auto& [ib, ia] : pairs) {
+    src.push_back(kb[std::size_t(ib)].pt);
+    dst.push_back(ka[std::size_t(ia)].pt);
+  }
+  std::vector<std::uint8_t> inliers;
+  const cv::Mat h = cv::estimateAffinePartial2D(src, dst, inliers, cv::RANSAC, 3.0);
+  if (h.empty()) return out;
+  out.inliers = int(std::count(inliers.begin(), inliers.end(), std::uint8_t(1)));
+  out.confidence = out.inliers / (8.0 + 0.3 * out.matches);
+  Eigen::Matrix<double, 2, 3> m;
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 3; ++c) m(r, c) = h.at<double>(r, c);
+  out.b_to_a = m;
+  out.merged = out.confidence >= 1.0;
+  return out;
+}
+
+// --- pairs and records --------------------------------------------------------------------
+
+struct Pair {
+  std::string set;       // "house300", "campus1000", "campus4000", "unrelated"
+  std::string source;    // plan id(s)
+  double overlap = 0.0;  // 0 for unrelated
+  mapping::OccupancyGrid a, b;
+  std::optional<core::Transform2> truth;
+  // Where a success must land (mean displacement under 2 cells): the truth, or for two robots'
+  // maps the best fit of the two maps next to the truth (each map is off the world by its own
+  // drift, up to several cells): the common refinement started at the truth.
+  std::optional<core::Transform2> reference;
+};
+
+// The fit of b to a next to `truth`: fleetmap's refinement from the truth, coarse to fine from cells
+// of 4 x 4 fine cells.
+core::Transform2 fit_near(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b, const core::Transform2& truth) {
+  const merging::KnownPart ka(a), kb(b);
+  const merging::PreparedGrid pa(ka.grid()), pb(kb.grid());
+  const Eigen::Vector2d oa = ka.origin().cast<double>(), ob = kb.origin().cast<double>();
+  // In the cuts' cells: cut_a = T (cut_b + ob) + t - oa.
+  const core::Transform2 cut(truth.translation() + truth.rotation_matrix() * ob - oa, truth.rotation());
+  merging::MergeResult r;
+  r.transform = merging::refine_alignment(pa, pb, cut, 2).b_to_a;
+  return merging::uncut(r, ka, kb).transform;
+}
+
+struct Outcome {
+  bool merged = false;
+  bool found = false;          // the answer (merged or not) is within 2 cells
+  double error = -1.0;         // mean displacement of b's known cells, cells (-1: no answer or no truth)
+  double confidence = 0.0;
+  double cpu_s = 0.0, wall_s = 0.0;
+  std::string detail;          // for the CSV
+};
+
+struct Record {
+  const Pair* pair = nullptr;
+  Outcome fleetmap, peer;
+};
+
+constexpr double kSuccessCells = 2.0;
+
+Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
+  Outcome o;
+  const auto w0 = std::chrono::steady_clock::now();
+  const double c0 = thread_seconds();
+  const merging::MergeResult r = merging::align_maps(p.a, p.b, options);
+  o.cpu_s = thread_seconds() - c0;
+  o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  o.merged = r.merged;
+  o.confidence = r.confidence;
+  if (p.truth && r.candidates > 0) {
+    o.error = merging::mean_displacement(r.transform, p.reference.value_or(*p.truth), p.b);
+    o.found = o.error < kSuccessCells;
+  }
+  const merging::Acceptance acc = merging::acceptance_index(p.a, p.b, r.transform);
+  o.detail = fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};{}",
+                         r.method, r.quality.agreement, r.acceptance, r.quality.constraint, r.distinctiveness,
+                         r.quality.matched, r.quality.contradicted, r.quality.tested, r.quality.overlap_radius,
+                         acc.common(), acc.disagree, r.quality.residual_rms, r.reason);
+  return o;
+}
+
+Outcome run_peer(const Pair& p) {
+  Outcome o;
+  const auto w0 = std::chrono::steady_clock::now();
+  const double c0 = thread_seconds();
+  const PeerResult r = orb_peer(p.a, p.b);
+  o.cpu_s = thread_seconds() - c0;
+  o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  o.merged = r.merged;
+  o.confidence = r.confidence;
+  if (p.truth && r.b_to_a) {
+    o.error = merging::mean_displacement(*r.b_to_a, p.reference.value_or(*p.truth), p.b);
+    o.found = o.error < kSuccessCells;
+  }
+  o.detail = fmt::format("matches={};inliers={}", r.matches, r.inliers);
+  return o;
+}
+
+bool success(const Outcome& o) { return o.merged && o.found; }
+bool wrong(const Outcome& o) { return o.merged && !o.found; }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string ms(double s) { return std::isnan(s) ? "-" : s < 0.01 ? fmt::format("{:.1f} ms", 1e3 * s) : fmt::format("{:.0f} ms", 1e3 * s); }
+std::string cells(double c) { return std::isnan(c) ? "-" : fmt::format("{:.2f}", c); }
+
+// One row: success n/N (%), wrong, median error of successes, median CPU time.
+std::string summary(const std::vector<const Outcome*>& os) {
+  int n = 0, ok = 0, bad = 0;
+  std::vector<double> err, t;
+  for (const auto* o : os) {
+    ++n;
+    ok += success(*o);
+    bad += wrong(*o);
+    if (success(*o)) err.push_back(o->error);
+    t.push_back(o->cpu_s);
+  }
+  return fmt::format("{:.0f}% ({}/{}), {} wrong, {} c, {}", n ? 100.0 * ok / n : 0.0, ok, n, bad, cells(median(err)),
+                     ms(median(t)));
+}
+
+// --- main ------------------------------------------------------------------------------------
+
+int overlap_percent(double f) { return int(std::lround(100.0 * f)); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Args args = parse_args(argc, argv);
+  clutter_scale = args.clutter;
+  cv::setNumThreads(1);
+  try {
+    merging::MergeOptions options;
+    options.method = args.method;
+    options.min_confidence = args.min_confidence;
+    merging::check_merge_method(options.method);
+
+    // The robot-built maps.
+    std::vector<fs::path> plans;
+    if (!fs::is_directory(args.plans)) usage("--plans: " + args.plans.string() + " is not a folder");
+    for (const auto& e : fs::directory_iterator(args.plans))
+      if (e.path().extension() == ".yaml") plans.push_back(e.path());
+    std::sort(plans.begin(), plans.end());
+    if (plans.size() < 2) usage("--plans: " + args.plans.string() + " holds fewer than two map_server YAML plans");
+    std::vector<PlanMap> maps, second;
+    for (std::size_t i = 0; i < plans.size(); ++i) {
+      std::cerr << fmt::format("\rmaps: {}/{} {}      ", i + 1, plans.size(), plans[i].stem().string()) << std::flush;
+      maps.push_back(build_plan_map(plans[i], int(i), 0, args.cache));
+      if (args.two_robots > 0) second.push_back(build_plan_map(plans[i], int(i), 1, args.cache));
+    }
+    std::cerr << "\n";
+
+    std::vector<std::unique_ptr<Pair>> pairs;
+    core::Random random(args.seed);
+    // 300 x 300 windows of the robot maps.
+    merging::CropPairOptions crop;
+    crop.width = crop.height = 300;
+    crop.measure = merging::OverlapMeasure::Known;
+    crop.min_known = 0.25;
+    crop.max_tries = 60;
+    std::size_t next_plan = 0;
+    for (const double f : args.overlaps) {
+      crop.overlap = f;
+      for (int k = 0; k < args.pairs; ++k) {
+        for (std::size_t tries = 0; tries < maps.size(); ++tries) {
+          const PlanMap& m = maps[next_plan++ % maps.size()];
+          try {
+            merging::CropPair c = merging::make_crop_pair(m.map, crop, random);
+            clutter_pair(c.a, c.b, random);
+            pairs.push_back(std::make_unique<Pair>(Pair{"house300", m.id, f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+            break;
+          } catch (const Error&) {
+            // This plan has no such windows (too small for this overlap): the next one.
+          }
+        }
+      }
+    }
+    // The same windows, a from one robot's map and b from another robot's map of the plan: both
+    // maps are in the plan's frame, so the truth is the windows' transform (up to each map's drift).
+    std::size_t next_two = 0;
+    for (const double f : args.overlaps) {
+      crop.overlap = f;
+      for (int k = 0; k < args.two_robots; ++k) {
+        for (std::size_t tries = 0; tries < maps.size(); ++tries) {
+          const std::size_t i = next_two++ % maps.size();
+          try {
+            merging::CropPair c = merging::make_crop_pair(maps[i].map, crop, random);
+            mapping::OccupancyGrid b = merging::resample_grid(second[i].map, c.b_to_source, crop.width, crop.height);
+            clutter_pair(c.a, b, random);
+            const core::Transform2 reference = fit_near(c.a, b, c.b_to_a);
+            // Farther than 1 m from the truth, the fit found another place: no reference for this window.
+            if (merging::mean_displacement(reference, c.b_to_a, b) > 1.0 / b.resolution()) continue;
+            pairs.push_back(std::make_unique<Pair>(
+                Pair{"house300x2", maps[i].id, f, std::move(c.a), std::move(b), c.b_to_a, reference}));
+            break;
+          } catch (const Error&) {
+          }
+        }
+      }
+    }
+    // Windows of two different plans.
+    merging::CropPairOptions single = crop;
+    single.overlap = 0.9;
+    for (int k = 0; k < args.unrelated; ++k) {
+      for (int tries = 0; tries < 100; ++tries) {
+        const std::size_t i = std::size_t(random.uniform_int(0, int(maps.size()) - 1));
+        const std::size_t j = std::size_t(random.uniform_int(0, int(maps.size()) - 1));
+        if (i == j) continue;
+        try {
+          merging::CropPair ci = merging::make_crop_pair(maps[i].map, single, random);
+          merging::CropPair cj = merging::make_crop_pair(maps[j].map, single, random);
+          clutter_pair(ci.a, cj.b, random);
+          pairs.push_back(std::make_unique<Pair>(
+              Pair{"unrelated", maps[i].id + "/" + maps[j].id, 0.0, std::move(ci.a), std::move(cj.b), std::nullopt, {}}));
+          break;
+        } catch (const Error&) {
+        }
+      }
+    }
+    // Campus windows.
+    const mapping::OccupancyGrid campus = maps::load_map_source("campus");
+    merging::CropPairOptions campus_crop = crop;
+    campus_crop.width = campus_crop.height = 1000;
+    campus_crop.min_known = 0.3;
+    for (const double f : args.overlaps) {
+      campus_crop.overlap = f;
+      for (int k = 0; k < args.campus_pairs; ++k) {
+        merging::CropPair c = merging::make_crop_pair(campus, campus_crop, random);
+        clutter_pair(c.a, c.b, random);
+        pairs.push_back(std::make_unique<Pair>(Pair{"campus1000", "campus", f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+      }
+    }
+    if (args.large_pairs > 0) {
+      const mapping::OccupancyGrid fine = refine_grid(campus, 4);
+      merging::CropPairOptions big = crop;
+      big.width = big.height = 4000;
+      big.min_known = 0.3;
+      for (int k = 0; k < args.large_pairs; ++k) {
+        big.overlap = k % 2 ? 0.2 : 0.5;
+        merging::CropPair c = merging::make_crop_pair(fine, big, random);
+        pairs.push_back(std::make_unique<Pair>(Pair{"campus4000", "campus", big.overlap, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+      }
+    }
+
+    std::vector<Record> records;
+    std::ofstream csv;
+    if (!args.csv.empty()) {
+      csv.open(args.csv);
+      csv << "pair,set,source,overlap,truth_x,truth_y,truth_deg,method,merged,found,error_cells,confidence,cpu_ms,wall_ms,detail\n";
+    }
+    for (std::size_t i = 0; i < pairs.size(); ++i) {
+      const Pair& p = *pairs[i];
+      if (!args.only.empty() && std::find(args.only.begin(), args.only.end(), int(i)) == args.only.end()) continue;
+      std::cerr << fmt::format("\rpairs: {}/{} {} {}%      ", i + 1, pairs.size(), p.set, overlap_percent(p.overlap))
+                << std::flush;
+      if (!args.dump.empty()) {
+        fs::create_directories(args.dump);
+        io::save_map_image(p.a, args.dump / fmt::format("a_{}.png", i));
+        io::save_map_image(p.b, args.dump / fmt::format("b_{}.png", i));
+      }
+      Record r;
+      r.pair = &p;
+      r.fleetmap = run_fleetmap(p, options);
+      if (args.peer) r.peer = run_peer(p);
+      records.push_back(r);
+      if (csv) {
+        for (const auto& [name, o] : {std::pair<std::string, const Outcome*>{"fleetmap", &r.fleetmap}, {"peer", &r.peer}}) {
+          if (name == "peer" && !args.peer) continue;
+          const core::Transform2 t = p.truth.value_or(core::Transform2::identity());
+          csv << fmt::format("{},{},{},{:.2f},{:.3f},{:.3f},{:.3f},{},{},{},{:.4f},{:.4f},{:.2f},{:.2f},\"{}\"\n", i, p.set,
+                             p.source, p.overlap, t.translation().x(), t.translation().y(), core::rad2deg(t.rotation()),
+                             name, int(o->merged), int(o->found), o->error, o->confidence, 1e3 * o->cpu_s,
+                             1e3 * o->wall_s, o->detail);
+        }
+        csv.flush();
+      }
+    }
+    std::cerr << "\n";
+
+    // Tables.
+    std::cout << "Maps: " << maps.size() << " robot-built HouseExpo maps (cache " << args.cache.string() << ")\n\n";
+    const auto select = [&](const std::string& set, std::optional<double> f, bool peer) {
+      std::vector<const Outcome*> out;
+      for (const auto& r : records) {
+        if (r.pair->set != set || (f && std::abs(r.pair->overlap - *f) > 1e-9)) continue;
+        out.push_back(peer ? &r.peer : &r.fleetmap);
+      }
+      return out;
+    };
+    for (const std::string set : {"house300", "house300x2", "campus1000", "campus4000"}) {
+      std::vector<double> fs_;
+      for (const auto& r : records)
+        if (r.pair->set == set && std::find(fs_.begin(), fs_.end(), r.pair->overlap) == fs_.end()) fs_.push_back(r.pair->overlap);
+      if (fs_.empty()) continue;
+      std::sort(fs_.begin(), fs_.end());
+      std::cout << "### " << set << "\n\n| overlap | peer (ORB): success, wrong, median error, median CPU | peer's answer right, "
+                   "whatever its confidence | fleetmap `" << args.method
+                << "`: success, wrong, median error, median CPU | fleetmap's answer right but refused |\n|---|---|---|---|---|\n";
+      const auto found = [](const std::vector<const Outcome*>& os, bool refused_only) {
+        int n = 0;
+        for (const auto* o : os) n += o->found && (!refused_only || !o->merged);
+        return n;
+      };
+      for (const double f : fs_) {
+        const auto fl = select(set, f, false), pe = select(set, f, true);
+        std::cout << fmt::format("| {}% | {} | {} | {} | {} |\n", overlap_percent(f), args.peer ? summary(pe) : "-",
+                                 args.peer ? std::to_string(found(pe, false)) : "-", summary(fl), found(fl, true));
+      }
+      const auto fl = select(set, std::nullopt, false), pe = select(set, std::nullopt, true);
+      std::cout << fmt::format("| all | {} | {} | {} | {} |\n\n", args.peer ? summary(pe) : "-",
+                               args.peer ? std::to_string(found(pe, false)) : "-", summary(fl), found(fl, true));
+    }
+    {
+      const auto fl = select("unrelated", std::nullopt, false);
+      const auto pe = select("unrelated", std::nullopt, true);
+      int ff = 0, pf = 0;
+      std::vector<double> tf, tp;
+      for (const auto* o : fl) ff += o->merged, tf.push_back(o->cpu_s);
+      for (const auto* o : pe) pf += o->merged, tp.push_back(o->cpu_s);
+      std::cout << fmt::format("### unrelated (windows of two different plans)\n\n| | pairs | false merges | median CPU |\n|---|---|---|---|\n"
+                               "| peer (ORB) | {} | {} | {} |\n| fleetmap | {} | {} | {} |\n\n",
+                               args.peer ? int(pe.size()) : 0, args.peer ? std::to_string(pf) : "-", ms(median(tp)),
+                               fl.size(), ff, ms(median(tf)));
+    }
+    // Reliability: of the answers with confidence in a bin, the share that is right; and at each
+    // threshold, what a user gets.
+    {
+      std::cout << "### fleetmap's confidence (every pair above but campus4000)\n\n"
+                << "| confidence | answers | right | share right | accepted at >= c: answers, share right, share of all right answers |\n|---|---|---|---|---|\n";
+      int total_right = 0;
+      for (const auto& r : records) total_right += r.pair->set != "campus4000" && r.fleetmap.found;
+      for (int k = 0; k < 10; ++k) {
+        const double lo = 0.1 * k, hi = k == 9 ? 1.01 : 0.1 * (k + 1);
+        int n = 0, right = 0, acc = 0, acc_right = 0;
+        for (const auto& r : records) {
+          if (r.pair->set == "campus4000") continue;
+          const double c = r.fleetmap.confidence;
+          if (c >= lo && c < hi) ++n, right += r.fleetmap.found;
+          if (c >= lo) ++acc, acc_right += r.fleetmap.found;
+        }
+        std::cout << fmt::format("| {:.1f}-{:.1f} | {} | {} | {} | {}, {}, {} |\n", lo, std::min(hi, 1.0), n, right,
+                                 n ? fmt::format("{:.0f}%", 100.0 * right / n) : "-", acc,
+                                 acc ? fmt::format("{:.1f}%", 100.0 * acc_right / acc) : "-",
+                                 total_right ? fmt::format("{:.1f}%", 100.0 * acc_right / total_right) : "-");
+      }
+      std::cout << "\n";
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "fleetmap_bench_merging_real: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}
