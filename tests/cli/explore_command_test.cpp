@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/videoio.hpp>
 
@@ -46,6 +48,20 @@ TEST(ExploreCommand, WritesEveryOutputAndSaysWhere) {
   // Each robot's map too, with a known cell for every cell its picture shows known.
   const auto robot = io::load_map(dir / "run" / "robot_1.yaml");
   EXPECT_GT(robot.known_count(), 0);
+}
+
+// The whole chain on files: explore, merge the robots' own maps, plan on the merged map.
+TEST(ExploreCommand, TheRobotsMapsMergeAndThePlannerReadsTheResult) {
+  TempDir dir;
+  ASSERT_EQ(run_fleetmap("explore --map office --robots 2 --comm-range 0 --steps 150 --out run", dir).exit_code, 0);
+  const auto m = run_fleetmap("merge run/robot_1.yaml run/robot_2.yaml --out merged.yaml --json merge.json", dir);
+  ASSERT_EQ(m.exit_code, 0) << m.err << m.out;
+  // With known frames both maps are in the world frame: the transform is the identity.
+  const auto t = nlohmann::json::parse(slurp(dir / "merge.json"))["transforms"][0];
+  EXPECT_LT(std::hypot(t["tx"].get<double>(), t["ty"].get<double>()), 1.0) << t.dump();
+  EXPECT_LT(std::abs(t["theta_deg"].get<double>()), 0.5) << t.dump();
+  const auto p = run_fleetmap("plan --map merged.yaml --from 3,15 --to 17,4 --planner astar", dir);
+  EXPECT_EQ(p.exit_code, 0) << p.err << p.out;
 }
 
 TEST(ExploreCommand, RandomStartsSpreadTheTeamAndReplay) {
