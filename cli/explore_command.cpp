@@ -1,4 +1,5 @@
 // `fleetmap explore`: one exploration run, from flags or a scenario file, with its outputs.
+#include <algorithm>
 #include <fmt/format.h>
 
 #include <cmath>
@@ -40,6 +41,7 @@ struct ExploreFlags {
   std::optional<double> sensor_range, landmarks;
   std::string out;
   bool animate = false;
+  std::string video;  // a file name inside --out; --animate is run.mp4
   bool quiet = false;
   long long max_cells = 64'000'000;
 };
@@ -177,7 +179,15 @@ int run_explore(const ExploreFlags& f) {
   if (!f.scenario.empty()) inputs.push_back(f.scenario);
   std::vector<std::string> files = sim::run_output_files(s);
   if (request) files.push_back("path.json");
-  if (f.animate) files.push_back("run.mp4");
+  const std::string video_name = !f.video.empty() ? f.video : f.animate ? "run.mp4" : "";
+  if (!video_name.empty()) {
+    const auto& ext = sim::video_extensions();
+    if (fs::path(video_name).filename() != video_name ||
+        std::find(ext.begin(), ext.end(), fs::path(video_name).extension().string()) == ext.end()) {
+      throw InputError("--video " + video_name + ": give a file name (no folder) ending in .mp4 (H.264) or .webm (VP9)");
+    }
+    files.push_back(video_name);
+  }
   io::OutputFolder folder(out, "explore", files, inputs, "--out " + out.string());
 
   io::MapLoadOptions load;
@@ -199,7 +209,7 @@ int run_explore(const ExploreFlags& f) {
   sim::Simulation& simulation = *made;
   ProgressBar bar(!f.quiet);
   std::unique_ptr<sim::RunVideo> video;
-  if (f.animate) video = std::make_unique<sim::RunVideo>(out / "run.mp4");
+  if (!video_name.empty()) video = std::make_unique<sim::RunVideo>(out / video_name);
   const sim::RunResult result = simulation.run(
       [&](int step, int limit, double coverage) { bar.update(step, limit, "coverage " + format_percent(coverage)); },
       [&](const sim::Simulation& sim) {
@@ -220,7 +230,8 @@ int run_explore(const ExploreFlags& f) {
   }
   if (video) {
     video->finish();
-    written.push_back(out / "run.mp4");
+    written.push_back(out / video_name);
+    if (!video->fallback_note().empty()) fmt::print(stderr, "fleetmap: {}: {}\n", video_name, video->fallback_note());
   }
   folder.finish(io::OutputFolder::names(written));
   // A plan that failed: the run's outputs are written; the plan's problem gets one line.
@@ -314,7 +325,9 @@ Command add_explore_command(CLI::App& root) {
       ->check(in_range(planning::kTimeBudgetRange));
   app->add_option("--out", f->out,
                   "Output folder: new, empty, or of an earlier explore run (its files are replaced) [default: out/<map>]");
-  app->add_flag("--animate", f->animate, "Also write run.mp4, a frame per step");
+  app->add_flag("--animate", f->animate, "Also write run.mp4 (H.264), a frame per step");
+  app->add_option("--video", f->video,
+                  "Write the video under this name in --out: NAME.mp4 (H.264) or NAME.webm (VP9); implies --animate");
   app->add_flag("--quiet,-q", f->quiet, "Print only the merged map's path; no progress bar");
   app->add_option("--max-cells", f->max_cells, "Refuse maps with more cells than this")
       ->capture_default_str()

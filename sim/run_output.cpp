@@ -40,10 +40,20 @@ std::vector<Eigen::Vector2d> positions(const std::vector<core::Pose2>& poses) {
   return out;
 }
 
+// Pictures of maps hold the known cells plus a metre around them.
 viz::RenderOptions render_options(const std::string& t) {
   viz::RenderOptions o;
   o.title = t;
+  o.crop_margin_m = 1.0;
   return o;
+}
+
+const viz::Color kLegendGrey{90, 90, 90};
+
+// Legend rows for the marks every robot shares.
+void add_pose_legend(viz::Overlays& o) {
+  o.legend.push_back({viz::LegendItem::Ring, kLegendGrey, "start"});
+  o.legend.push_back({viz::LegendItem::Disc, kLegendGrey, "final pose"});
 }
 
 }  // namespace
@@ -177,13 +187,16 @@ cv::Mat render_merged(const RunResult& r, const std::string& map_label, const vi
     const std::string name = "robot " + std::to_string(i + 1);
     o.paths.push_back({positions(t.truth), colour, name + (show_estimates ? " (true)" : ""), 2, false});
     if (show_estimates) o.paths.push_back({positions(t.estimate), colour, name + " (estimate)", 1, true});
+    o.poses.push_back({t.truth.front(), r.scenario.robot.radius_m, colour, "", true});
     o.poses.push_back({t.truth.back(), r.scenario.robot.radius_m, colour, ""});
   }
+  add_pose_legend(o);
   if (!r.landmarks.empty()) o.points.push_back({r.landmarks, {200, 0, 200}, "landmarks", 3});
   o.cells.insert(o.cells.end(), extra.cells.begin(), extra.cells.end());
   o.paths.insert(o.paths.end(), extra.paths.begin(), extra.paths.end());
   o.points.insert(o.points.end(), extra.points.begin(), extra.points.end());
   o.poses.insert(o.poses.end(), extra.poses.begin(), extra.poses.end());
+  o.legend.insert(o.legend.end(), extra.legend.begin(), extra.legend.end());
   const std::string numbers = fmt::format(", {} steps, {:.1f}%", r.steps, 100.0 * (r.coverage.empty() ? 0.0 : r.coverage.back()));
   return viz::render_map(r.merged, o, render_options(title(r, map_label) + numbers));
 }
@@ -195,10 +208,12 @@ cv::Mat render_robot(const RunResult& r, int robot, const std::string& map_label
   const core::Transform2 to_frame = r.robot_frames[std::size_t(robot)].inverse();
   std::vector<Eigen::Vector2d> trajectory;
   for (const auto& p : t.estimate) trajectory.push_back(to_frame.apply(p.position()));
+  const core::Pose2 first = core::Pose2::from_transform(to_frame * t.estimate.front().as_transform());
   const core::Pose2 last = core::Pose2::from_transform(to_frame * t.estimate.back().as_transform());
   viz::Overlays o;
   o.paths.push_back({trajectory, colour, "trajectory (estimate)", 2, false});
-  o.poses.push_back({last, r.scenario.robot.radius_m, colour, "robot " + std::to_string(robot + 1)});
+  o.poses.push_back({first, r.scenario.robot.radius_m, colour, "start", true});
+  o.poses.push_back({last, r.scenario.robot.radius_m, colour, "robot " + std::to_string(robot + 1) + " at the end"});
   return viz::render_map(r.robot_maps[std::size_t(robot)], o,
                              render_options(map_label + ": robot " + std::to_string(robot + 1) + "'s map"));
 }
@@ -241,15 +256,41 @@ std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& m
   return written;
 }
 
+namespace {
+
+struct VideoCodec {
+  const char* name;
+  char fourcc[4];
+};
+
+// Codecs per extension, the preferred first.
+const std::vector<VideoCodec>& codecs_for(const std::string& extension) {
+  static const std::vector<VideoCodec> kMp4 = {{"H.264", {'a', 'v', 'c', '1'}}, {"MPEG-4 Part 2", {'m', 'p', '4', 'v'}}};
+  static const std::vector<VideoCodec> kWebm = {{"VP9", {'V', 'P', '9', '0'}}, {"VP8", {'V', 'P', '8', '0'}}};
+  static const std::vector<VideoCodec> kNone;
+  return extension == ".mp4" ? kMp4 : extension == ".webm" ? kWebm : kNone;
+}
+
+}  // namespace
+
+const std::vector<std::string>& video_extensions() {
+  static const std::vector<std::string> kExtensions = {".mp4", ".webm"};
+  return kExtensions;
+}
+
 struct RunVideo::Impl {
   fs::path path, tmp;
   double fps = 12.0;
   cv::VideoWriter writer;
   cv::Size size;
   int frames = 0;
+  std::string codec, note;
 };
 
 RunVideo::RunVideo(fs::path path, double fps) : impl_(std::make_unique<Impl>()) {
+  if (codecs_for(path.extension().string()).empty()) {
+    throw InputError(path.string() + ": a video is .mp4 (H.264) or .webm (VP9), not '" + path.extension().string() + "'");
+  }
   impl_->path = std::move(path);
   impl_->tmp = impl_->path;
   impl_->tmp.replace_extension(".partial" + impl_->path.extension().string());
@@ -264,34 +305,57 @@ RunVideo::~RunVideo() {
   }
 }
 
+const std::string& RunVideo::codec() const { return impl_->codec; }
+const std::string& RunVideo::fallback_note() const { return impl_->note; }
+
 void RunVideo::add_frame(const Simulation& sim, const std::string& map_label) {
   viz::Overlays o;
   const auto estimates = sim.estimated_poses();
   for (int i = 0; i < sim.scenario().robot_count; ++i) {
     const auto colour = viz::palette_color(i);
-    o.paths.push_back({positions(sim.track(i).truth), colour, "robot " + std::to_string(i + 1), 2, false});
+    const auto& truth = sim.track(i).truth;
+    o.paths.push_back({positions(truth), colour, "robot " + std::to_string(i + 1), 2, false});
     auto plan = sim.path(i);
     if (!plan.empty()) {
       plan.insert(plan.begin(), estimates[std::size_t(i)].position());
       o.paths.push_back({plan, colour, "", 1, true});
     }
+    if (!truth.empty()) o.poses.push_back({truth.front(), sim.scenario().robot.radius_m, colour, "", true});
     o.poses.push_back({sim.true_poses()[std::size_t(i)], sim.scenario().robot.radius_m, colour, ""});
   }
+  // Every frame has the same legend rows, so frames keep one size.
+  o.legend.push_back({viz::LegendItem::Dashed, kLegendGrey, "planned path"});
+  o.legend.push_back({viz::LegendItem::Ring, kLegendGrey, "start"});
+  o.legend.push_back({viz::LegendItem::Disc, kLegendGrey, "robot now"});
   viz::RenderOptions ro;
   ro.title = fmt::format("{}: step {}, {:.1f}%", map_label, sim.step_count(), 100.0 * sim.coverage());
   ro.max_size_px = 1600;
   cv::Mat frame = viz::render_map(sim.merged_map(), o, ro);
   if (!impl_->writer.isOpened()) {
-    // Even dimensions keep every codec happy.
-    impl_->size = cv::Size(frame.cols + (frame.cols % 2), frame.rows + (frame.rows % 2));
+    // Even dimensions keep every codec happy; a little room for longer titles later.
+    impl_->size = cv::Size(frame.cols + 40 + (frame.cols % 2), frame.rows + (frame.rows % 2));
     io::ensure_directory(impl_->path.parent_path());
-    if (!impl_->writer.open(impl_->tmp.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), impl_->fps, impl_->size)) {
-      throw Error(impl_->path.string() + ": cannot open a video writer (OpenCV without an MP4 encoder?)");
+    const auto& codecs = codecs_for(impl_->path.extension().string());
+    for (const auto& c : codecs) {
+      const int fourcc = cv::VideoWriter::fourcc(c.fourcc[0], c.fourcc[1], c.fourcc[2], c.fourcc[3]);
+      if (impl_->writer.open(impl_->tmp.string(), cv::CAP_FFMPEG, fourcc, impl_->fps, impl_->size)) {
+        impl_->codec = c.name;
+        break;
+      }
+      impl_->note += fmt::format("{}OpenCV's FFmpeg cannot write {} ({:.4s})", impl_->note.empty() ? "" : "; ", c.name, std::string_view(c.fourcc, 4));
     }
+    if (!impl_->writer.isOpened()) {
+      throw Error(impl_->path.string() + ": cannot open a video writer: " + impl_->note);
+    }
+    if (!impl_->note.empty()) impl_->note += "; wrote " + impl_->codec;
+  }
+  // A frame larger than the first (a longer title) is shrunk to fit, never cut.
+  if (frame.cols > impl_->size.width || frame.rows > impl_->size.height) {
+    const double f = std::min(double(impl_->size.width) / frame.cols, double(impl_->size.height) / frame.rows);
+    cv::resize(frame, frame, {}, f, f, cv::INTER_AREA);
   }
   cv::Mat padded(impl_->size, CV_8UC3, cv::Scalar(255, 255, 255));
-  frame(cv::Rect(0, 0, std::min(frame.cols, impl_->size.width), std::min(frame.rows, impl_->size.height)))
-      .copyTo(padded(cv::Rect(0, 0, std::min(frame.cols, impl_->size.width), std::min(frame.rows, impl_->size.height))));
+  frame.copyTo(padded(cv::Rect(0, 0, std::min(frame.cols, impl_->size.width), std::min(frame.rows, impl_->size.height))));
   impl_->writer.write(padded);
   ++impl_->frames;
 }

@@ -33,14 +33,23 @@ std::vector<std::filesystem::path> write_run_outputs(const RunResult& result, co
                                                      const std::filesystem::path& dir,
                                                      const viz::Overlays& extra = {});
 
-// An MP4 of a run, a frame per step (the merged map, robots, their paths and goals).
+// The video formats RunVideo writes, by the file's extension: ".mp4" (H.264, which browsers play;
+// MPEG-4 Part 2 where OpenCV's FFmpeg has no H.264 encoder) and ".webm" (VP9, else VP8).
+const std::vector<std::string>& video_extensions();
+
+// A video of a run, a frame per step (the merged map, robots, their paths and planned paths).
 class RunVideo {
  public:
+  // Throws InputError when the extension is not one of video_extensions().
   RunVideo(std::filesystem::path path, double fps = 12.0);
   ~RunVideo();
   void add_frame(const Simulation& sim, const std::string& map_label);
   // Closes the video and moves it into place. Throws fleetmap::Error when nothing could be written.
   void finish();
+  // After the first frame: the codec written ("H.264", "MPEG-4 Part 2", "VP9", "VP8").
+  const std::string& codec() const;
+  // After the first frame: why the preferred codec was not used, or empty.
+  const std::string& fallback_note() const;
 
  private:
   struct Impl;

@@ -77,6 +77,28 @@ std::size_t metric_index(const std::string& name) {
   return std::size_t(std::find_if(m.begin(), m.end(), [&](const ReportMetric& x) { return x.name == name; }) - m.begin());
 }
 
+// The row whose mean is best in metric m and whose 95% interval lies clear of every other row's
+// interval; nullptr when there is none (intervals overlap, or a row has too few runs for one).
+const GroupSummary* clearly_best(const std::vector<const GroupSummary*>& rows, std::size_t m, bool higher_is_better) {
+  const GroupSummary* best = nullptr;
+  for (const auto* g : rows) {
+    const double v = g->metrics[m].mean;
+    if (!std::isfinite(v)) continue;
+    if (!best || (higher_is_better ? v > best->metrics[m].mean : v < best->metrics[m].mean)) best = g;
+  }
+  if (!best) return nullptr;
+  const SampleSummary& b = best->metrics[m];
+  int others = 0;
+  for (const auto* g : rows) {
+    const SampleSummary& o = g->metrics[m];
+    if (g == best || o.n == 0) continue;
+    ++others;
+    if (!std::isfinite(b.ci_low) || !std::isfinite(o.ci_low)) return nullptr;
+    if (!(b.ci_high < o.ci_low || o.ci_high < b.ci_low)) return nullptr;
+  }
+  return others > 0 ? best : nullptr;
+}
+
 }  // namespace
 
 const std::vector<ReportMetric>& report_metrics() {
@@ -178,7 +200,7 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
         "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) + (seeds.size() == 1 ? " seed. " : " seeds. ") + settings + ".\n\n";
   md += "Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
         "reached the level. **Bold**: the best strategy in the column for that map and team size (lowest; highest for "
-        "efficiency and coverage). Efficiency = lower bound / steps to 99% (README.md, \"Benchmarking strategies\").\n";
+        "efficiency and coverage), only when its 95% interval overlaps no other strategy's (so never with one seed). Efficiency = lower bound / steps to 99% (README.md, \"Benchmarking strategies\").\n";
   for (const auto& map : maps) {
     md += "\n## " + map + "\n";
     for (int team : teams) {
@@ -196,22 +218,8 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
       md += "\n|---|---:|";
       for (std::size_t m = 0; m < metrics.size(); ++m) md += "---:|";
       md += "\n";
-      // The best mean per column among rows with a value; ties are all marked.
-      std::vector<double> best(metrics.size(), std::nan(""));
-      for (std::size_t m = 0; m < metrics.size(); ++m) {
-        for (const auto* g : rows) {
-          const double v = g->metrics[m].mean;
-          if (!std::isfinite(v)) continue;
-          if (!std::isfinite(best[m]) || (metrics[m].higher_is_better ? v > best[m] : v < best[m])) best[m] = v;
-        }
-      }
-      // A column where every row shows the best value has no best.
-      std::vector<bool> all_tie(metrics.size(), true);
-      for (std::size_t m = 0; m < metrics.size(); ++m) {
-        for (const auto* g : rows) {
-          if (number(g->metrics[m].mean, metrics[m].decimals) != number(best[m], metrics[m].decimals)) all_tie[m] = false;
-        }
-      }
+      std::vector<const GroupSummary*> best(metrics.size(), nullptr);
+      for (std::size_t m = 0; m < metrics.size(); ++m) best[m] = clearly_best(rows, m, metrics[m].higher_is_better);
       for (const auto* g : rows) {
         md += "| " + g->series() + " | " + std::to_string(g->runs) + " |";
         for (std::size_t m = 0; m < metrics.size(); ++m) {
@@ -220,8 +228,7 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
           if (s.n > 0) {
             cell = number(s.mean, metrics[m].decimals);
             if (s.n > 1) cell += " ± " + number(s.half_width(), metrics[m].decimals);
-            const bool is_best = !all_tie[m] && number(s.mean, metrics[m].decimals) == number(best[m], metrics[m].decimals);
-            if (is_best) cell = "**" + cell + "**";
+            if (best[m] == g) cell = "**" + cell + "**";
             if (s.n < g->runs) cell += " (" + std::to_string(s.n) + "/" + std::to_string(g->runs) + ")";
           }
           md += " " + cell + " |";
@@ -385,9 +392,9 @@ std::string comparison_text(const StrategyComparison& c) {
 namespace {
 
 // Coverage against step on `map`: a panel per team size, a curve per strategy with its 95% band.
-cv::Mat coverage_plot(const std::vector<RunRecord>& records, const std::string& map, const std::vector<int>& teams,
-                      const std::vector<std::string>& strategies) {
-  std::vector<cv::Mat> panels;
+viz::Drawing coverage_plot(const std::vector<RunRecord>& records, const std::string& map, const std::vector<int>& teams,
+                           const std::vector<std::string>& strategies) {
+  std::vector<viz::Drawing> panels;
   for (int team : teams) {
     std::vector<const RunRecord*> runs;
     int last = 1;
@@ -422,13 +429,13 @@ cv::Mat coverage_plot(const std::vector<RunRecord>& records, const std::string& 
       }
       plot.series.push_back(std::move(s));
     }
-    panels.push_back(viz::draw_line_plot(plot, {760, 500}));
+    panels.push_back(viz::line_plot(plot, {760, 500}));
   }
-  return viz::tile_images(panels, 2);
+  return viz::tile(panels, 2);
 }
 
 // Steps to 99% against team size on `map`, a line per strategy, with the lower bound.
-cv::Mat time_plot(const std::vector<GroupSummary>& groups, const std::string& map, const std::vector<int>& teams,
+viz::Drawing time_plot(const std::vector<GroupSummary>& groups, const std::string& map, const std::vector<int>& teams,
                   const std::vector<std::string>& strategies) {
   const std::size_t steps99 = metric_index("steps_to_99");
   viz::LinePlot time;
@@ -455,6 +462,7 @@ cv::Mat time_plot(const std::vector<GroupSummary>& groups, const std::string& ma
   viz::PlotSeries bound;
   bound.label = "lower bound";
   bound.color = {90, 90, 90};
+  bound.dashed = true;
   for (int team : teams) {
     int lb = -1;
     for (const auto& g : groups) {
@@ -465,11 +473,11 @@ cv::Mat time_plot(const std::vector<GroupSummary>& groups, const std::string& ma
     bound.y.push_back(lb);
   }
   time.series.push_back(std::move(bound));
-  return viz::draw_line_plot(time);
+  return viz::line_plot(time);
 }
 
 // Efficiency per strategy, on each map and on all maps.
-cv::Mat efficiency_chart(const std::vector<RunRecord>& records, const std::vector<std::string>& maps,
+viz::Drawing efficiency_chart(const std::vector<RunRecord>& records, const std::vector<std::string>& maps,
                          const std::vector<std::string>& strategies) {
   viz::BarChart bars;
   bars.title = "efficiency = lower bound / steps to 99% (mean over team sizes and seeds, 95% CI)";
@@ -496,7 +504,7 @@ cv::Mat efficiency_chart(const std::vector<RunRecord>& records, const std::vecto
     bars.low.push_back(low);
     bars.high.push_back(high);
   }
-  return viz::draw_bar_chart(bars, {std::max(900, 160 * int(bars.groups.size()) + 300), 560});
+  return viz::bar_chart(bars, {std::max(900, 160 * int(bars.groups.size()) + 300), 560});
 }
 
 }  // namespace
@@ -509,10 +517,11 @@ std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records) {
   const auto teams = teams_of(records);
   const auto groups = summarize_groups(records);
   for (const auto& map : maps) {
-    plots.push_back({"coverage_" + map + ".png", coverage_plot(records, map, teams, strategies)});
-    plots.push_back({"time_" + map + ".png", time_plot(groups, map, teams, strategies)});
+    plots.push_back({"coverage_" + map + ".png", coverage_plot(records, map, teams, strategies), {}});
+    plots.push_back({"time_" + map + ".png", time_plot(groups, map, teams, strategies), {}});
   }
-  plots.push_back({"efficiency.png", efficiency_chart(records, maps, strategies)});
+  plots.push_back({"efficiency.png", efficiency_chart(records, maps, strategies), {}});
+  for (auto& p : plots) p.image = viz::rasterize(p.drawing);
   return plots;
 }
 
@@ -528,6 +537,9 @@ std::vector<fs::path> write_sweep_reports(const fs::path& dir, const std::vector
     if (plot.image.empty()) continue;
     io::write_image(dir / plot.file, plot.image);
     written.push_back(dir / plot.file);
+    const fs::path svg = (dir / plot.file).replace_extension(".svg");
+    io::write_file_atomic(svg, viz::to_svg(plot.drawing));
+    written.push_back(svg);
   }
   return written;
 }

@@ -13,6 +13,7 @@
 
 #include "sweep/statistics.h"
 #include "sweep/sweep_results.h"
+#include "viz/drawing.h"
 
 namespace fleetmap::sweep {
 
@@ -71,16 +72,19 @@ StrategyComparison compare_strategies(const std::vector<RunRecord>& records, con
 std::string comparison_text(const StrategyComparison& comparison);
 
 struct SweepPlot {
-  std::string file;  // e.g. "coverage_office.png"
-  cv::Mat image;
+  std::string file;  // e.g. "coverage_office.png"; the SVG beside it has the same stem
+  viz::Drawing drawing;
+  cv::Mat image;     // the drawing rasterized
 };
 
 // coverage_<map>.png (coverage against step, a panel per team size, a curve per strategy: the mean
-// over seeds with its 95% confidence band), time_<map>.png (steps to 99% against team size, with
-// the lower bound) and efficiency.png (mean efficiency per strategy on each map and on all).
+// over seeds with its translucent 95% confidence band), time_<map>.png (steps to 99% against team
+// size, with the lower bound, also for a single team size) and efficiency.png (mean efficiency
+// per strategy on each map and on all).
 std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records);
 
-// Writes summary.csv, summary.md and the plots into `dir` (each atomically); returns the files.
+// Writes summary.csv, summary.md and the plots into `dir`, each plot as PNG and as SVG beside it
+// (each file atomically); returns the files.
 std::vector<std::filesystem::path> write_sweep_reports(const std::filesystem::path& dir,
                                                        const std::vector<RunRecord>& records);
 

@@ -7,47 +7,22 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 
 namespace fleetmap::viz {
 
 namespace {
 
-constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kTickFont = 0.45;
 constexpr double kLabelFont = 0.5;
 constexpr double kTitleFont = 0.6;
-const cv::Scalar kBlack(0, 0, 0);
-const cv::Scalar kGrid(225, 225, 225);
-const cv::Scalar kWhite(255, 255, 255);
-
-cv::Scalar bgr(const Color& c) { return cv::Scalar(c.b, c.g, c.r); }
+const Color kBlack{0, 0, 0};
+const Color kGrid{225, 225, 225};
+constexpr double kBandOpacity = 0.2;
 
 bool finite(double v) { return std::isfinite(v); }
 
-int text_width(const std::string& text, double scale) { return cv::getTextSize(text, kFont, scale, 1, nullptr).width; }
-
-void put_text(cv::Mat& img, const std::string& text, cv::Point at, double scale) {
-  cv::putText(img, text, at, kFont, scale, kBlack, 1, cv::LINE_AA);
-}
-
-void put_centered(cv::Mat& img, const std::string& text, int cx, int baseline_y, double scale) {
-  put_text(img, text, cv::Point(cx - text_width(text, scale) / 2, baseline_y), scale);
-}
-
-// Text turned 90 degrees counter-clockwise, centred on (cx, cy).
-void put_vertical(cv::Mat& img, const std::string& text, int cx, int cy, double scale) {
-  if (text.empty()) return;
-  int baseline = 0;
-  const cv::Size s = cv::getTextSize(text, kFont, scale, 1, &baseline);
-  cv::Mat strip(s.height + baseline + 4, s.width + 4, CV_8UC3, kWhite);
-  cv::putText(strip, text, cv::Point(2, s.height + 2), kFont, scale, kBlack, 1, cv::LINE_AA);
-  cv::Mat turned;
-  cv::rotate(strip, turned, cv::ROTATE_90_COUNTERCLOCKWISE);
-  const cv::Rect where(cx - turned.cols / 2, cy - turned.rows / 2, turned.cols, turned.rows);
-  const cv::Rect clipped = where & cv::Rect(0, 0, img.cols, img.rows);
-  if (clipped.area() == 0) return;
-  turned(cv::Rect(clipped.x - where.x, clipped.y - where.y, clipped.width, clipped.height)).copyTo(img(clipped));
-}
+int text_width(const std::string& text, double scale) { return text_size(text, scale).width; }
 
 // Decimals enough to tell ticks `step` apart.
 std::string tick_text(double v, double step) {
@@ -103,13 +78,16 @@ struct Frame {
   double x0, x1, y0, y1;
   double px(double x) const { return std::clamp((x - x0) / (x1 - x0) * area.width, -1e4, 1e4); }
   double py(double y) const { return std::clamp((1.0 - (y - y0) / (y1 - y0)) * area.height, -1e4, 1e4); }
-  cv::Point point(double x, double y) const { return cv::Point(int(std::lround(px(x))), int(std::lround(py(y)))); }
+  // Canvas coordinates of a data point.
+  cv::Point2d point(double x, double y) const { return {area.x + px(x), area.y + py(y)}; }
 };
 
 struct LegendEntry {
   std::string label;
-  cv::Scalar color;
+  Color color;
   bool box = false;  // a filled square (bars) or a line (series)
+  double width = 3.0;
+  bool dashed = false;
 };
 
 int legend_width(const std::vector<LegendEntry>& entries) {
@@ -118,44 +96,48 @@ int legend_width(const std::vector<LegendEntry>& entries) {
   return entries.empty() ? 20 : w + 60;
 }
 
-void draw_legend(cv::Mat& img, const std::vector<LegendEntry>& entries, int x, int y) {
+void draw_legend(Drawing& d, const std::vector<LegendEntry>& entries, int x, int y) {
   for (std::size_t i = 0; i < entries.size(); ++i) {
     const int row = y + int(i) * 22;
-    if (entries[i].box) {
-      cv::rectangle(img, cv::Rect(x, row - 10, 22, 12), entries[i].color, cv::FILLED);
+    const auto& e = entries[i];
+    if (e.box) {
+      d.rect(cv::Rect2d(x, row - 10, 22, 12), e.color);
     } else {
-      cv::line(img, cv::Point(x, row - 4), cv::Point(x + 22, row - 4), entries[i].color, 3, cv::LINE_AA);
+      d.line(cv::Point2d(x, row - 4), cv::Point2d(x + 24, row - 4), e.color, std::min(e.width, 6.0), e.dashed);
     }
-    put_text(img, entries[i].label, cv::Point(x + 30, row), kLabelFont);
+    d.text(cv::Point2d(x + 32, row), e.label, kLabelFont);
   }
 }
 
 // Canvas, title, y ticks with grid lines and y label; returns the frame for the data.
-Frame draw_frame(cv::Mat& img, const std::string& title, const std::string& y_label, double y0, double y1,
-                 int legend_w, const PlotOptions& options, const std::vector<double>& given_ticks = {}) {
+Frame draw_frame(Drawing& d, const std::string& title, const std::string& y_label, double y0, double y1, int legend_w,
+                 const PlotOptions& options, const std::vector<double>& given_ticks = {}) {
   const auto ticks = given_ticks.empty() ? nice_ticks(y0, y1) : given_ticks;
   int tick_w = 0;
   for (double t : ticks) tick_w = std::max(tick_w, text_width(tick_text(t, tick_step(ticks)), kTickFont));
   const int left = tick_w + 45, top = 45, bottom = 62, right = legend_w + 15;
-  img = cv::Mat(options.height_px, options.width_px, CV_8UC3, kWhite);
-  Frame f{cv::Rect(left, top, std::max(50, options.width_px - left - right), std::max(50, options.height_px - top - bottom)),
+  // A title wider than the canvas widens it: titles are never cut.
+  const int width = std::max(options.width_px, text_width(title, kTitleFont) + 20);
+  d = Drawing(width, options.height_px);
+  Frame f{cv::Rect(left, top, std::max(50, width - left - right), std::max(50, options.height_px - top - bottom)),
           0.0, 1.0, y0, y1};
-  put_centered(img, title, img.cols / 2, 28, kTitleFont);
+  d.text(cv::Point2d(width / 2.0, 28), title, kTitleFont, TextAnchor::Middle);
   for (double t : ticks) {
     if (t < y0 - 1e-9 * (y1 - y0) || t > y1 + 1e-9 * (y1 - y0)) continue;
-    const int y = f.area.y + int(std::lround(f.py(t)));
-    cv::line(img, cv::Point(f.area.x, y), cv::Point(f.area.x + f.area.width, y), kGrid, 1);
-    cv::line(img, cv::Point(f.area.x - 5, y), cv::Point(f.area.x, y), kBlack, 1);
-    const std::string text = tick_text(t, tick_step(ticks));
-    put_text(img, text, cv::Point(f.area.x - 8 - text_width(text, kTickFont), y + 5), kTickFont);
+    const double y = f.point(0.0, t).y;
+    d.line({double(f.area.x), y}, {double(f.area.x + f.area.width), y}, kGrid);
+    d.line({f.area.x - 5.0, y}, {double(f.area.x), y}, kBlack);
+    d.text({f.area.x - 8.0, y + 5}, tick_text(t, tick_step(ticks)), kTickFont, TextAnchor::End);
   }
-  put_vertical(img, y_label, 14, f.area.y + f.area.height / 2, kLabelFont);
+  d.vertical_text({14.0, f.area.y + f.area.height / 2.0}, y_label, kLabelFont);
   return f;
 }
 
-void finish_frame(cv::Mat& img, const Frame& f, const std::string& x_label) {
-  cv::rectangle(img, f.area, kBlack, 1);
-  put_centered(img, x_label, f.area.x + f.area.width / 2, f.area.y + f.area.height + 50, kLabelFont);
+void finish_frame(Drawing& d, const Frame& f, const std::string& x_label) {
+  d.end_clip();
+  const double l = f.area.x, t = f.area.y, r = f.area.x + f.area.width, b = f.area.y + f.area.height;
+  d.polyline({{l, t}, {r, t}, {r, b}, {l, b}, {l, t}}, kBlack);
+  d.text({(l + r) / 2.0, b + 50}, x_label, kLabelFont, TextAnchor::Middle);
 }
 
 // Index ranges [begin, end) of consecutive points with finite x and y.
@@ -195,7 +177,36 @@ std::vector<double> nice_ticks(double lo, double hi, int target) {
   return ticks;
 }
 
-cv::Mat draw_line_plot(const LinePlot& plot, const PlotOptions& options) {
+namespace {
+
+// The line width of each series: 2 px, plus 2 px for every later series whose line lies on this
+// one (within half a percent of the y range at more than half the shared x values), so lines that
+// coincide (e.g. every strategy with a single robot) stay visible as nested stripes.
+std::vector<double> line_widths(const std::vector<PlotSeries>& series, double y_range) {
+  std::vector<double> widths(series.size(), 2.0);
+  const double tol = 0.005 * y_range;
+  for (std::size_t j = 1; j < series.size(); ++j) {
+    std::map<double, double> later;
+    for (std::size_t b = 0; b < std::min(series[j].x.size(), series[j].y.size()); ++b) {
+      if (finite(series[j].y[b])) later[series[j].x[b]] = series[j].y[b];
+    }
+    for (std::size_t i = 0; i < j; ++i) {
+      int shared = 0, same = 0;
+      for (std::size_t a = 0; a < std::min(series[i].x.size(), series[i].y.size()); ++a) {
+        const auto it = later.find(series[i].x[a]);
+        if (it == later.end() || !finite(series[i].y[a])) continue;
+        ++shared;
+        same += std::abs(series[i].y[a] - it->second) <= tol;
+      }
+      if (shared > 0 && 2 * same > shared) widths[i] = std::min(widths[i] + 2.0, 12.0);
+    }
+  }
+  return widths;
+}
+
+}  // namespace
+
+Drawing line_plot(const LinePlot& plot, const PlotOptions& options) {
   Range xr, yr;
   for (const auto& s : plot.series) {
     for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
@@ -207,59 +218,70 @@ cv::Mat draw_line_plot(const LinePlot& plot, const PlotOptions& options) {
   }
   const auto [x0, x1] = axis_range(xr, plot.x.min, plot.x.max, plot.x.ticks);
   const auto [y0, y1] = axis_range(yr, plot.y.min, plot.y.max, plot.y.ticks);
+  const std::vector<double> widths = line_widths(plot.series, y1 - y0);
   std::vector<LegendEntry> legend;
-  for (const auto& s : plot.series) {
-    if (!s.label.empty()) legend.push_back({s.label, bgr(s.color), false});
+  for (std::size_t k = 0; k < plot.series.size(); ++k) {
+    const auto& s = plot.series[k];
+    if (!s.label.empty()) legend.push_back({s.label, s.color, false, std::max(3.0, widths[k]), s.dashed});
   }
-  cv::Mat img;
-  Frame f = draw_frame(img, plot.title, plot.y.label, y0, y1, legend_width(legend), options, plot.y.ticks);
+  Drawing d;
+  Frame f = draw_frame(d, plot.title, plot.y.label, y0, y1, legend_width(legend), options, plot.y.ticks);
   f.x0 = x0;
   f.x1 = x1;
   const auto xticks = plot.x.ticks.empty() ? nice_ticks(x0, x1, std::max(2, f.area.width / 90)) : plot.x.ticks;
+  const double bottom = f.area.y + f.area.height;
   for (double t : xticks) {
     if (t < x0 || t > x1) continue;
-    const int x = f.area.x + int(std::lround(f.px(t)));
-    cv::line(img, cv::Point(x, f.area.y), cv::Point(x, f.area.y + f.area.height), kGrid, 1);
-    cv::line(img, cv::Point(x, f.area.y + f.area.height), cv::Point(x, f.area.y + f.area.height + 5), kBlack, 1);
-    put_centered(img, tick_text(t, tick_step(xticks)), x, f.area.y + f.area.height + 22, kTickFont);
+    const double x = f.point(t, 0.0).x;
+    d.line({x, double(f.area.y)}, {x, bottom}, kGrid);
+    d.line({x, bottom}, {x, bottom + 5}, kBlack);
+    d.text({x, bottom + 22}, tick_text(t, tick_step(xticks)), kTickFont, TextAnchor::Middle);
   }
 
-  cv::Mat area = img(f.area);  // drawing here clips to the plot area
+  d.begin_clip(f.area);
+  // Each band is blended on its own, so where bands overlap both colours show.
   if (plot.bands) {
-    cv::Mat overlay = area.clone();
     for (const auto& s : plot.series) {
       if (!has_band(s)) continue;
       for (const auto& [b, e] : runs_of_finite(s)) {
-        std::vector<cv::Point> poly;
+        std::vector<cv::Point2d> poly;
         for (std::size_t i = b; i < e; ++i) poly.push_back(f.point(s.x[i], s.y_high[i]));
         for (std::size_t i = e; i-- > b;) poly.push_back(f.point(s.x[i], s.y_low[i]));
-        cv::fillPoly(overlay, std::vector<std::vector<cv::Point>>{poly}, bgr(s.color), cv::LINE_AA);
+        if (e - b == 1) {  // one point: the band is a short bar
+          const cv::Point2d hi = poly[0], lo = poly[1];
+          poly = {hi + cv::Point2d(-6, 0), hi + cv::Point2d(6, 0), lo + cv::Point2d(6, 0), lo + cv::Point2d(-6, 0)};
+        }
+        d.polygon(poly, s.color, kBandOpacity);
+        d.set_role("band");
       }
     }
-    cv::addWeighted(overlay, 0.22, area, 0.78, 0.0, area);
   }
-  for (const auto& s : plot.series) {
+  for (std::size_t k = 0; k < plot.series.size(); ++k) {
+    const auto& s = plot.series[k];
     for (const auto& [b, e] : runs_of_finite(s)) {
-      std::vector<cv::Point> line;
+      std::vector<cv::Point2d> line;
       for (std::size_t i = b; i < e; ++i) line.push_back(f.point(s.x[i], s.y[i]));
-      cv::polylines(area, line, false, bgr(s.color), 2, cv::LINE_AA);
+      // A single point is a short level line, so a one-value series (e.g. a bound at one team size) shows.
+      if (line.size() == 1) line = {line[0] + cv::Point2d(-14, 0), line[0] + cv::Point2d(14, 0)};
+      d.polyline(line, s.color, widths[k], s.dashed);
+      d.set_role("series");
       for (std::size_t i = b; i < e; ++i) {
         if (!plot.bands && has_band(s) && finite(s.y_low[i]) && finite(s.y_high[i])) {
-          const cv::Point lo = f.point(s.x[i], s.y_low[i]), hi = f.point(s.x[i], s.y_high[i]);
-          cv::line(area, lo, hi, bgr(s.color), 1, cv::LINE_AA);
-          cv::line(area, lo - cv::Point(4, 0), lo + cv::Point(4, 0), bgr(s.color), 1, cv::LINE_AA);
-          cv::line(area, hi - cv::Point(4, 0), hi + cv::Point(4, 0), bgr(s.color), 1, cv::LINE_AA);
+          const cv::Point2d lo = f.point(s.x[i], s.y_low[i]), hi = f.point(s.x[i], s.y_high[i]);
+          d.line(lo, hi, s.color);
+          d.line(lo - cv::Point2d(4, 0), lo + cv::Point2d(4, 0), s.color);
+          d.line(hi - cv::Point2d(4, 0), hi + cv::Point2d(4, 0), s.color);
         }
-        if (s.markers) cv::circle(area, line[i - b], 4, bgr(s.color), cv::FILLED, cv::LINE_AA);
+        if (s.markers) d.circle(f.point(s.x[i], s.y[i]), 2.0 + widths[k], s.color);
       }
     }
   }
-  finish_frame(img, f, plot.x.label);
-  draw_legend(img, legend, f.area.x + f.area.width + 15, f.area.y + 14);
-  return img;
+  finish_frame(d, f, plot.x.label);
+  draw_legend(d, legend, f.area.x + f.area.width + 15, f.area.y + 14);
+  return d;
 }
 
-cv::Mat draw_bar_chart(const BarChart& chart, const PlotOptions& options) {
+Drawing bar_chart(const BarChart& chart, const PlotOptions& options) {
   const std::size_t n_series = chart.values.size(), n_groups = chart.groups.size();
   const auto value = [](const std::vector<std::vector<double>>& v, std::size_t s, std::size_t g) {
     return s < v.size() && g < v[s].size() ? v[s][g] : std::numeric_limits<double>::quiet_NaN();
@@ -276,40 +298,55 @@ cv::Mat draw_bar_chart(const BarChart& chart, const PlotOptions& options) {
   std::vector<LegendEntry> legend;
   for (std::size_t s = 0; s < n_series; ++s) {
     const Color c = s < chart.colors.size() ? chart.colors[s] : palette_color(int(s));
-    legend.push_back({s < chart.series_labels.size() ? chart.series_labels[s] : "", bgr(c), true});
+    legend.push_back({s < chart.series_labels.size() ? chart.series_labels[s] : "", c, true});
   }
-  cv::Mat img;
-  Frame f = draw_frame(img, chart.title, chart.y_label, y0, y1, legend_width(legend), options);
+  Drawing d;
+  Frame f = draw_frame(d, chart.title, chart.y_label, y0, y1, legend_width(legend), options);
   f.x0 = 0.0;
   f.x1 = double(std::max<std::size_t>(1, n_groups));
-  cv::Mat area = img(f.area);
+  d.begin_clip(f.area);
   const double slot = 0.8 / double(std::max<std::size_t>(1, n_series));
   for (std::size_t g = 0; g < n_groups; ++g) {
     for (std::size_t s = 0; s < n_series; ++s) {
       const double v = value(chart.values, s, g);
       if (!finite(v)) continue;
       const double left = double(g) + 0.1 + slot * double(s);
-      const cv::Point a = f.point(left + 0.05 * slot, std::max(y0, 0.0)), b = f.point(left + 0.95 * slot, v);
-      cv::rectangle(area, cv::Rect(a, b), legend[s].color, cv::FILLED);
+      const cv::Point2d a = f.point(left + 0.05 * slot, std::max(y0, 0.0)), b = f.point(left + 0.95 * slot, v);
+      d.rect(cv::Rect2d(a, b), legend[s].color);
+      d.set_role("bar");
       const double lo = value(chart.low, s, g), hi = value(chart.high, s, g);
       if (finite(lo) && finite(hi)) {
         const double mid = left + 0.5 * slot;
-        const cv::Point p = f.point(mid, lo), q = f.point(mid, hi);
-        cv::line(area, p, q, kBlack, 1, cv::LINE_AA);
-        cv::line(area, p - cv::Point(4, 0), p + cv::Point(4, 0), kBlack, 1, cv::LINE_AA);
-        cv::line(area, q - cv::Point(4, 0), q + cv::Point(4, 0), kBlack, 1, cv::LINE_AA);
+        const cv::Point2d p = f.point(mid, lo), q = f.point(mid, hi);
+        d.line(p, q, kBlack);
+        d.line(p - cv::Point2d(4, 0), p + cv::Point2d(4, 0), kBlack);
+        d.line(q - cv::Point2d(4, 0), q + cv::Point2d(4, 0), kBlack);
       }
     }
   }
+  d.end_clip();
   for (std::size_t g = 0; g < n_groups; ++g) {
-    const int cx = f.area.x + int(std::lround(f.px(double(g) + 0.5)));
+    const double cx = f.point(double(g) + 0.5, 0.0).x;
     const int room = int(f.area.width / double(std::max<std::size_t>(1, n_groups)));
     const double scale = std::min(kLabelFont, kLabelFont * room / double(std::max(1, text_width(chart.groups[g], kLabelFont) + 8)));
-    put_centered(img, chart.groups[g], cx, f.area.y + f.area.height + 22, scale);
+    d.text({cx, f.area.y + f.area.height + 22.0}, chart.groups[g], scale, TextAnchor::Middle);
   }
-  finish_frame(img, f, "");
-  draw_legend(img, legend, f.area.x + f.area.width + 15, f.area.y + 14);
-  return img;
+  finish_frame(d, f, "");
+  draw_legend(d, legend, f.area.x + f.area.width + 15, f.area.y + 14);
+  return d;
+}
+
+Drawing tile(const std::vector<Drawing>& drawings, int columns) {
+  if (drawings.empty()) return {};
+  columns = std::clamp(columns, 1, int(drawings.size()));
+  int w = 0, h = 0;
+  for (const auto& d : drawings) w = std::max(w, d.width()), h = std::max(h, d.height());
+  const int rows = (int(drawings.size()) + columns - 1) / columns;
+  Drawing out(columns * w, rows * h);
+  for (std::size_t k = 0; k < drawings.size(); ++k) {
+    out.place(drawings[k], cv::Point2d(int(k) % columns * w, int(k) / columns * h));
+  }
+  return out;
 }
 
 cv::Mat tile_images(const std::vector<cv::Mat>& images, int columns) {
@@ -318,7 +355,7 @@ cv::Mat tile_images(const std::vector<cv::Mat>& images, int columns) {
   int w = 0, h = 0;
   for (const auto& i : images) w = std::max(w, i.cols), h = std::max(h, i.rows);
   const int rows = (int(images.size()) + columns - 1) / columns;
-  cv::Mat out(rows * h, columns * w, CV_8UC3, kWhite);
+  cv::Mat out(rows * h, columns * w, CV_8UC3, cv::Scalar(255, 255, 255));
   for (std::size_t k = 0; k < images.size(); ++k) {
     cv::Mat src = images[k];
     if (src.channels() == 1) cv::cvtColor(src, src, cv::COLOR_GRAY2BGR);

@@ -1,13 +1,14 @@
 #pragma once
-// Charts for reports: line plots (a mean with a shaded band or error bars per series) and grouped
-// bar charts, with axes, "nice" ticks, a light grid, a title and a legend. Images are OpenCV BGR
-// matrices on a white background; writing them is map_io's write_image.
+// Charts for reports: line plots (a mean with a translucent band or error bars per series) and
+// grouped bar charts, with axes, "nice" ticks, a light grid, a title and a legend. Each is a
+// Drawing: rasterize() gives the PNG's image, to_svg() the same figure as SVG.
 #include <opencv2/core/mat.hpp>
 
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "viz/drawing.h"
 #include "viz/render.h"
 
 namespace fleetmap::viz {
@@ -18,6 +19,7 @@ struct PlotSeries {
   std::vector<double> x, y;             // same length; NaN y values leave a gap
   std::vector<double> y_low, y_high;    // empty, or one value per point: the band or error bar
   bool markers = false;                 // a dot at every point
+  bool dashed = false;                  // e.g. a bound rather than a measurement
 };
 
 struct PlotAxis {
@@ -33,6 +35,9 @@ struct LinePlot {
   PlotAxis x, y;
   std::vector<PlotSeries> series;
   // y_low/y_high drawn as a translucent band (true) or as error bars at the points (false).
+  // Bands blend where they overlap, so no series hides another's; a line that coincides with a
+  // later series' line is drawn wider, so both stay visible. A series with a single point is
+  // drawn as a short level line across it.
   bool bands = true;
 };
 
@@ -55,9 +60,17 @@ struct PlotOptions {
 // Tick values at 1, 2 or 5 times a power of ten covering [lo, hi], about `target` of them.
 std::vector<double> nice_ticks(double lo, double hi, int target = 6);
 
-cv::Mat draw_line_plot(const LinePlot& plot, const PlotOptions& options = {});
-cv::Mat draw_bar_chart(const BarChart& chart, const PlotOptions& options = {});
+Drawing line_plot(const LinePlot& plot, const PlotOptions& options = {});
+Drawing bar_chart(const BarChart& chart, const PlotOptions& options = {});
+inline cv::Mat draw_line_plot(const LinePlot& plot, const PlotOptions& options = {}) {
+  return rasterize(line_plot(plot, options));
+}
+inline cv::Mat draw_bar_chart(const BarChart& chart, const PlotOptions& options = {}) {
+  return rasterize(bar_chart(chart, options));
+}
 
+// Drawings side by side, `columns` per row; cells are as large as the largest drawing.
+Drawing tile(const std::vector<Drawing>& drawings, int columns);
 // Images side by side, `columns` per row, on white; cells are as large as the largest image.
 cv::Mat tile_images(const std::vector<cv::Mat>& images, int columns);
 
