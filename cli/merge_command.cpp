@@ -67,8 +67,12 @@ nlohmann::json transform_json(const std::string& map, const core::Transform2& pi
   return j;
 }
 
-// The fused map in map colours, each known cell tinted by the inputs that saw it: free cells
-// lightly, occupied cells strongly; cells where inputs disagree in red.
+// The fused map in map colours: free cells tinted by the inputs that saw them, occupied cells
+// black (walls dark and clear), cells where inputs disagree in red.
+uchar free_tint(double channel) { return cv::saturate_cast<uchar>(255 * 0.7 + channel * 0.3); }
+
+viz::Color free_tint(const viz::Color& c) { return {free_tint(c.r), free_tint(c.g), free_tint(c.b)}; }
+
 cv::Mat tinted(const merging::FusedMap& fused) {
   const auto& g = fused.grid;
   cv::Mat img(g.height(), g.width(), CV_8UC3);
@@ -91,12 +95,9 @@ cv::Mat tinted(const merging::FusedMap& fused) {
       }
       if (n > 0) tint /= n;
       if (state == mapping::CellState::Free) {
-        row[x] = cv::Vec3b(cv::saturate_cast<uchar>(255 * 0.75 + tint[0] * 0.25),
-                           cv::saturate_cast<uchar>(255 * 0.75 + tint[1] * 0.25),
-                           cv::saturate_cast<uchar>(255 * 0.75 + tint[2] * 0.25));
+        row[x] = cv::Vec3b(free_tint(tint[0]), free_tint(tint[1]), free_tint(tint[2]));
       } else {
-        row[x] = cv::Vec3b(cv::saturate_cast<uchar>(tint[0] * 0.55), cv::saturate_cast<uchar>(tint[1] * 0.55),
-                           cv::saturate_cast<uchar>(tint[2] * 0.55));
+        row[x] = cv::Vec3b(0, 0, 0);
       }
       if (fused.conflicts[i]) row[x] = cv::Vec3b(40, 39, 214);
     }
@@ -107,19 +108,14 @@ cv::Mat tinted(const merging::FusedMap& fused) {
 cv::Mat picture(const merging::FusedMap& fused, const std::vector<std::string>& names) {
   viz::Overlays overlays;
   for (int input : fused.inputs) {
-    viz::CellsOverlay legend_only;
-    legend_only.color = viz::palette_color(input);
-    legend_only.label = std::to_string(input + 1) + ": " + fs::path(names[std::size_t(input)]).filename().string();
-    overlays.cells.push_back(legend_only);
+    overlays.legend.push_back({viz::LegendItem::Swatch, free_tint(viz::palette_color(input)),
+                               std::to_string(input + 1) + ": " + fs::path(names[std::size_t(input)]).filename().string()});
   }
-  if (fused.conflict_cells > 0) {
-    viz::CellsOverlay conflicts;
-    conflicts.color = {214, 39, 40};
-    conflicts.label = "free vs occupied";
-    overlays.cells.push_back(conflicts);
-  }
+  if (fused.conflict_cells > 0) overlays.legend.push_back({viz::LegendItem::Swatch, {214, 39, 40}, "free vs occupied"});
   viz::RenderOptions render;
   render.title = "merged: " + std::to_string(fused.inputs.size()) + " of " + std::to_string(names.size()) + " maps";
+  // The known cells and half a metre around them: a small map gives a small picture.
+  render.crop_margin_m = 0.5;
   return viz::decorate(tinted(fused), fused.grid.geometry(), overlays, render);
 }
 
@@ -236,8 +232,8 @@ Command add_merge_command(CLI::App& root) {
                 "confident pairs chain each map to the first.\n"
                 "--json holds `transforms`: per input after the first, map, merged, tx, ty (pixels), theta_deg,\n"
                 "acceptance, confidence, method, via (the input it was aligned to); or merged: false and the reason.\n"
-                "The picture tints each input's cells in its own colour; red cells are free in one map, occupied in\n"
-                "another. A map file (--out merged.yaml) holds the fused map as map_server writes maps (0 occupied,\n"
+                "The picture tints each input's free cells in its own colour, walls black; red cells are free in one\n"
+                "map, occupied in another; it holds the known cells and half a metre around them, with metre axes. A map file (--out merged.yaml) holds the fused map as map_server writes maps (0 occupied,\n"
                 "254 free, 205 unknown), with the first map's resolution and origin: `fleetmap plan --map merged.yaml`\n"
                 "plans on it in the first robot's metres. Exit codes: 0 all merged, 1 some map not merged, 2 bad input.");
   auto o = std::make_shared<MergeCommandOptions>();

@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libopencv-dev libompl-dev liboctomap-dev libpng-dev
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev
+  libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libexpat1-dev
   slurm-wlm
 )
 # `--robustness` adds clang and its libFuzzer runtime, for the fuzzing stage of .ci/run.

@@ -142,6 +142,32 @@ TEST(ExploreCommand, AnimateWritesAVideo) {
   EXPECT_FALSE(std::filesystem::exists(dir / "v" / "run.partial.mp4"));
 }
 
+// The fourcc the file's first video stream holds, e.g. "avc1" (H.264).
+std::string stream_fourcc(const std::filesystem::path& p) {
+  cv::VideoCapture v(p.string());
+  const int c = int(v.get(cv::CAP_PROP_FOURCC));
+  return {char(c & 255), char((c >> 8) & 255), char((c >> 16) & 255), char((c >> 24) & 255)};
+}
+
+TEST(ExploreCommand, VideosAreH264OrWebmWhereOpenCVCanWriteThem) {
+  TempDir dir;
+  const auto r = run_fleetmap("explore --map empty --robots 2 --steps 4 --video run.webm --out w", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  cv::VideoCapture webm((dir / "w" / "run.webm").string());
+  ASSERT_TRUE(webm.isOpened());
+  cv::Mat frame;
+  ASSERT_TRUE(webm.read(frame));
+  // The WebM muxer takes only VP8, VP9 or AV1, so a file that opens holds one of them; no fallback note.
+  EXPECT_EQ(r.err.find("cannot write"), std::string::npos) << r.err;
+  // --animate: H.264 in MP4 where OpenCV's FFmpeg has an encoder (Debian 12's does, libx264).
+  const auto m = run_fleetmap("explore --map empty --robots 2 --steps 4 --animate --out m", dir);
+  ASSERT_EQ(m.exit_code, 0) << m.err;
+  const bool h264 = m.err.find("cannot write H.264") == std::string::npos;
+  EXPECT_EQ(stream_fourcc(dir / "m" / "run.mp4"), h264 ? "avc1" : "mp4v") << m.err;
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map empty --steps 2 --video run.avi --out x", dir), ".mp4 (H.264) or .webm");
+  EXPECT_FALSE(std::filesystem::exists(dir / "x"));
+}
+
 TEST(ExploreCommand, BadInputGetsOneLineAndNonZeroExit) {
   TempDir dir;
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map ofice", dir), "unknown map 'ofice'");

@@ -66,20 +66,38 @@ TEST(MergeCommand, MergesTwoMapsInThePixelConvention) {
   EXPECT_EQ(t["via"], "a.png");
   EXPECT_NE(j["convention"].get<std::string>().find("R(theta) (u, v) + (tx, ty)"), std::string::npos);
 
-  // The picture tints each input in its own palette colour (legend swatches included).
+  // The picture tints each input's free cells toward its palette colour (legend swatches included).
   const cv::Mat img = cv::imread((dir / "out" / "merged.png").string());
   ASSERT_FALSE(img.empty());
   const auto has_colour = [&](const viz::Color& c) {
     for (int y = 0; y < img.rows; ++y) {
       for (int x = 0; x < img.cols; ++x) {
         const auto& p = img.at<cv::Vec3b>(y, x);
-        if (p[0] == c.b && p[1] == c.g && p[2] == c.r) return true;
+        const auto tint = [](int v) { return cv::saturate_cast<uchar>(255 * 0.7 + v * 0.3); };
+        if (p[0] == tint(c.b) && p[1] == tint(c.g) && p[2] == tint(c.r)) return true;
       }
     }
     return false;
   };
   EXPECT_TRUE(has_colour(viz::palette_color(0)));
   EXPECT_TRUE(has_colour(viz::palette_color(1)));
+}
+
+TEST(MergeCommand, ThePictureHoldsTheMapWithoutEmptyMarginsAndDarkWalls) {
+  TempDir dir;
+  write_pair(dir, "a.png", "b.png", 5);
+  ASSERT_EQ(run_fleetmap("merge a.png b.png --out m.png", dir).exit_code, 0);
+  const cv::Mat img = cv::imread((dir / "m.png").string());
+  ASSERT_FALSE(img.empty());
+  // Two 140-cell crops overlapping by half span at most 280 cells: drawn at 3 px or more per
+  // cell toward 800 px, the picture stays near that size plus axes and legend, nowhere near the
+  // fused grid's padded extent.
+  EXPECT_LT(img.cols, 1400);
+  EXPECT_LT(img.rows, 1100);
+  // Walls are black, not tints.
+  cv::Mat black;
+  cv::inRange(img, cv::Scalar(0, 0, 0), cv::Scalar(0, 0, 0), black);
+  EXPECT_GT(cv::countNonZero(black), 2000);
 }
 
 TEST(MergeCommand, AMapWithoutOverlapIsReportedNotMerged) {

@@ -4,6 +4,9 @@
 
 #include <opencv2/core.hpp>
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include "core/error.h"
@@ -111,6 +114,24 @@ TEST(SweepReport, MarkdownMarksTheBestPerColumn) {
   EXPECT_EQ(line_of("cave", "fast").find("**0.167"), std::string::npos) << line_of("cave", "fast");
 }
 
+TEST(SweepReport, BoldOnlyWhenTheIntervalsDoNotOverlap) {
+  // "close" is faster on average but its interval overlaps "far"'s: no bold in steps to 99%.
+  std::vector<RunRecord> records;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    records.push_back(record("office", "close", 2, seed, 100 + 20 * int(seed), 50.0));
+    records.push_back(record("office", "far", 2, seed, 110 + 20 * int(seed), 50.0 + double(seed)));
+  }
+  const std::string md = summary_markdown(records, summarize_groups(records));
+  const auto at = md.find("| close |");
+  const std::string close = md.substr(at, md.find('\n', at) - at);
+  EXPECT_EQ(close.find("**140.0"), std::string::npos) << close;
+  EXPECT_NE(close.find("140.0 ± "), std::string::npos) << close;
+  // A single seed gives no interval, so nothing is bold.
+  std::vector<RunRecord> one = {record("office", "close", 2, 1, 100, 50.0), record("office", "far", 2, 1, 300, 60.0)};
+  const std::string md_one = summary_markdown(one, summarize_groups(one));
+  EXPECT_EQ(md_one.find("**", md_one.find("| strategy |")), std::string::npos) << md_one;
+}
+
 TEST(SweepReport, PairedComparisonOfTwoStrategies) {
   const auto records = sample_records();
   const StrategyComparison c = compare_strategies(records, "fast", "slow", "steps_to_99");
@@ -182,6 +203,40 @@ TEST(SweepReport, PlotsForEveryMapAndEfficiency) {
   }
   EXPECT_EQ(files, (std::vector<std::string>{"coverage_office.png", "time_office.png", "coverage_cave.png", "time_cave.png",
                                              "efficiency.png"}));
+}
+
+TEST(SweepReport, TheLowerBoundIsDrawnForASingleTeamSize) {
+  // Every record has 2 robots: the bound is one point, drawn as a short dashed level line.
+  const auto plots = sweep_plots(sample_records());
+  const auto& time = plots[1];
+  ASSERT_EQ(time.file, "time_office.png");
+  int series = 0, dashed = 0;
+  for (const auto& shape : time.drawing.shapes()) {
+    if (shape.role != "series") continue;
+    ++series;
+    if (shape.dashed && shape.color == viz::Color{90, 90, 90}) {
+      ++dashed;
+      ASSERT_EQ(shape.points.size(), 2u);
+      EXPECT_GT(shape.points[1].x - shape.points[0].x, 10.0);
+    }
+  }
+  EXPECT_EQ(series, 3);  // fast, slow and the bound
+  EXPECT_EQ(dashed, 1);
+}
+
+TEST(SweepReport, EveryPlotIsWrittenAsPngAndSvg) {
+  fleetmap::testing::TempDir dir;
+  const auto written = write_sweep_reports(dir.path(), sample_records());
+  for (const char* stem : {"coverage_office", "time_office", "coverage_cave", "time_cave", "efficiency"}) {
+    for (const char* ext : {".png", ".svg"}) {
+      const auto p = dir.path() / (std::string(stem) + ext);
+      EXPECT_TRUE(std::filesystem::exists(p)) << p;
+      EXPECT_NE(std::find(written.begin(), written.end(), p), written.end()) << p;
+    }
+  }
+  std::ifstream svg(dir.path() / "efficiency.svg");
+  const std::string text((std::istreambuf_iterator<char>(svg)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("<svg"), std::string::npos);
 }
 
 }  // namespace
