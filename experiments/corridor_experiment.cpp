@@ -378,8 +378,10 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
         core::normalize_angle(bearing_om + core::deg2rad(err_deg)));
     m.rotation_error_deg = core::rad2deg(std::abs(core::normalize_angle(t.rotation() - true_other_to_master.rotation())));
     m.far_end_error_m = (t.apply(Eigen::Vector2d::Zero()) - true_other_to_master.apply(Eigen::Vector2d::Zero())).norm();
-    m.merged = master_map;
-    merging::fuse_into(m.merged, other_map, merging::cells_from_world(master_map.geometry(), other_map.geometry(), t));
+    // A grid covering both maps, so the other's map, turned by a wrong orientation, is not cut at
+    // the master grid's edge.
+    m.merged = merging::fuse_pair(master_map, other_map,
+                                  merging::cells_from_world(master_map.geometry(), other_map.geometry(), t)).grid;
     // The other's walls, placed by t, against the true walls.
     mapping::MapQualityOptions quality;
     quality.wall_tolerance_m = 0.3;

@@ -96,7 +96,7 @@ struct DetectionMerge {
   double far_end_error_m = 0.0;          // where the other robot's start lands vs. where it is
   double mean_wall_distance_m = 0.0;     // the other's walls in the merged map to the nearest true wall
   double misplaced_wall_share = 0.0;     // share of the other's wall cells farther than 0.3 m from a wall
-  mapping::OccupancyGrid merged;         // in the master's frame (the world's)
+  mapping::OccupancyGrid merged;         // in the world frame, covering both maps
 };
 
 struct CorridorResult {

@@ -176,6 +176,7 @@ std::vector<std::filesystem::path> write_corridor_outputs(const CorridorResult& 
     o.paths.push_back({positions(run.truth), green, "true path", 1, false});
     o.paths.push_back({positions(run.estimate), blue, "estimated path", 1, true});
     viz::RenderOptions ro;
+    ro.crop_margin_m = 1.0;
     ro.title = run.method + ", " + laps_text(run.laps) + ": length " + num(run.dimensions.length_m, 2) + " m, height " +
                num(run.dimensions.height_m, 2) + " m";
     const auto path = dir / ("corridor_" + run.method + "_" + std::to_string(run.laps) + "lap.png");
@@ -194,6 +195,7 @@ std::vector<std::filesystem::path> write_corridor_outputs(const CorridorResult& 
       o.poses.push_back({r.meeting_other, 0.3, blue, "other at the meeting"});
       viz::RenderOptions ro;
       ro.title = "merge by detection, orientation error " + num(m.orientation_error_deg, 1) + " deg";
+      ro.crop_margin_m = 1.0;
       const auto path = dir / ("merge_detection_" + error_name(m.orientation_error_deg) + "deg.png");
       io::write_image(path, viz::render_map(m.merged, o, ro));
       written.push_back(path);

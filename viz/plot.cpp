@@ -262,7 +262,7 @@ Drawing line_plot(const LinePlot& plot, const PlotOptions& options) {
       std::vector<cv::Point2d> line;
       for (std::size_t i = b; i < e; ++i) line.push_back(f.point(s.x[i], s.y[i]));
       // A single point is a short level line, so a one-value series (e.g. a bound at one team size) shows.
-      if (line.size() == 1) line = {line[0] + cv::Point2d(-14, 0), line[0] + cv::Point2d(14, 0)};
+      if (line.size() == 1) line = {line[0] + cv::Point2d(-24, 0), line[0] + cv::Point2d(24, 0)};
       d.polyline(line, s.color, widths[k], s.dashed);
       d.set_role("series");
       for (std::size_t i = b; i < e; ++i) {
