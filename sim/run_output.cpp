@@ -310,14 +310,15 @@ const std::string& RunVideo::fallback_note() const { return impl_->note; }
 
 void RunVideo::add_frame(const Simulation& sim, const std::string& map_label) {
   viz::Overlays o;
-  const auto estimates = sim.estimated_poses();
   for (int i = 0; i < sim.scenario().robot_count; ++i) {
     const auto colour = viz::palette_color(i);
     const auto& truth = sim.track(i).truth;
     o.paths.push_back({positions(truth), colour, "robot " + std::to_string(i + 1), 2, false});
+    // The plan is in the robot's own map frame; the picture is in the world's.
     auto plan = sim.path(i);
-    if (!plan.empty()) {
-      plan.insert(plan.begin(), estimates[std::size_t(i)].position());
+    for (auto& p : plan) p = sim.frame_origin(i).apply(p);
+    if (!plan.empty() && !sim.track(i).estimate.empty()) {
+      plan.insert(plan.begin(), sim.track(i).estimate.back().position());
       o.paths.push_back({plan, colour, "", 1, true});
     }
     if (!truth.empty()) o.poses.push_back({truth.front(), sim.scenario().robot.radius_m, colour, "", true});
