@@ -24,12 +24,6 @@ bool finite(double v) { return std::isfinite(v); }
 
 int text_width(const std::string& text, double scale) { return text_size(text, scale).width; }
 
-// Decimals enough to tell ticks `step` apart.
-std::string tick_text(double v, double step) {
-  const int decimals = std::clamp(int(-std::floor(std::log10(step) + 1e-9)), 0, 6);
-  return fmt::format("{:.{}f}", std::abs(v) < step * 1e-9 ? 0.0 : v, decimals);
-}
-
 double tick_step(const std::vector<double>& ticks) { return ticks.size() > 1 ? ticks[1] - ticks[0] : 1.0; }
 
 struct Range {
@@ -157,6 +151,11 @@ std::vector<std::pair<std::size_t, std::size_t>> runs_of_finite(const PlotSeries
 bool has_band(const PlotSeries& s) { return s.y_low.size() == s.y.size() && s.y_high.size() == s.y.size(); }
 
 }  // namespace
+
+std::string tick_text(double v, double step) {
+  const int decimals = std::clamp(int(-std::floor(std::log10(step) + 1e-9)), 0, 6);
+  return fmt::format("{:.{}f}", std::abs(v) < step * 1e-9 ? 0.0 : v, decimals);
+}
 
 std::vector<double> nice_ticks(double lo, double hi, int target) {
   if (!finite(lo) || !finite(hi)) return {};

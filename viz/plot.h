@@ -59,6 +59,8 @@ struct PlotOptions {
 
 // Tick values at 1, 2 or 5 times a power of ten covering [lo, hi], about `target` of them.
 std::vector<double> nice_ticks(double lo, double hi, int target = 6);
+// A tick's label with decimals enough to tell ticks `step` apart ("0.5", "10").
+std::string tick_text(double v, double step);
 
 Drawing line_plot(const LinePlot& plot, const PlotOptions& options = {});
 Drawing bar_chart(const BarChart& chart, const PlotOptions& options = {});

@@ -43,12 +43,6 @@ std::string format_metres(double m) {
 
 const cv::Vec3b kOutside(238, 238, 238);
 
-// Decimals enough to tell ticks `step` apart.
-std::string tick_text(double v, double step) {
-  const int decimals = std::clamp(int(-std::floor(std::log10(step) + 1e-9)), 0, 6);
-  return fmt::format("{:.{}f}", std::abs(v) < step * 1e-9 ? 0.0 : v, decimals);
-}
-
 // Cells [x0, x1) x [y0, y1) of the picture; may reach beyond the grid.
 struct CellBox {
   int x0, y0, x1, y1;
