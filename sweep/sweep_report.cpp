@@ -200,7 +200,8 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
         "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) + (seeds.size() == 1 ? " seed. " : " seeds. ") + settings + ".\n\n";
   md += "Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
         "reached the level. **Bold**: the best strategy in the column for that map and team size (lowest; highest for "
-        "efficiency and coverage), only when its 95% interval overlaps no other strategy's (so never with one seed). Efficiency = lower bound / steps to 99% (README.md, \"Benchmarking strategies\").\n";
+        "efficiency and coverage), only when its 95% interval overlaps no other row's (so never with one seed). "
+        "Efficiency = lower bound / steps to 99% (README.md, \"Benchmarking strategies\").\n";
   for (const auto& map : maps) {
     md += "\n## " + map + "\n";
     for (int team : teams) {
