@@ -129,17 +129,22 @@ void check_same_sweep(const fs::path& out, const sweep::Sweep& sweep, const std:
 
 // The files a bench folder holds for these maps.
 std::vector<std::string> bench_files(const std::vector<std::string>& map_labels) {
-  std::vector<std::string> files = {"results.csv", "summary.csv", "summary.md", "sweep.yaml", "scenario.yaml", "efficiency.png"};
+  std::vector<std::string> files = {"results.csv", "summary.csv", "summary.md", "sweep.yaml", "scenario.yaml"};
+  std::vector<std::string> plots = {"efficiency"};
   for (const auto& m : map_labels) {
-    files.push_back("coverage_" + m + ".png");
-    files.push_back("time_" + m + ".png");
+    plots.push_back("coverage_" + m);
+    plots.push_back("time_" + m);
+  }
+  for (const auto& p : plots) {
+    files.push_back(p + ".png");
+    files.push_back(p + ".svg");
   }
   return files;
 }
 
 void print_outputs(const fs::path& out, const std::vector<fs::path>& reports) {
   fmt::print("results: {}\nsummary: {}\n", (out / "results.csv").string(), (out / "summary.md").string());
-  fmt::print("plots:");
+  fmt::print("plots (PNG, and SVG beside each):");
   for (const auto& p : reports) {
     if (p.extension() == ".png") fmt::print(" {}", p.filename().string());
   }
@@ -324,7 +329,7 @@ Command add_bench_command(CLI::App& root) {
       "Runs every combination in parallel (--jobs), with a progress bar and ETA on stderr when it is a terminal,\n"
       "and writes into --out: results.csv (a row per run, appended whole and flushed), summary.csv and summary.md\n"
       "(mean, standard deviation and 95% confidence interval per map x strategy x team size (x --vary values), best marked),\n"
-      "coverage_<map>.png, time_<map>.png, efficiency.png, and sweep.yaml. efficiency = lower bound / steps to 99% (README.md, \"Benchmarking\n"
+      "coverage_<map>.png, time_<map>.png, efficiency.png (each also as .svg), and sweep.yaml. efficiency = lower bound / steps to 99% (README.md, \"Benchmarking\n"
       "strategies\"). Run it again with the same --out after an interruption and it finishes the sweep without\n"
       "redoing finished runs. The same flags give the same rows whatever --jobs (only wall_time_s differs).\n\n"
       "Examples:\n"
