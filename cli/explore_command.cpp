@@ -100,7 +100,7 @@ void print_summary(const sim::RunResult& result, const std::string& label) {
   fmt::print("{}: {}, strategy {}, localization {}, communication {}, seed {}\n", label,
              counted(sc.placement == sim::Placement::List ? long(sc.starts.size()) : sc.robot_count, "robot"),
              sc.exploration.strategy, sc.localization, range, sc.seed);
-  fmt::print("explored {} of the reachable free space in {} ({}); {}, {}\n", format_percent(result.coverage.back()),
+  fmt::print("explored {} of the observable space in {} ({}); {}, {}\n", format_percent(result.coverage.back()),
              counted(result.steps, "step"), result.finished ? "no reachable frontier left" : "step limit reached",
              level_text("95%", result.steps_to_95), level_text("99%", result.steps_to_99));
   fmt::print("travelled {:.1f} m in all, redundancy {:.2f}, {} bytes sent in {}, {:.2f} s\n", distance,

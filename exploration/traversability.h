@@ -1,6 +1,7 @@
 #pragma once
-// Where a robot's centre may go on a map it has built.
+// Where a robot fits, and where its centre may go on a map it has built.
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "mapping/occupancy_grid.h"
@@ -9,17 +10,40 @@ namespace fleetmap::exploration {
 
 struct TraversabilityOptions {
   double robot_radius_m = 0.2;
-  // Extra clearance beyond the radius: a robot is not always at a cell centre.
+  // Extra clearance beyond the radius, kept where the map allows: a robot is not always at a cell
+  // centre. A place with less (but more than the radius) is still passable, at a higher cost.
   double safety_margin_m = 0.05;
 };
 
+// Where a robot of radius `radius_m` fits: the cells whose centre lies farther than the radius from
+// every blocking cell (the nearest point of its square, as World::disc_free measures a move) and
+// from the grid's outside. `blocking` has one flag per cell, row-major. This is the one notion of
+// "fits" behind both the explorer's passable cells (blocking: its map's occupied cells) and the
+// coverage metric's reachable poses (blocking: every cell of the true map that is not free).
+std::vector<std::uint8_t> fitting_cells(const core::GridGeometry& geometry, std::span<const std::uint8_t> blocking,
+                                        double radius_m);
+
+// How a robot's centre may use a cell of its own map.
+enum class Passage : std::uint8_t {
+  Blocked = 0,  // not known free, or the robot does not fit among the occupied cells
+  Fits = 1,     // known free and the robot fits, but unknown cells or walls lie within radius + margin
+  Clear = 2,    // known free with radius + margin of known free space around it (traversable_cells)
+};
+
+// Per cell, a Passage value. Waves pass Fits and Clear cells and prefer Clear ones: unknown space
+// next to a path is often more wall, yet a doorway seen at a slant, or the spokes of a sparse scan,
+// can only be entered through cells whose surroundings are not all seen yet.
+std::vector<std::uint8_t> passage_cells(const mapping::OccupancyGrid& map, const TraversabilityOptions& options);
+
 // Known-free cells whose centre is farther than radius + margin from the centre of every cell that is
-// not known free (an OpenCV distance transform): robots keep clear of walls and of unknown space
-// alike, since unknown cells next to a wall are usually more wall.
+// not known free (an OpenCV distance transform): the Clear cells of passage_cells.
 std::vector<std::uint8_t> traversable_cells(const mapping::OccupancyGrid& map, const TraversabilityOptions& options);
 
 // True when every cell within radius + margin of the cell's centre is known free (the local form of
-// traversable_cells, used to see whether a planned path became blocked).
+// traversable_cells).
 bool cell_clear(const mapping::OccupancyGrid& map, const core::Cell& c, const TraversabilityOptions& options);
+// True when the cell is known free and the robot fits there among the occupied cells (the local
+// form of a Fits-or-better cell of passage_cells: used to see whether a planned path became blocked).
+bool cell_fits(const mapping::OccupancyGrid& map, const core::Cell& c, const TraversabilityOptions& options);
 
 }  // namespace fleetmap::exploration

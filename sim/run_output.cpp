@@ -162,7 +162,13 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   j["redundancy"] = r.redundancy;
   j["bytes_sent"] = r.bytes_sent;
   j["meetings"] = r.meetings;
-  j["reachable_free_cells"] = r.reachable_free_cells;
+  const auto& sp = r.space;
+  j["space"] = {{"observable_cells", sp.observable_cells},
+                {"observable_m2", double(sp.observable_cells) * sp.cell_area_m2},
+                {"free_m2", double(sp.free_cells) * sp.cell_area_m2},
+                {"pose_cells", sp.pose_cells},
+                {"unreachable_observable_m2", double(sp.unreachable_cells) * sp.cell_area_m2},
+                {"seen_unreachable_m2", double(sp.seen_unreachable.size()) * sp.cell_area_m2}};
   j["landmarks"] = r.landmarks.size();
   j["map_quality"] = map_quality_json(r.map_quality);
   j["per_robot"] = per_robot_json(r, totals);
@@ -192,6 +198,12 @@ cv::Mat render_merged(const RunResult& r, const std::string& map_label, const vi
   }
   add_pose_legend(o);
   if (!r.landmarks.empty()) o.points.push_back({r.landmarks, {200, 0, 200}, "landmarks", 3});
+  if (!r.space.seen_unreachable.empty()) {
+    // Seen, counted in the coverage, but beyond where a robot fits (through a gap, in a corner).
+    mapping::CellsOverlay seen{{}, {255, 160, 40}, "seen, not reachable", 0.45};
+    for (int idx : r.space.seen_unreachable) seen.cells.push_back(r.merged.geometry().cell_of_index(idx));
+    o.cells.push_back(std::move(seen));
+  }
   o.cells.insert(o.cells.end(), extra.cells.begin(), extra.cells.end());
   o.paths.insert(o.paths.end(), extra.paths.begin(), extra.paths.end());
   o.points.insert(o.points.end(), extra.points.begin(), extra.points.end());

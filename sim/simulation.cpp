@@ -232,7 +232,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   blocked_streak_.assign(std::size_t(n), 0);
   std::vector<Eigen::Vector2d> start_points;
   for (const auto& p : truths_) start_points.push_back(p.position());
-  reachable_ = world_.reachable_free_cells(start_points);
+  observable_ = world_.observable_space(start_points, scenario_.robot.radius_m, scenario_.range.max_range_m);
   sensed_by_.assign(std::size_t(world_.geometry().cell_count()), 0);
   previous_links_.assign(std::size_t(n), std::vector<char>(std::size_t(n), 0));
 
@@ -360,8 +360,9 @@ void Simulation::decide() {
 void Simulation::measure() {
   const auto t0 = Clock::now();
   std::int64_t known = 0;
-  for (int idx : reachable_) known += merged_.log_odds_at(idx) != 0.0f;
-  coverage_.push_back(reachable_.empty() ? 1.0 : double(known) / double(reachable_.size()));
+  const auto& cells = observable_.observable;
+  for (int idx : cells) known += merged_.log_odds_at(idx) != 0.0f;
+  coverage_.push_back(cells.empty() ? 1.0 : double(known) / double(cells.size()));
   for (int i = 0; i < scenario_.robot_count; ++i) {
     auto& t = tracks_[std::size_t(i)];
     t.truth.push_back(truths_[std::size_t(i)]);
@@ -522,7 +523,7 @@ RunResult Simulation::result() const {
     if (!r.steps_to_99 && coverage_[k] >= 0.99) r.steps_to_99 = int(k);
   }
   std::int64_t sensed = 0, shared = 0;
-  for (int idx : reachable_) {
+  for (int idx : observable_.observable) {
     const int robots = std::popcount(sensed_by_[std::size_t(idx)]);
     sensed += robots > 0;
     shared += robots > 1;
@@ -530,7 +531,13 @@ RunResult Simulation::result() const {
   r.redundancy = sensed ? double(shared) / double(sensed) : 0.0;
   r.bytes_sent = bytes_sent_;
   r.meetings = meetings_;
-  r.reachable_free_cells = std::int64_t(reachable_.size());
+  r.space.observable_cells = std::int64_t(observable_.observable.size());
+  r.space.unreachable_cells = std::int64_t(observable_.unreachable.size());
+  r.space.pose_cells = observable_.poses;
+  r.space.free_cells = observable_.free_cells;
+  r.space.cell_area_m2 = observable_.cell_area_m2;
+  for (int idx : observable_.unreachable)
+    if (merged_.log_odds_at(idx) != 0.0f) r.space.seen_unreachable.push_back(idx);
   r.robots = tracks_;
   for (int i = 0; i < scenario_.robot_count; ++i) r.robot_frames.push_back(frame_origin(i));
   r.merges = merges_;

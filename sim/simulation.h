@@ -57,18 +57,28 @@ struct Timings {  // seconds
          metrics = 0;
 };
 
+// The space a run is measured on (World::observable_space), and what of it was left.
+struct CoverageSpace {
+  std::int64_t observable_cells = 0;   // coverage is the share of these the merged map observed
+  std::int64_t unreachable_cells = 0;  // observable, but outside every reachable pose's disc
+  std::int64_t pose_cells = 0;         // cells where a robot's centre can be
+  std::int64_t free_cells = 0;         // every free cell of the true map
+  double cell_area_m2 = 0.0;
+  std::vector<int> seen_unreachable;   // cell indices: the unreachable cells the merged map observed
+};
+
 struct RunResult {
   Scenario scenario;                 // as run: starts resolved, landmarks placed
   int steps = 0;                     // steps taken
   bool finished = false;             // every robot ran out of reachable frontiers before the limit
-  // coverage[k] after step k (k = 0: the first scan, before moving): the share of the reachable free
-  // cells of the ground truth that the merged map has observed.
+  // coverage[k] after step k (k = 0: the first scan, before moving): the share of the observable
+  // cells of the ground truth (World::observable_space) that the merged map has observed.
   std::vector<double> coverage;
   std::optional<int> steps_to_95, steps_to_99;
-  double redundancy = 0.0;           // of the reachable free cells sensed, the share sensed by 2+ robots
+  double redundancy = 0.0;           // of the observable cells sensed, the share sensed by 2+ robots
   std::int64_t bytes_sent = 0;
   int meetings = 0;
-  std::int64_t reachable_free_cells = 0;
+  CoverageSpace space;
   std::vector<RobotTrack> robots;     // truth and estimates in the world frame
   std::vector<core::Transform2> robot_frames;  // where each robot's map frame lies in the world, at the end
   std::vector<MergeRecord> merges;
@@ -135,7 +145,7 @@ class Simulation {
   exploration::TeamExplorer explorer_;
   std::vector<std::vector<Detection>> detections_;
   std::vector<std::vector<char>> links_, previous_links_;
-  std::vector<int> reachable_;        // indices of the reachable free cells of the truth
+  ObservableSpace observable_;         // the cells coverage is measured on
   std::vector<std::uint64_t> sensed_by_;  // per cell, a bit per robot
   std::vector<double> coverage_;
   std::vector<RobotTrack> tracks_;

@@ -12,6 +12,20 @@ namespace fleetmap::sim {
 
 using core::Cell;
 
+// What robots starting at given points can observe of a world (DESIGN.md §5). A pose is a cell
+// centre where the robot fits (exploration::fitting_cells on the true map: farther than its radius
+// from every cell that is not free) and that it can reach from a start (4-connected through such
+// cells, as the explorer's waves go). A free cell is observable when it lies within the sensor range
+// of a pose and in its line of sight (the traversal every beam takes). Cells seen through a gap
+// the robot cannot pass count only as far as they can be seen from the reachable side.
+struct ObservableSpace {
+  std::vector<int> observable;   // sorted cell indices: coverage is the share of these observed
+  std::vector<int> unreachable;  // the observable cells no robot's body can cover (outside every pose's disc)
+  std::int64_t poses = 0;        // cells where a robot's centre can be
+  std::int64_t free_cells = 0;   // every free cell of the map
+  double cell_area_m2 = 0.0;
+};
+
 class World {
  public:
   World(mapping::OccupancyGrid truth, std::vector<Eigen::Vector2d> landmarks);
@@ -27,9 +41,11 @@ class World {
   // A disc of radius r at p touches no blocked cell and lies inside the map.
   bool disc_free(const Eigen::Vector2d& p, double radius_m) const;
 
-  // Free cells in the 4-connected free region(s) holding the given points: the space robots
-  // starting there can explore. Coverage is measured against these cells.
-  std::vector<int> reachable_free_cells(const std::vector<Eigen::Vector2d>& starts) const;
+  // The space exploration is measured on, for robots of radius `robot_radius_m` with a range sensor
+  // of `sensor_range_m` starting at `starts` (see ObservableSpace). The one definition behind
+  // coverage, the lower bound and the run's report.
+  ObservableSpace observable_space(const std::vector<Eigen::Vector2d>& starts, double robot_radius_m,
+                                          double sensor_range_m) const;
 
  private:
   mapping::OccupancyGrid truth_;

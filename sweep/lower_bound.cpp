@@ -10,11 +10,17 @@ namespace fleetmap::sweep {
 
 ExplorationLowerBound exploration_lower_bound(const sim::World& world, const std::vector<Eigen::Vector2d>& starts,
                                               const LowerBoundOptions& options) {
+  const std::vector<int> observable =
+      world.observable_space(starts, options.robot_radius_m, options.sensor_range_m).observable;
+  return exploration_lower_bound(world, starts, observable, options);
+}
+
+ExplorationLowerBound exploration_lower_bound(const sim::World& world, const std::vector<Eigen::Vector2d>& starts,
+                                              const std::vector<int>& observable, const LowerBoundOptions& options) {
   ExplorationLowerBound b;
   const auto& g = world.geometry();
   const double cell = g.resolution();
-  const std::vector<int> reachable = world.reachable_free_cells(starts);
-  const std::int64_t n_cells = std::int64_t(reachable.size());
+  const std::int64_t n_cells = std::int64_t(observable.size());
   if (n_cells == 0 || starts.empty()) return b;
   // At least this many cells are known when coverage >= options.coverage.
   const std::int64_t needed = std::clamp<std::int64_t>(
@@ -31,11 +37,12 @@ ExplorationLowerBound exploration_lower_bound(const sim::World& world, const std
   wo.eight_connected = true;
   const auto wave = exploration::compute_wave({g.width(), g.height(), passable, {}}, sources, wo);
 
-  // Distances of the reachable cells; the `needed`-th smallest bounds the farthest cell a robot
-  // must have come near. Every reachable cell is reached by the wave (4-connected moves are in it).
+  // Distances of the observable cells; the `needed`-th smallest bounds the farthest cell a robot
+  // must have come near. Every observable cell is reached by the wave: a line of sight runs through
+  // 4-connected free cells.
   std::vector<double> distance;
-  distance.reserve(reachable.size());
-  for (int idx : reachable) distance.push_back(double(wave.cost_at(idx)) * cell / kOctileStretch);
+  distance.reserve(observable.size());
+  for (int idx : observable) distance.push_back(double(wave.cost_at(idx)) * cell / kOctileStretch);
   const auto nth = distance.begin() + (needed - 1);
   std::nth_element(distance.begin(), nth, distance.end());
   b.quantile_distance_m = *nth;

@@ -409,7 +409,7 @@ viz::Drawing coverage_plot(const std::vector<RunRecord>& records, const std::str
     viz::LinePlot plot;
     plot.title = map + ", " + team_text(team);
     plot.x = {"step", 0.0, double(last), {}};
-    plot.y = {"coverage of the reachable free space (%)", 0.0, 100.0, {}};
+    plot.y = {"coverage of the observable space (%)", 0.0, 100.0, {}};
     for (const auto& strategy : strategies) {
       std::vector<const RunRecord*> mine;
       for (const auto* r : runs) {

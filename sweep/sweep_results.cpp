@@ -247,6 +247,7 @@ RunRecord make_record(const sim::RunResult& result, const sim::World& world, con
   lb_options.coverage = 0.99;
   lb_options.sensor_range_m = s.range.max_range_m;
   lb_options.step_length_m = s.robot.max_speed_mps * s.period_s;
+  lb_options.robot_radius_m = s.robot.radius_m;
   const ExplorationLowerBound lb = exploration_lower_bound(world, starts, lb_options);
   r.lower_bound_steps = lb.steps();
   r.lower_bound_travel_steps = lb.travel_steps;
