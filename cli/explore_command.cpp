@@ -13,6 +13,7 @@
 #include "cli/progress.h"
 #include "cli/validators.h"
 #include "core/error.h"
+#include "core/format.h"
 #include "exploration/strategy.h"
 #include "localization/localizer.h"
 #include "io/file_io.h"
@@ -103,6 +104,14 @@ void print_summary(const sim::RunResult& result, const std::string& label) {
   fmt::print("explored {} of the observable space in {} ({}); {}, {}\n", format_percent(result.coverage.back()),
              counted(result.steps, "step"), result.finished ? "no reachable frontier left" : "step limit reached",
              level_text("95%", result.steps_to_95), level_text("99%", result.steps_to_99));
+  if (result.coverage.back() < 0.99 && !result.unexplored.empty()) {
+    // Why the run ended short, for the largest region left (metrics.json lists more).
+    double area = 0.0;
+    for (const auto& u : result.unexplored) area += u.area_m2;
+    const auto& big = result.unexplored.front();
+    fmt::print("left unexplored: {:.2f} m2 in {}; the largest, {:.2f} m2 at {}: {}\n", area,
+               counted(long(result.unexplored.size()), "region"), big.area_m2, core::format_point(big.centre_m), big.reason);
+  }
   fmt::print("travelled {:.1f} m in all, redundancy {:.2f}, {} bytes sent in {}, {:.2f} s\n", distance,
              result.redundancy, result.bytes_sent, counted(result.meetings, "meeting"), result.timing.total);
   // How well the robots knew where they were, and what that did to the map.

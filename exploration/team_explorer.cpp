@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <unordered_map>
 
 #include "mapping/grid_traversal.h"
 
@@ -13,8 +14,8 @@ namespace {
 Cell robot_cell(const ExplorerRobot& r) { return r.map->geometry().world_to_cell_unbounded(r.pose.position()); }
 
 WaveGrid wave_grid(const mapping::OccupancyGrid& map, const std::vector<std::uint8_t>& passable,
-                   std::vector<float>& occupancy, const WaveOptions& options) {
-  WaveGrid g{map.width(), map.height(), passable, {}};
+                   const std::vector<std::uint8_t>& factor, std::vector<float>& occupancy, const WaveOptions& options) {
+  WaveGrid g{map.width(), map.height(), passable, {}, factor};
   if (options.occupancy_weight > 0.0) {
     occupancy.resize(passable.size());
     for (std::size_t i = 0; i < occupancy.size(); ++i) occupancy[i] = float(mapping::log_odds_to_probability(map.log_odds_at(int(i))));
@@ -24,9 +25,11 @@ WaveGrid wave_grid(const mapping::OccupancyGrid& map, const std::vector<std::uin
 }
 
 // A robot standing in inflated space (it cut a corner, or the map just grew a wall beside it) must
-// still find a way out: the free cells within the inflation distance of it become passable.
+// still find a way out: the free cells within the inflation distance of it become passable. A robot
+// on a passable cell needs no way out (opening around it would let paths cut round wall ends).
 void open_around(const mapping::OccupancyGrid& map, const Cell& c, const TraversabilityOptions& options,
                  std::vector<std::uint8_t>& passable) {
+  if (map.contains(c) && passable[std::size_t(map.geometry().index(c))]) return;
   const double reach = (options.robot_radius_m + options.safety_margin_m) / map.resolution() + 1.0;
   const int r = int(std::ceil(reach));
   for (int dy = -r; dy <= r; ++dy) {
@@ -83,29 +86,58 @@ std::optional<Eigen::Vector2d> TeamExplorer::goal(int i) const {
   return r.geometry.cell_center(r.goal);
 }
 
-void TeamExplorer::give_up(int i, std::int64_t known_cells) {
-  RobotState& r = robots_[std::size_t(i)];
-  r.has_task = false;
-  ++stats_.targets_given_up;
-  // A place given up before counts another attempt.
-  int attempts = 1;
-  for (const auto& list : {r.given_up, r.abandoned}) {
-    for (const auto& g : list) {
-      if (g.frontier == r.frontier) attempts = std::max(attempts, g.attempts + 1);
-    }
+void TeamExplorer::passage_grid(const std::vector<std::uint8_t>& passage, std::vector<std::uint8_t>& passable,
+                                std::vector<std::uint8_t>& factor) const {
+  passable = passage;
+  factor.resize(passable.size());
+  const auto tight = std::uint8_t(std::clamp(options_.tight_cost_factor, 1, 255));
+  for (std::size_t i = 0; i < passable.size(); ++i) {
+    factor[i] = passable[i] == std::uint8_t(Passage::Fits) ? tight : 1;
+    passable[i] = passable[i] != std::uint8_t(Passage::Blocked);
   }
-  std::erase_if(r.given_up, [&](const GivenUp& g) { return g.frontier == r.frontier; });
-  if (attempts >= options_.max_attempts) r.abandoned.push_back({r.frontier, known_cells, attempts});
-  else r.given_up.push_back({r.frontier, known_cells, attempts});
 }
 
-bool TeamExplorer::blacklisted(const RobotState& r, const Target& t, double resolution) const {
-  const double radius_cells = options_.targets.piece_radius_m / resolution;
-  for (const auto& list : {std::cref(r.given_up), std::cref(r.abandoned)}) {
-    for (const auto& g : list.get()) {
-      const double dx = g.frontier.x - t.frontier.x, dy = g.frontier.y - t.frontier.y;
-      if (dx * dx + dy * dy <= radius_cells * radius_cells) return true;
+namespace {
+
+double cell_distance2(const Cell& a, const Cell& b) {
+  return double(a.x - b.x) * (a.x - b.x) + double(a.y - b.y) * (a.y - b.y);
+}
+
+// Frontier cells this close (in cells) are the same frontier when counting failed approaches.
+double same_frontier_cells(double resolution) { return std::max(3.0, 0.15 / resolution); }
+// Goals this close (in cells) are the same approach.
+double same_goal_cells(double resolution) { return std::max(2.0, 0.1 / resolution); }
+
+}  // namespace
+
+void TeamExplorer::fail_approach(int i, Failure why, std::int64_t known_cells,
+                                 const std::vector<std::vector<char>>* tell) {
+  RobotState& r = robots_[std::size_t(i)];
+  r.has_task = false;
+  const double res = r.geometry.resolution();
+  const FailedApproach failure{r.frontier, r.goal, known_cells, why, false};
+  for (std::size_t j = 0; j < robots_.size(); ++j) {
+    if (int(j) != i && (tell == nullptr || !(*tell)[std::size_t(i)][j])) continue;
+    auto& failed = robots_[j].failed;
+    failed.push_back(failure);
+    // After max_attempts failed approaches to one frontier, every one of them stays.
+    const double near = same_frontier_cells(res);
+    const auto at_frontier = [&](const FailedApproach& f) { return cell_distance2(f.frontier, failure.frontier) <= near * near; };
+    if (std::count_if(failed.begin(), failed.end(), at_frontier) >= options_.max_attempts) {
+      if (int(j) == i) ++stats_.frontiers_abandoned;
+      for (auto& f : failed)
+        if (at_frontier(f)) f.for_good = true;
     }
+  }
+}
+
+bool TeamExplorer::blocked(const RobotState& r, const Cell& frontier, const Cell& goal, double resolution) const {
+  const double piece = options_.targets.piece_radius_m / resolution, same_goal = same_goal_cells(resolution);
+  const double near = same_frontier_cells(resolution);
+  for (const auto& f : r.failed) {
+    const double df = cell_distance2(f.frontier, frontier);
+    if (f.for_good && df <= near * near) return true;
+    if (df <= piece * piece && cell_distance2(f.goal, goal) <= same_goal * same_goal) return true;
   }
   return false;
 }
@@ -113,7 +145,7 @@ bool TeamExplorer::blacklisted(const RobotState& r, const Target& t, double reso
 void TeamExplorer::set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const {
   r.path = std::move(path);
   r.was_clear.resize(r.path.size());
-  for (std::size_t k = 0; k < r.path.size(); ++k) r.was_clear[k] = cell_clear(map, r.path[k], options_.traversability);
+  for (std::size_t k = 0; k < r.path.size(); ++k) r.was_clear[k] = cell_fits(map, r.path[k], options_.traversability);
   r.next = 0;
 }
 
@@ -173,32 +205,39 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
     }
     return r.has_task;
   }
-  if ((map.geometry().cell_center(r.goal) - p).norm() <= options_.reach_tolerance_m || r.next >= r.path.size()) {
+  // A goal that sees its unseen cell from beyond the observe range must be reached closely: a
+  // robot stopping short would have it out of range.
+  const double far = options_.targets.observe_range_m / res;
+  const double tolerance = std::sqrt(double((r.goal.x - r.unknown.x) * (r.goal.x - r.unknown.x) +
+                                            (r.goal.y - r.unknown.y) * (r.goal.y - r.unknown.y))) > far
+                               ? res
+                               : options_.reach_tolerance_m;
+  if ((map.geometry().cell_center(r.goal) - p).norm() <= tolerance || r.next >= r.path.size()) {
     ++stats_.targets_reached;
     r.has_task = false;
-    // Standing at the goal with the frontier still there: its unknown side cannot be seen from the
-    // free space (e.g. the inside of a wall whose corner a beam clipped). Nobody should come again;
-    // the robots this one talks to learn it too.
-    if (frontier_cells_near(map, r.frontier, 2.0 * res, options_.targets.frontiers) > 0) {
+    // Standing at the goal, in sight of the unseen cell, and it is still unseen (the beams passed
+    // beside it): this approach failed, another goal is tried next; the robots this one talks to
+    // learn it too.
+    if (!map.observed(r.unknown) && frontier_cells_near(map, r.frontier, 2.0 * res, options_.targets.frontiers, r.kind) > 0) {
       ++stats_.unobservable;
-      for (std::size_t j = 0; j < robots_.size(); ++j) {
-        if (int(j) == i || links[std::size_t(i)][j]) robots_[j].abandoned.push_back({r.frontier, map.observed_count(), options_.max_attempts});
-      }
+      fail_approach(i, Failure::Unobservable, map.observed_count(), &links);
     }
     return false;
   }
-  if (frontier_cells_near(map, r.frontier, options_.targets.piece_radius_m, options_.targets.frontiers) == 0) {
+  if (frontier_cells_near(map, r.frontier, options_.targets.piece_radius_m, options_.targets.frontiers, r.kind) == 0) {
     r.has_task = false;  // explored meanwhile, by this robot or by what it was told
     return false;
   }
   // Stuck, most likely behind or facing another robot: plan a way around the robots it knows of.
   if (r.steps_since_progress > 0 && r.steps_since_progress % options_.detour_after_steps == 0) {
-    auto passable = traversable_cells(map, options_.traversability);
+    std::vector<std::uint8_t> passable, factor;
+    passage_grid(passage_cells(map, options_.traversability), passable, factor);
     mark_robots(map, robots, i, links, options_.traversability, passable);
     const Cell from = robot_cell(robot);
     open_around(map, from, options_.traversability, passable);
     std::vector<float> occupancy;
-    compute_wave(wave_grid(map, passable, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave, wave_);
+    compute_wave(wave_grid(map, passable, factor, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave,
+                 wave_);
     ++stats_.waves;
     if (wave_.reached(r.goal)) {
       ++stats_.detours;
@@ -207,28 +246,32 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
   }
   if (r.steps_since_progress > options_.stall_steps) {
     ++stats_.given_up_stalled;
-    give_up(i, map.observed_count());
+    ++stats_.targets_given_up;
+    fail_approach(i, Failure::Stalled, map.observed_count());
     return false;
   }
   // New obstacles on the path ahead (cells clear when planned, blocked now): plan again to the same
   // goal, or give it up.
   const std::size_t end = std::min(r.path.size(), r.next + std::size_t(options_.path_check_cells));
   for (std::size_t k = r.next; k < end; ++k) {
-    if (!r.was_clear[k] || cell_clear(map, r.path[k], options_.traversability)) continue;
-    if (!cell_clear(map, r.goal, options_.traversability)) {
+    if (!r.was_clear[k] || cell_fits(map, r.path[k], options_.traversability)) continue;
+    if (!cell_fits(map, r.goal, options_.traversability)) {
       r.has_task = false;  // the goal itself turned out too close to a wall: a new target, not a failure
       return false;
     }
-    auto passable = traversable_cells(map, options_.traversability);
+    std::vector<std::uint8_t> passable, factor;
+    passage_grid(passage_cells(map, options_.traversability), passable, factor);
     std::vector<float> occupancy;
     const Cell from = robot_cell(robot);
     open_around(map, from, options_.traversability, passable);
-    compute_wave(wave_grid(map, passable, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave, wave_);
+    compute_wave(wave_grid(map, passable, factor, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave,
+                 wave_);
     ++stats_.waves;
     ++stats_.paths_replanned;
     if (!wave_.reached(r.goal)) {
       ++stats_.given_up_unreachable;
-      give_up(i, map.observed_count());
+      ++stats_.targets_given_up;
+      fail_approach(i, Failure::Unreachable, map.observed_count());
       return false;
     }
     set_path(r, plan(map, robot, r.goal, wave_), map);
@@ -260,10 +303,12 @@ void TeamExplorer::make_way(int stuck, const std::vector<ExplorerRobot>& robots,
     if (!near_path(at)) continue;
     // The nearest place (by wave cost on its own map) that is clear of the stuck robot's way.
     const auto& map = *robots[j].map;
-    auto passable = traversable_cells(map, options_.traversability);
+    std::vector<std::uint8_t> passable, factor;
+    passage_grid(passage_cells(map, options_.traversability), passable, factor);
     open_around(map, at, options_.traversability, passable);
     std::vector<float> occupancy;
-    compute_wave(wave_grid(map, passable, occupancy, options_.wave), std::span<const Cell>(&at, 1), options_.wave, wave_);
+    compute_wave(wave_grid(map, passable, factor, occupancy, options_.wave), std::span<const Cell>(&at, 1), options_.wave,
+                 wave_);
     ++stats_.waves;
     const int window = int(std::ceil(4.0 / res));
     float best = WaveField::kUnreached;
@@ -307,8 +352,10 @@ void TeamExplorer::decide(const std::vector<ExplorerRobot>& robots, const std::v
     RobotState& r = robots_[std::size_t(i)];
     r.geometry = robots[std::size_t(i)].map->geometry();
     const auto known = robots[std::size_t(i)].map->observed_count();
-    // Targets given up are retried once the map has grown enough.
-    std::erase_if(r.given_up, [&](const GivenUp& g) { return known - g.known_cells >= options_.retry_after_new_cells; });
+    // Failed approaches are retried once the map has grown enough.
+    std::erase_if(r.failed, [&](const FailedApproach& f) {
+      return !f.for_good && known - f.known_cells >= options_.retry_after_new_cells;
+    });
     if (r.finished) {
       if (r.has_task) check_task(i, robots, links);  // a yield task
       if (known - r.known_when_finished >= options_.retry_after_new_cells / 4 + 1 && !r.has_task) r.finished = false;
@@ -363,37 +410,54 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
                                 const std::vector<int>& claim_holders) {
   ++stats_.assignment_rounds;
   const auto& map = *robots[std::size_t(leader)].map;
-  auto passable = traversable_cells(map, options_.traversability);
-  const std::vector<Target> targets = make_targets(map, passable, options_.targets);
+  const double res = map.resolution();
+  const std::vector<std::uint8_t> passage = passage_cells(map, options_.traversability);
+  std::vector<std::uint8_t> passable, factor;
+  passage_grid(passage, passable, factor);
   for (int i : members) open_around(map, robot_cell(robots[std::size_t(i)]), options_.traversability, passable);
   std::vector<float> occupancy;
-  const WaveGrid grid = wave_grid(map, passable, occupancy, options_.wave);
+  const WaveGrid grid = wave_grid(map, passable, factor, occupancy, options_.wave);
+  std::vector<WaveField> waves(members.size());
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const Cell from = robot_cell(robots[std::size_t(members[k])]);
+    compute_wave(grid, std::span<const Cell>(&from, 1), options_.wave, waves[k]);
+    ++stats_.waves;
+  }
+  // A goal is usable by member k when its wave reaches it, it is not an approach that failed for
+  // it, and on its own map too the robot fits there and the frontier is open (what it checks while
+  // driving: a target it would drop at once would be handed to it again every round).
+  std::vector<std::unordered_map<int, bool>> open_on_own_map(members.size());
+  const auto usable_by = [&](std::size_t k, const Cell& frontier, const Cell& goal) {
+    const int i = members[k];
+    const auto& own_map = *robots[std::size_t(i)].map;
+    if (!waves[k].reached(goal) || blocked(robots_[std::size_t(i)], frontier, goal, res)) return false;
+    if (&own_map == &map) return true;
+    if (!cell_fits(own_map, goal, options_.traversability)) return false;
+    const auto [it, added] = open_on_own_map[k].try_emplace(map.geometry().index(frontier), false);
+    if (added) it->second = frontier_cells_near(own_map, frontier, options_.targets.piece_radius_m, options_.targets.frontiers) > 0;
+    return it->second;
+  };
+  const TargetSet found = find_targets(map, passage, [&](const Cell& frontier, const Cell& goal) {
+    for (std::size_t k = 0; k < members.size(); ++k)
+      if (usable_by(k, frontier, goal)) return true;
+    return false;
+  }, options_.targets);
+  const std::vector<Target>& targets = found.targets;
 
   AssignmentInput input;
   input.targets = targets;
   input.sensor_range_m = options_.sensor_range_m;
   for (int c : claim_holders) input.claimed.push_back(map.geometry().cell_center(robots_[std::size_t(c)].goal));
-  std::vector<std::vector<Cell>> paths_by_member;
-  std::vector<WaveField> waves(members.size());
   for (std::size_t k = 0; k < members.size(); ++k) {
     const int i = members[k];
-    const RobotState& r = robots_[std::size_t(i)];
-    const Cell from = robot_cell(robots[std::size_t(i)]);
-    compute_wave(grid, std::span<const Cell>(&from, 1), options_.wave, waves[k]);
-    ++stats_.waves;
     AssignmentRobot ar;
     ar.team_index = i;
     ar.team_size = int(robots_.size());
     ar.position_m = robots[std::size_t(i)].pose.position();
     ar.cost_m.resize(targets.size());
-    const auto& own_map = *robots[std::size_t(i)].map;
     for (std::size_t t = 0; t < targets.size(); ++t) {
-      const float c = waves[k].cost(targets[t].goal);
-      // The goal must be clear on the member's own map as well: that is what it checks while driving.
-      ar.cost_m[t] = (c < WaveField::kUnreached && !blacklisted(r, targets[t], map.resolution()) &&
-                      (&own_map == &map || cell_clear(own_map, targets[t].goal, options_.traversability)))
-                         ? double(c) * map.resolution()
-                         : std::numeric_limits<double>::infinity();
+      ar.cost_m[t] = usable_by(k, targets[t].frontier, targets[t].goal) ? double(waves[k].cost(targets[t].goal)) * res
+                                                                        : std::numeric_limits<double>::infinity();
     }
     input.robots.push_back(std::move(ar));
   }
@@ -403,12 +467,28 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
     const int t = choice[k];
     if (t < 0) {
       if (r.has_task) continue;
-      if (!r.given_up.empty()) {
-        r.given_up.clear();  // nothing else to do: try the given-up targets again next round
+      if (std::any_of(r.failed.begin(), r.failed.end(), [](const FailedApproach& f) { return !f.for_good; })) {
+        // Nothing else to do: try the failed approaches again next round.
+        std::erase_if(r.failed, [](const FailedApproach& f) { return !f.for_good; });
         continue;
       }
       r.finished = true;
       r.known_when_finished = robots[std::size_t(members[k])].map->observed_count();
+      // What is left, for the report of a run that ends early.
+      r.left.clear();
+      const auto at = [&](const Cell& c) { return map.geometry().cell_center(c); };
+      for (const Cell& c : found.without_goal) r.left.push_back({at(c), "unreachable: no pose the robots can reach sees it"});
+      for (std::size_t u = 0; u < targets.size(); ++u) {
+        if (std::isfinite(input.robots[k].cost_m[u])) continue;
+        std::string why = "unreachable: no path on the robot's map";
+        for (const auto& f : r.failed) {
+          const double near = same_frontier_cells(res);
+          if (!f.for_good || cell_distance2(f.frontier, targets[u].frontier) > near * near) continue;
+          why = f.why == Failure::Unobservable ? "unobservable: reached every approach, the unseen cell stayed unseen"
+                                               : "unreachable: every approach stalled or was cut off";
+        }
+        r.left.push_back({at(targets[u].frontier), why});
+      }
       continue;
     }
     const Target& target = targets[std::size_t(t)];
@@ -417,6 +497,8 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
     r.yielding = false;
     r.finished = false;
     r.frontier = target.frontier;
+    r.unknown = target.unknown;
+    r.kind = target.kind;
     r.goal = target.goal;
     set_path(r, plan(*robots[std::size_t(members[k])].map, robots[std::size_t(members[k])], target.goal, waves[k]),
              *robots[std::size_t(members[k])].map);

@@ -29,10 +29,15 @@ struct ExplorationOptions {
   double reach_tolerance_m = 0.25;  // a goal closer than this is reached
   int stall_steps = 20;             // steps without progress along the path before giving a target up
   int path_check_cells = 30;        // path cells ahead checked each step against new obstacles
-  // A given-up target is tried again once the robot's map holds this many more observed cells, or
-  // when the robot has nothing else to do, up to `max_attempts` times in all.
+  // A failed approach (stalled, cut off, or reached without seeing the unseen cell) is not tried
+  // again from the same goal until the robot's map holds this many more observed cells, or the robot
+  // has nothing else to do; other goals for the same frontier are tried meanwhile. After
+  // `max_attempts` failed approaches to one frontier, it is left for good.
   int retry_after_new_cells = 400;
   int max_attempts = 3;
+  // Entering a cell where the robot fits but without radius + margin of known free space around
+  // it (Passage::Fits) costs this many times a Clear cell's step.
+  int tight_cost_factor = 3;
   // A robot that made no progress for this many steps plans a detour around the robots it knows of.
   int detour_after_steps = 4;
   // The explorer decides (traversability, frontiers, waves, paths) on cells of at least this size:
@@ -72,8 +77,15 @@ class TeamExplorer {
   // No reachable frontier is left for the robot (on its map); it may resume when its map grows.
   bool finished(int i) const { return robots_[std::size_t(i)].finished; }
   bool all_finished() const;
-  // Forgets robot i's target, path and given-up places (its map moved to another frame).
+  // Forgets robot i's target, path and failed approaches (its map moved to another frame).
   void reset_robot(int i) { robots_[std::size_t(i)] = RobotState{}; }
+
+  // A frontier robot i left when it last ran out of targets, in its map's frame, and why.
+  struct LeftFrontier {
+    Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+    std::string reason;
+  };
+  const std::vector<LeftFrontier>& left_frontiers(int i) const { return robots_[std::size_t(i)].left; }
 
   struct Stats {
     int assignment_rounds = 0;
@@ -82,7 +94,8 @@ class TeamExplorer {
     int targets_given_up = 0;     // stalled or cut off; the counts below split them
     int given_up_stalled = 0;
     int given_up_unreachable = 0;
-    int unobservable = 0;  // reached, yet the frontier stayed: abandoned and told to the others
+    int unobservable = 0;  // reached, yet the unseen cell stayed unseen: another approach is tried
+    int frontiers_abandoned = 0;  // max_attempts approaches failed: left for good
     int paths_replanned = 0;
     int detours = 0;
     int yields = 0;  // finished robots that moved out of another's way
@@ -93,24 +106,27 @@ class TeamExplorer {
   const CoordinationStrategy& strategy() const { return *strategy_; }
 
  private:
-  struct GivenUp {
-    Cell frontier;
-    std::int64_t known_cells = 0;  // the robot's observed-cell count when it gave up
-    int attempts = 1;
+  enum class Failure { Stalled, Unreachable, Unobservable };
+  struct FailedApproach {
+    Cell frontier, goal;
+    std::int64_t known_cells = 0;  // the robot's observed-cell count when it failed
+    Failure why = Failure::Stalled;
+    bool for_good = false;  // part of max_attempts failures at one frontier: never retried
   };
   struct RobotState {
     bool has_task = false;
     bool yielding = false;  // the task is only to get out of another robot's way
-    Cell frontier, goal;
+    Cell frontier, unknown, goal;
+    std::uint8_t kind = FrontierMask::kWide;  // the target's frontier kind
     std::vector<Cell> path;
-    std::vector<char> was_clear;  // per path cell: clear of obstacles when the path was planned
+    std::vector<char> was_clear;  // per path cell: the robot fitted there when the path was planned
     std::size_t next = 0;  // first path cell not yet passed
     std::size_t best_remaining = 0;  // fewest path cells left to the goal so far (replans included)
     int steps_since_progress = 0;
     bool finished = false;
     std::int64_t known_when_finished = 0;
-    std::vector<GivenUp> given_up;
-    std::vector<GivenUp> abandoned;  // given up max_attempts times: never tried again
+    std::vector<FailedApproach> failed;
+    std::vector<LeftFrontier> left;
     core::GridGeometry geometry;  // of the robot's map, to turn cells into metres
   };
 
@@ -118,10 +134,15 @@ class TeamExplorer {
   void decide(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
   // false: the task was dropped.
   bool check_task(int i, const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
-  void give_up(int i, std::int64_t known_cells);
+  // Robot i's approach to its target failed; with `tell`, the robots it talks to learn it too.
+  void fail_approach(int i, Failure why, std::int64_t known_cells, const std::vector<std::vector<char>>* tell = nullptr);
   void assign_group(const std::vector<int>& members, int leader, const std::vector<ExplorerRobot>& robots,
                     const std::vector<int>& claim_holders);
-  bool blacklisted(const RobotState& r, const Target& t, double resolution) const;
+  // The goal is an approach that failed for this frontier, or the frontier is left for good.
+  bool blocked(const RobotState& r, const Cell& frontier, const Cell& goal, double resolution) const;
+  // Passable cells (Fits or Clear) of passage_cells and their wave step factors.
+  void passage_grid(const std::vector<std::uint8_t>& passage, std::vector<std::uint8_t>& passable,
+                    std::vector<std::uint8_t>& factor) const;
   void set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const;
   // The provider's path to the goal as cells, or the wave's when the provider has none.
   std::vector<Cell> plan(const mapping::OccupancyGrid& map, const ExplorerRobot& robot, const Cell& goal,

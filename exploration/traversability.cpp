@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "mapping/distance_field.h"
 
 namespace fleetmap::exploration {
 
@@ -18,38 +18,29 @@ double square_distance2(int dx, int dy) {
   return ex * ex + ey * ey;
 }
 
-// Distance transform of a mask (non-zero: open) with a ring of closed cells around it: beyond the
-// grid's edge is no place for a robot. Distances in cells between centres, exact (Felzenszwalb).
-cv::Mat distance_to_closed(int w, int h, const auto& open) {
-  cv::Mat mask(h + 2, w + 2, CV_8UC1, cv::Scalar(0));
-  for (int y = 0; y < h; ++y) {
-    auto* row = mask.ptr<std::uint8_t>(y + 1);
-    for (int x = 0; x < w; ++x) row[x + 1] = open(y * w + x) ? 255 : 0;
-  }
-  cv::Mat dist;
-  cv::distanceTransform(mask, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-  return dist;
+// The radius tested against a robot's own map (see wall_tolerance_m).
+double map_radius(const mapping::OccupancyGrid& map, const TraversabilityOptions& options) {
+  return std::max(0.0, options.robot_radius_m - std::min(options.wall_tolerance_m, map.resolution()));
 }
 
 }  // namespace
 
-std::vector<std::uint8_t> fitting_cells(const core::GridGeometry& geometry, std::span<const std::uint8_t> blocking,
+std::vector<std::uint8_t> fitting_cells(const core::GridGeometry& geometry, const std::vector<std::uint8_t>& blocking,
                                         double radius_m) {
   const int w = geometry.width(), h = geometry.height();
   if (blocking.size() != std::size_t(geometry.cell_count())) throw Error("fitting_cells: one flag per cell expected");
   std::vector<std::uint8_t> out(blocking.size(), 0);
   if (w == 0 || h == 0) return out;
   const double rho = radius_m / geometry.resolution();
-  const cv::Mat dist = distance_to_closed(w, h, [&](int i) { return blocking[std::size_t(i)] == 0; });
+  const std::vector<float> dist = mapping::distance_to_blocked(w, h, blocking);
   const int reach = int(std::ceil(rho)) + 1;
   const auto closed = [&](int x, int y) { return x < 0 || y < 0 || x >= w || y >= h || blocking[std::size_t(y * w + x)] != 0; };
   for (int y = 0; y < h; ++y) {
-    const float* d = dist.ptr<float>(y + 1);
     for (int x = 0; x < w; ++x) {
       if (closed(x, y)) continue;
       // The nearest blocking centre is dc away; its square is between dc - sqrt(1/2) and dc - 1/2 away,
       // and no other square is nearer than dc - sqrt(1/2). Only the band in between needs a look.
-      const double dc = d[x + 1];
+      const double dc = dist[std::size_t(y * w + x)];
       if (dc - 0.5 < rho - 1e-4) continue;
       if (dc - 0.7072 > rho) {
         out[std::size_t(y * w + x)] = 1;
@@ -69,14 +60,11 @@ std::vector<std::uint8_t> traversable_cells(const mapping::OccupancyGrid& map, c
   const int w = map.width(), h = map.height();
   std::vector<std::uint8_t> out(std::size_t(w) * std::size_t(h), 0);
   if (w == 0 || h == 0) return out;
-  // 0 at cells that are not known free. Rows are in grid order (row 0 at the bottom); the transform
-  // does not care.
-  const cv::Mat dist = distance_to_closed(w, h, [&](int i) { return map.state_at(i) == CellState::Free; });
+  std::vector<std::uint8_t> not_free(out.size());
+  for (std::size_t i = 0; i < out.size(); ++i) not_free[i] = map.state_at(int(i)) != CellState::Free;
+  const std::vector<float> dist = mapping::distance_to_blocked(w, h, not_free);
   const double need_cells = (options.robot_radius_m + options.safety_margin_m) / map.resolution();
-  for (int y = 0; y < h; ++y) {
-    const float* d = dist.ptr<float>(y + 1);
-    for (int x = 0; x < w; ++x) out[std::size_t(y * w + x)] = d[x + 1] > need_cells;
-  }
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = dist[i] > need_cells;
   return out;
 }
 
@@ -84,7 +72,7 @@ std::vector<std::uint8_t> passage_cells(const mapping::OccupancyGrid& map, const
   const std::size_t n = std::size_t(map.geometry().cell_count());
   std::vector<std::uint8_t> occupied(n);
   for (std::size_t i = 0; i < n; ++i) occupied[i] = map.state_at(int(i)) == CellState::Occupied;
-  std::vector<std::uint8_t> out = fitting_cells(map.geometry(), occupied, options.robot_radius_m);
+  std::vector<std::uint8_t> out = fitting_cells(map.geometry(), occupied, map_radius(map, options));
   const std::vector<std::uint8_t> clear = traversable_cells(map, options);
   for (std::size_t i = 0; i < n; ++i) {
     if (!out[i] || map.state_at(int(i)) != CellState::Free) out[i] = std::uint8_t(Passage::Blocked);
@@ -108,7 +96,7 @@ bool cell_clear(const mapping::OccupancyGrid& map, const core::Cell& c, const Tr
 
 bool cell_fits(const mapping::OccupancyGrid& map, const core::Cell& c, const TraversabilityOptions& options) {
   if (map.state(c) != CellState::Free) return false;
-  const double rho = options.robot_radius_m / map.resolution();
+  const double rho = map_radius(map, options) / map.resolution();
   const int reach = int(std::ceil(rho)) + 1;
   for (int dy = -reach; dy <= reach; ++dy) {
     for (int dx = -reach; dx <= reach; ++dx) {

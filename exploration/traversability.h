@@ -1,7 +1,6 @@
 #pragma once
 // Where a robot fits, and where its centre may go on a map it has built.
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "mapping/occupancy_grid.h"
@@ -13,6 +12,13 @@ struct TraversabilityOptions {
   // Extra clearance beyond the radius, kept where the map allows: a robot is not always at a cell
   // centre. A place with less (but more than the radius) is still passable, at a higher cost.
   double safety_margin_m = 0.05;
+  // A robot's map shows a wall face up to a cell nearer than it is: a range reading that falls short
+  // by its noise marks the free cell in front of the face, half the time. Whether a robot fits on
+  // its map is tested with the radius less one cell, but no more than this, so that a doorway a
+  // little wider than the robot is not closed by that (on real floor plans at 0.05 m per cell),
+  // while on coarse cells robots do not plan through places where they barely fit and stall there.
+  // Clear cells keep the whole radius and margin.
+  double wall_tolerance_m = 0.05;
 };
 
 // Where a robot of radius `radius_m` fits: the cells whose centre lies farther than the radius from
@@ -20,7 +26,7 @@ struct TraversabilityOptions {
 // from the grid's outside. `blocking` has one flag per cell, row-major. This is the one notion of
 // "fits" behind both the explorer's passable cells (blocking: its map's occupied cells) and the
 // coverage metric's reachable poses (blocking: every cell of the true map that is not free).
-std::vector<std::uint8_t> fitting_cells(const core::GridGeometry& geometry, std::span<const std::uint8_t> blocking,
+std::vector<std::uint8_t> fitting_cells(const core::GridGeometry& geometry, const std::vector<std::uint8_t>& blocking,
                                         double radius_m);
 
 // How a robot's centre may use a cell of its own map.

@@ -26,22 +26,26 @@ std::uint32_t WaveField::step_units(int dir, int entered_index) const {
 
 void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options, WaveField& out) {
   const std::size_t n = std::size_t(grid.width) * std::size_t(grid.height);
-  if (grid.passable.size() != n || (!grid.occupancy.empty() && grid.occupancy.size() != n)) {
-    throw Error("compute_wave: passable/occupancy sizes do not match the grid");
+  if (grid.passable.size() != n || (!grid.occupancy.empty() && grid.occupancy.size() != n) ||
+      (!grid.step_factor.empty() && grid.step_factor.size() != n)) {
+    throw Error("compute_wave: passable/occupancy/step_factor sizes do not match the grid");
   }
   out.width_ = grid.width;
   out.height_ = grid.height;
   out.eight_connected_ = options.eight_connected;
   out.units_.assign(n, WaveField::kUnreachedUnits);
   out.passable_.assign(grid.passable.begin(), grid.passable.end());
-  const bool weighted = options.occupancy_weight > 0.0 && !grid.occupancy.empty();
+  const bool occupancy_weighted = options.occupancy_weight > 0.0 && !grid.occupancy.empty();
+  const bool weighted = occupancy_weighted || !grid.step_factor.empty();
   std::uint32_t max_step = WaveField::kDiagonalUnits;
   if (weighted) {
     out.step_units_.resize(2 * n);
     for (std::size_t i = 0; i < n; ++i) {
-      const double factor = 1.0 + options.occupancy_weight * std::clamp(double(grid.occupancy[i]), 0.0, 1.0);
-      out.step_units_[2 * i] = std::uint32_t(std::lround(double(WaveField::kUnitsPerCell) * factor));
-      out.step_units_[2 * i + 1] = std::uint32_t(std::lround(double(WaveField::kDiagonalUnits) * factor));
+      const double factor =
+          occupancy_weighted ? 1.0 + options.occupancy_weight * std::clamp(double(grid.occupancy[i]), 0.0, 1.0) : 1.0;
+      const std::uint32_t times = grid.step_factor.empty() ? 1 : std::max<std::uint32_t>(1, grid.step_factor[i]);
+      out.step_units_[2 * i] = times * std::uint32_t(std::lround(double(WaveField::kUnitsPerCell) * factor));
+      out.step_units_[2 * i + 1] = times * std::uint32_t(std::lround(double(WaveField::kDiagonalUnits) * factor));
       max_step = std::max(max_step, out.step_units_[2 * i + 1]);
     }
   } else {

@@ -30,6 +30,9 @@ struct WaveGrid {
   int height = 0;
   std::span<const std::uint8_t> passable;  // width * height, non-zero = passable
   std::span<const float> occupancy;        // empty, or width * height probabilities
+  // Empty, or width * height whole factors (0 is read as 1): entering a cell costs its step times
+  // its factor, e.g. to make a wave prefer cells with room to spare.
+  std::span<const std::uint8_t> step_factor;
 };
 
 class WaveField {

@@ -119,12 +119,26 @@ json exploration_json(const RunResult& r) {
           {"given_up_stalled", r.exploration.given_up_stalled},
           {"given_up_unreachable", r.exploration.given_up_unreachable},
           {"unobservable_frontiers", r.exploration.unobservable},
+          {"frontiers_abandoned", r.exploration.frontiers_abandoned},
           {"paths_replanned", r.exploration.paths_replanned},
           {"detours", r.exploration.detours},
           {"yields", r.exploration.yields},
           {"path_planner", r.scenario.path_planner},
           {"planner_paths", r.exploration.provider_paths},
           {"planner_fallbacks", r.exploration.provider_fallbacks}};
+}
+
+// The observable space left unobserved: its area, and its largest regions with the reason each was left.
+json unexplored_json(const RunResult& r) {
+  constexpr std::size_t kListed = 10;
+  double area = 0.0;
+  json largest = json::array();
+  for (const auto& u : r.unexplored) {
+    area += u.area_m2;
+    if (largest.size() < kListed)
+      largest.push_back({{"area_m2", u.area_m2}, {"centre", {u.centre_m.x(), u.centre_m.y()}}, {"reason", u.reason}});
+  }
+  return {{"m2", area}, {"regions", r.unexplored.size()}, {"largest", std::move(largest)}};
 }
 
 json timing_json(const RunResult& r) {
@@ -169,6 +183,7 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
                 {"pose_cells", sp.pose_cells},
                 {"unreachable_observable_m2", double(sp.unreachable_cells) * sp.cell_area_m2},
                 {"seen_unreachable_m2", double(sp.seen_unreachable.size()) * sp.cell_area_m2}};
+  j["unexplored"] = unexplored_json(r);
   j["landmarks"] = r.landmarks.size();
   j["map_quality"] = map_quality_json(r.map_quality);
   j["per_robot"] = per_robot_json(r, totals);
@@ -200,7 +215,7 @@ cv::Mat render_merged(const RunResult& r, const std::string& map_label, const vi
   if (!r.landmarks.empty()) o.points.push_back({r.landmarks, {200, 0, 200}, "landmarks", 3});
   if (!r.space.seen_unreachable.empty()) {
     // Seen, counted in the coverage, but beyond where a robot fits (through a gap, in a corner).
-    mapping::CellsOverlay seen{{}, {255, 160, 40}, "seen, not reachable", 0.45};
+    viz::CellsOverlay seen{{}, {255, 160, 40}, "seen, not reachable", 0.45};
     for (int idx : r.space.seen_unreachable) seen.cells.push_back(r.merged.geometry().cell_of_index(idx));
     o.cells.push_back(std::move(seen));
   }

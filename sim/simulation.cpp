@@ -7,6 +7,9 @@
 #include <cstdio>
 #include <limits>
 
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
 #include "core/error.h"
 #include "core/format.h"
 #include "core/angle.h"
@@ -127,6 +130,22 @@ std::vector<core::Pose2> place_robots(const Scenario& s, const World& world, cor
 
 namespace {
 
+// The explorer plans for the robots and the sensor the scenario describes: their radius, the range,
+// goals that see their unseen cell from well within range, and that count as reached close enough.
+// A short range leaves narrow unseen bands along walls the robot passed at its radius: unknown space
+// that narrow still counts as a frontier.
+exploration::ExplorationOptions explorer_options(const Scenario& s) {
+  exploration::ExplorationOptions o = s.exploration;
+  const double range = s.range.max_range_m;
+  o.traversability.robot_radius_m = s.robot.radius_m;
+  o.sensor_range_m = range;
+  o.targets.observe_range_m = std::min(o.targets.observe_range_m, 0.6 * range);
+  o.reach_tolerance_m = std::min(o.reach_tolerance_m, 0.3 * range);
+  o.targets.max_observe_range_m = std::max(o.targets.observe_range_m, range - 2.0 * o.planning_resolution_m);
+  o.targets.frontiers.min_unknown_width_m = std::min(o.targets.frontiers.min_unknown_width_m, 0.3 * range);
+  return o;
+}
+
 World make_world(const Scenario& s, mapping::OccupancyGrid truth) {
   core::Random rng = core::Random(s.seed).fork(2);
   std::vector<Eigen::Vector2d> landmarks;
@@ -149,8 +168,17 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
       rng_(scenario.seed),
       merged_(world_.geometry()),
       exchange_(scenario.robot_count, world_.geometry()),
-      explorer_(scenario.robot_count, scenario.exploration) {
+      explorer_(scenario.robot_count, explorer_options(scenario)) {
   validate_scenario(scenario_);
+  {
+    // A sensor that does not reach past the cell the robot stands in can never show it a place to go.
+    const double cell = std::max(world_.geometry().resolution(), scenario_.exploration.planning_resolution_m);
+    if (scenario_.range.max_range_m <= cell) {
+      throw InputError(fmt::format(
+          "sensors.range.max_range: {} m does not reach beyond the robot's own cell ({} m): it cannot observe anything "
+          "to explore", scenario_.range.max_range_m, cell));
+    }
+  }
   core::Random placement_rng = rng_.fork(1);
   truths_ = place_robots(scenario_, world_, placement_rng);
   scenario_.starts = truths_;
@@ -512,6 +540,52 @@ RunResult Simulation::run(const ProgressCallback& progress, const std::function<
   return result();
 }
 
+std::vector<UnexploredRegion> Simulation::unexplored_regions() const {
+  const auto& g = world_.geometry();
+  cv::Mat left(g.height(), g.width(), CV_8UC1, cv::Scalar(0));
+  for (int idx : observable_.observable)
+    if (merged_.log_odds_at(idx) == 0.0f) left.at<std::uint8_t>(idx / g.width(), idx % g.width()) = 1;
+  cv::Mat labels;
+  const int n = cv::connectedComponents(left, labels, 8, CV_32S);
+  std::vector<UnexploredRegion> out(std::size_t(std::max(0, n - 1)));
+  std::vector<std::vector<Eigen::Vector2d>> cells(out.size());
+  for (int idx : observable_.observable) {
+    const int label = labels.at<int>(idx / g.width(), idx % g.width());
+    if (label > 0) cells[std::size_t(label - 1)].push_back(g.cell_center(g.cell_of_index(idx)));
+  }
+  // What the robots' explorers left when they ran out of targets, in the world frame.
+  std::vector<exploration::TeamExplorer::LeftFrontier> frontiers;
+  for (int i = 0; i < scenario_.robot_count; ++i)
+    for (auto f : explorer_.left_frontiers(i)) {
+      f.position_m = frame_origin(i) * f.position_m;
+      frontiers.push_back(std::move(f));
+    }
+  const bool finished = explorer_.all_finished();
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    auto& r = out[k];
+    r.area_m2 = double(cells[k].size()) * observable_.cell_area_m2;
+    for (const auto& c : cells[k]) r.centre_m += c;
+    r.centre_m /= double(std::max<std::size_t>(1, cells[k].size()));
+    if (!finished) {
+      r.reason = "step limit: the run ended with targets left";
+      continue;
+    }
+    // The nearest frontier piece the explorers left, if the region is within its reach: a piece is
+    // represented by one cell and reaches piece_radius_m from it (on cells of the explorer's size).
+    const double cell = std::max(g.resolution(), scenario_.exploration.planning_resolution_m);
+    double best = scenario_.exploration.targets.piece_radius_m + 2.0 * cell;
+    r.reason = "no frontier on the robots' maps: too small to be one, or closed off by cells mapped as walls";
+    for (const auto& f : frontiers)
+      for (const auto& c : cells[k])
+        if ((c - f.position_m).norm() < best) {
+          best = (c - f.position_m).norm();
+          r.reason = f.reason;
+        }
+  }
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.area_m2 > b.area_m2; });
+  return out;
+}
+
 RunResult Simulation::result() const {
   RunResult r;
   r.scenario = scenario_;
@@ -538,6 +612,7 @@ RunResult Simulation::result() const {
   r.space.cell_area_m2 = observable_.cell_area_m2;
   for (int idx : observable_.unreachable)
     if (merged_.log_odds_at(idx) != 0.0f) r.space.seen_unreachable.push_back(idx);
+  r.unexplored = unexplored_regions();
   r.robots = tracks_;
   for (int i = 0; i < scenario_.robot_count; ++i) r.robot_frames.push_back(frame_origin(i));
   r.merges = merges_;

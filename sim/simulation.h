@@ -67,6 +67,14 @@ struct CoverageSpace {
   std::vector<int> seen_unreachable;   // cell indices: the unreachable cells the merged map observed
 };
 
+// A connected part of the observable space the merged map has not observed at the end of a run,
+// and why exploration left it.
+struct UnexploredRegion {
+  double area_m2 = 0.0;
+  Eigen::Vector2d centre_m = Eigen::Vector2d::Zero();  // mean of its cell centres, world frame
+  std::string reason;
+};
+
 struct RunResult {
   Scenario scenario;                 // as run: starts resolved, landmarks placed
   int steps = 0;                     // steps taken
@@ -79,6 +87,8 @@ struct RunResult {
   std::int64_t bytes_sent = 0;
   int meetings = 0;
   CoverageSpace space;
+  // 8-connected regions of unobserved observable cells, largest first.
+  std::vector<UnexploredRegion> unexplored;
   std::vector<RobotTrack> robots;     // truth and estimates in the world frame
   std::vector<core::Transform2> robot_frames;  // where each robot's map frame lies in the world, at the end
   std::vector<MergeRecord> merges;
@@ -122,6 +132,8 @@ class Simulation {
   const core::Transform2& frame_origin(int i) const { return frame_origin_[std::size_t(frame_of_[std::size_t(i)])]; }
 
   RunResult result() const;
+  // The observable cells the merged map has not observed, in regions, with the reason each was left.
+  std::vector<UnexploredRegion> unexplored_regions() const;
 
  private:
   void sense_and_map();

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "exploration/traversability.h"
+#include "mapping/distance_field.h"
 #include "mapping/ray_cast.h"
 
 namespace fleetmap::sim {
@@ -12,17 +13,12 @@ namespace fleetmap::sim {
 World::World(mapping::OccupancyGrid truth, std::vector<Eigen::Vector2d> landmarks)
     : truth_(std::move(truth)), landmarks_(std::move(landmarks)) {
   const int w = truth_.width(), h = truth_.height();
-  // A ring of blocked cells around the map: outside the map is blocked too (distanceTransform
-  // would otherwise take the image border for open space, and a map with no wall for empty plains).
-  cv::Mat free(h + 2, w + 2, CV_8UC1, cv::Scalar(0));
+  // Outside the map is blocked too (a map with no wall is not an empty plain).
+  std::vector<std::uint8_t> blocked_cells(std::size_t(w) * std::size_t(h));
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) free.at<std::uint8_t>(y + 1, x + 1) = blocked({x, y}) ? 0 : 255;
-  cv::Mat dist;
-  cv::distanceTransform(free, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-  centre_clearance_m_.resize(std::size_t(w) * std::size_t(h));
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      centre_clearance_m_[std::size_t(y * w + x)] = dist.at<float>(y + 1, x + 1) * float(truth_.resolution());
+    for (int x = 0; x < w; ++x) blocked_cells[std::size_t(y * w + x)] = blocked({x, y});
+  centre_clearance_m_ = mapping::distance_to_blocked(w, h, blocked_cells, true);
+  for (float& d : centre_clearance_m_) d *= float(truth_.resolution());
 }
 
 double World::clearance(const Eigen::Vector2d& p, double horizon_m) const {
@@ -139,8 +135,8 @@ ObservableSpace World::observable_space(const std::vector<Eigen::Vector2d>& star
     auto* row = not_pose.ptr<std::uint8_t>(y);
     for (int x = 0; x < w; ++x) row[x] = pose[std::size_t(y * w + x)] ? 0 : 255;
   }
-  cv::Mat dist, approx, labels;
-  cv::distanceTransform(not_pose, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  const std::vector<float> dist = mapping::distance_to_blocked(w, h, pose, false);
+  cv::Mat approx, labels;
   cv::distanceTransform(not_pose, approx, labels, cv::DIST_L2, cv::DIST_MASK_5, cv::DIST_LABEL_PIXEL);
   std::vector<int> pose_of_label(std::size_t(out.poses) + 1, -1);
   for (int i = 0; i < int(n); ++i) {
@@ -167,7 +163,7 @@ ObservableSpace World::observable_space(const std::vector<Eigen::Vector2d>& star
   std::vector<std::pair<double, int>> candidates;
   for (int i = 0; i < int(n); ++i) {
     if (!connected[std::size_t(i)]) continue;
-    const double d = dist.at<float>(i / w, i % w);
+    const double d = dist[std::size_t(i)];
     if (d > range_cells + 1e-6) continue;
     // Within the robot's own disc at a pose (no wall inside it), a cell is in sight.
     bool seen = pose[std::size_t(i)] || d <= std::min(radius_cells, range_cells) + 1e-6;

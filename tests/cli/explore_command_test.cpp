@@ -53,7 +53,8 @@ TEST(ExploreCommand, WritesEveryOutputAndSaysWhere) {
 // The whole chain on files: explore, merge the robots' own maps, plan on the merged map.
 TEST(ExploreCommand, TheRobotsMapsMergeAndThePlannerReadsTheResult) {
   TempDir dir;
-  ASSERT_EQ(run_fleetmap("explore --map office --robots 2 --comm-range 0 --steps 150 --out run", dir).exit_code, 0);
+  // 200 steps: enough for the two robots (who never talk) to map common walls worth a merge.
+  ASSERT_EQ(run_fleetmap("explore --map office --robots 2 --comm-range 0 --steps 200 --out run", dir).exit_code, 0);
   const auto m = run_fleetmap("merge run/robot_1.yaml run/robot_2.yaml --out merged.yaml --json merge.json", dir);
   ASSERT_EQ(m.exit_code, 0) << m.err << m.out;
   // With known frames both maps are in the world frame: the transform is the identity.

@@ -56,10 +56,12 @@ TEST(Frontiers, UndecidedCellsAndTheMapEdgeAreNotFrontiers) {
   EXPECT_TRUE(find_frontier_regions(edge, {1}).empty());
 }
 
-TEST(Frontiers, ThinUnknownInsideObstaclesIsNotSpaceToExplore) {
+TEST(Frontiers, ThinUnknownInsideObstaclesIsOnlyANarrowFrontier) {
   // A free room with a 3-cell-thick block whose inside was never observed, seen through a gap in
-  // its outline (what a grazing beam leaves): not a frontier. With the opening width set below the
-  // block's thickness it would be one.
+  // its outline (what a grazing beam leaves): not wide unknown space, only a narrow strip, which is
+  // explored after every wide frontier and gap (it looks like the shadow of a door jamb). Without
+  // narrow strips it is no frontier; with the opening width set below the block's thickness it
+  // would be a wide one.
   OccupancyGrid g(core::GridGeometry(0.1, 30, 30));
   for (int y = 0; y < 30; ++y)
     for (int x = 0; x < 30; ++x) g.set_state({x, y}, CellState::Free);
@@ -69,12 +71,15 @@ TEST(Frontiers, ThinUnknownInsideObstaclesIsNotSpaceToExplore) {
   for (int y = 11; y < 14; ++y)
     for (int x = 6; x < 24; ++x) g.set_log_odds({x, y}, 0.0f);
   g.set_state({12, 10}, CellState::Free);  // the gap
-  EXPECT_TRUE(find_frontier_regions(g, {1}).empty());
-  EXPECT_FALSE(is_frontier(g, {12, 10}));
+  EXPECT_EQ(FrontierMask(g, {}).kind({12, 10}), FrontierMask::kNarrow);
+  FrontierOptions no_narrow;
+  no_narrow.min_narrow_width_m = 0.0;
+  EXPECT_TRUE(find_frontier_regions(g, no_narrow).empty());
+  EXPECT_FALSE(is_frontier(g, {12, 10}, no_narrow));
   FrontierOptions narrow;
   narrow.min_region_cells = 1;
   narrow.min_unknown_width_m = 0.3;
-  EXPECT_TRUE(is_frontier(g, {12, 10}, narrow));
+  EXPECT_EQ(FrontierMask(g, narrow).kind({12, 10}), FrontierMask::kWide);
 }
 
 TEST(Frontiers, WindowsAgreeWithTheWholeMap) {
@@ -106,21 +111,48 @@ TEST(Targets, LongFrontiersAreSplitAndGoalsAreTraversable) {
   TraversabilityOptions t;
   t.robot_radius_m = 0.1;
   t.safety_margin_m = 0.0;
-  const auto passable = traversable_cells(g, t);
+  const auto passage = passage_cells(g, t);
   TargetOptions o;
   o.piece_radius_m = 1.5;
   o.approach_radius_m = 0.6;
-  const auto targets = make_targets(g, passable, o);
+  const auto targets = find_targets(g, passage, [](const Cell&, const Cell&) { return true; }, o).targets;
   // 60 m of frontier in pieces at most 2 x 1.5 m wide.
   EXPECT_GE(targets.size(), 20u);
   int cells = 0;
   for (const auto& target : targets) {
-    EXPECT_TRUE(passable[std::size_t(g.geometry().index(target.goal))]);
+    // A goal with room to spare near the frontier, in sight of the unseen cell beside it.
+    EXPECT_EQ(Passage(passage[std::size_t(g.geometry().index(target.goal))]), Passage::Clear);
     EXPECT_TRUE(is_frontier(g, target.frontier));
+    EXPECT_FALSE(g.observed(target.unknown));
+    EXPECT_TRUE(sees_over_free(g, target.goal, target.unknown));
     EXPECT_LE((g.geometry().cell_center(target.goal) - g.geometry().cell_center(target.frontier)).norm(), 0.6 + 1e-9);
     cells += target.cells;
   }
   EXPECT_EQ(cells, 600);
+}
+
+// Kinds are tried in order, and a kind whose frontiers have no usable goal does not hide the next:
+// a room's wide frontier first; when no robot may go there, the narrow strip along a far wall.
+TEST(Targets, AKindWithNoUsableGoalLeavesTheNextKindItsTurn) {
+  OccupancyGrid g(core::GridGeometry(0.1, 40, 20));
+  for (int y = 0; y < 20; ++y)
+    for (int x = 0; x < 40; ++x) {
+      const bool unknown = x < 8 || (x >= 36 && x < 39);
+      g.set_state({x, y}, x == 39 ? CellState::Occupied : unknown ? CellState::Unknown : CellState::Free);
+      if (unknown) g.set_log_odds({x, y}, 0.0f);
+    }
+  TraversabilityOptions t;
+  t.robot_radius_m = 0.1;
+  const auto passage = passage_cells(g, t);
+  const auto all = find_targets(g, passage, [](const Cell&, const Cell&) { return true; }, {}).targets;
+  ASSERT_FALSE(all.empty());
+  for (const auto& target : all) EXPECT_EQ(target.kind, FrontierMask::kWide);
+  const auto right = find_targets(g, passage, [](const Cell& frontier, const Cell&) { return frontier.x >= 20; }, {}).targets;
+  ASSERT_FALSE(right.empty());
+  for (const auto& target : right) {
+    EXPECT_EQ(target.kind, FrontierMask::kNarrow);
+    EXPECT_EQ(target.frontier.x, 35);
+  }
 }
 
 TEST(Targets, FrontiersWithNoRoomForARobotGiveNoTarget) {
@@ -133,12 +165,16 @@ TEST(Targets, FrontiersWithNoRoomForARobotGiveNoTarget) {
   }
   g.set_state({29, 2}, CellState::Unknown);
   g.set_log_odds({29, 2}, 0.0f);
-  const auto passable = traversable_cells(g, {});
+  const auto passage = passage_cells(g, {});
   FrontierOptions any_unknown;
   any_unknown.min_region_cells = 1;
   any_unknown.min_unknown_width_m = 0.0;
   EXPECT_EQ(find_frontier_regions(g, any_unknown).size(), 1u);
-  EXPECT_TRUE(make_targets(g, passable, {}).empty());
+  TargetOptions o;
+  o.frontiers = any_unknown;
+  const auto found = find_targets(g, passage, [](const Cell&, const Cell&) { return true; }, o);
+  EXPECT_TRUE(found.targets.empty());
+  EXPECT_EQ(found.without_goal.size(), 1u);
 }
 
 TEST(Traversability, KeepsTheRobotRadiusAndMarginFromWhatIsNotFree) {

@@ -26,18 +26,26 @@ Scenario noisy(const std::string& localization, int robots, int steps) {
   return s;
 }
 
+// The position RMSE summed over seeds 1 to 3: one route can be a poor one for scan matching (a long
+// featureless wall) or a lucky one for dead reckoning (errors that cancel).
 double rmse(const std::string& localization, int steps) {
   const auto grid = maps::load_map_source("office");
-  return metrics_json(Simulation(noisy(localization, 1, steps), grid).run(), "office")["position_rmse_m"].get<double>();
+  double sum = 0.0;
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    Scenario s = noisy(localization, 1, steps);
+    s.seed = seed;
+    sum += metrics_json(Simulation(s, grid).run(), "office")["position_rmse_m"].get<double>();
+  }
+  return sum;
 }
 
 // Scan matching on the robot's own grid, and the particle filter, undo most of the drift that
-// dead reckoning accumulates over the same run (same seed, same noise).
+// dead reckoning accumulates over the same runs (same seeds, same noise).
 TEST(GridSlamSimulation, ScanMatchingAndRbpfBeatDeadReckoningInExplore) {
   const double odometry = rmse("odometry", 120);
   const double scan = rmse("scan-matching", 120);
   const double rbpf = rmse("rbpf", 120);
-  EXPECT_GT(odometry, 0.1);
+  EXPECT_GT(odometry, 0.3);
   EXPECT_LT(scan, 0.5 * odometry);
   EXPECT_LT(rbpf, 0.5 * odometry);
 }
