@@ -8,6 +8,7 @@
 #include "io/map_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  namespace io = fleetmap::io;
   namespace mapping = fleetmap::mapping;
   io::MapLoadOptions options;
   options.max_cells = 1 << 22;  // keeps every input quick; the limit itself is part of what is tested

@@ -10,6 +10,7 @@
 #include "io/map_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  namespace io = fleetmap::io;
   namespace mapping = fleetmap::mapping;
   static const cv::Mat image = [] {
     cv::Mat m(7, 5, CV_8UC1);

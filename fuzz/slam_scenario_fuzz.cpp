@@ -11,7 +11,7 @@
 #include "experiments/slam_scenario.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  namespace sim = fleetmap::sim;
+  namespace experiments = fleetmap::experiments;
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
     if (experiments::is_corridor_scenario(text, "fuzz.yaml")) {

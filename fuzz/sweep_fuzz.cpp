@@ -8,7 +8,7 @@
 #include "sweep/sweep.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  namespace sim = fleetmap::sim;
+  namespace sweep = fleetmap::sweep;
   try {
     const sweep::Sweep s = sweep::parse_sweep(std::string(reinterpret_cast<const char*>(data), size), "fuzz.yaml", "/nonexistent");
     // Without a scenario file (none exists under /nonexistent) the sweep file holds every setting.

@@ -35,7 +35,7 @@ ExplorationLowerBound exploration_lower_bound(const sim::World& world, const std
   for (const auto& p : starts) sources.push_back(g.world_to_cell_unbounded(p));
   exploration::WaveOptions wo;
   wo.eight_connected = true;
-  const auto wave = exploration::compute_wave({g.width(), g.height(), passable, {}}, sources, wo);
+  const auto wave = exploration::compute_wave({g.width(), g.height(), passable, {}, {}}, sources, wo);
 
   // Distances of the observable cells; the `needed`-th smallest bounds the farthest cell a robot
   // must have come near. Every observable cell is reached by the wave: a line of sight runs through

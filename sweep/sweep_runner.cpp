@@ -34,7 +34,7 @@ void check_placements(const Sweep& sweep, const SweepMaps& maps) {
     const std::string label = map_label(source);
     const sim::World world(map_of(maps, label), {});
     for (int robots : sweep.robots) {
-      SweepRun probe{0, label, source, sweep.strategies.front(), robots, sweep.first_seed};
+      SweepRun probe{0, label, source, sweep.strategies.front(), robots, sweep.first_seed, {}, {}};
       for (const auto& axis : sweep.axes) probe.values.push_back(axis.values.front());
       const sim::Scenario s = run_scenario(sweep, probe);
       core::Random rng = core::Random(s.seed).fork(1);

@@ -21,12 +21,6 @@ cv::Scalar bgr(const Color& c) { return {double(c.b), double(c.g), double(c.r)};
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kFontScale = 0.5;
 
-// Pixel position of a world point in an image drawn at `scale` pixels per cell.
-cv::Point2d to_pixel(const core::GridGeometry& geometry, double scale, const Eigen::Vector2d& p) {
-  const Eigen::Vector2d g = geometry.world_to_grid(p);
-  return {g.x() * scale, (geometry.height() - g.y()) * scale};
-}
-
 cv::Point rounded(const cv::Point2d& p) { return {int(std::lround(p.x)), int(std::lround(p.y))}; }
 
 double nice_length(double target) {
