@@ -217,8 +217,9 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
     r.has_task = false;
     // Standing at the goal, in sight of the unseen cell, and it is still unseen (the beams passed
     // beside it): this approach failed, another goal is tried next; the robots this one talks to
-    // learn it too.
-    if (!map.observed(r.unknown) && frontier_cells_near(map, r.frontier, 2.0 * res, options_.targets.frontiers, r.kind) > 0) {
+    // learn it too. Whatever frontier cells are left around it: a target found again at this goal
+    // would be reached again at once, every round.
+    if (!map.observed(r.unknown)) {
       ++stats_.unobservable;
       fail_approach(i, Failure::Unobservable, map.observed_count(), &links);
     }
@@ -426,15 +427,20 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
   // A goal is usable by member k when its wave reaches it, it is not an approach that failed for
   // it, and on its own map too the robot fits there and the frontier is open (what it checks while
   // driving: a target it would drop at once would be handed to it again every round).
-  std::vector<std::unordered_map<int, bool>> open_on_own_map(members.size());
-  const auto usable_by = [&](std::size_t k, const Cell& frontier, const Cell& goal) {
+  // The frontier's kind counts too: check_task drops a target whose kind of frontier is gone.
+  std::vector<std::unordered_map<std::int64_t, bool>> open_on_own_map(members.size());
+  const auto usable_by = [&](std::size_t k, const Cell& frontier, const Cell& goal,
+                             std::uint8_t kind = FrontierMask::kNarrow) {
     const int i = members[k];
     const auto& own_map = *robots[std::size_t(i)].map;
     if (!waves[k].reached(goal) || blocked(robots_[std::size_t(i)], frontier, goal, res)) return false;
     if (&own_map == &map) return true;
     if (!cell_fits(own_map, goal, options_.traversability)) return false;
-    const auto [it, added] = open_on_own_map[k].try_emplace(map.geometry().index(frontier), false);
-    if (added) it->second = frontier_cells_near(own_map, frontier, options_.targets.piece_radius_m, options_.targets.frontiers) > 0;
+    const auto [it, added] = open_on_own_map[k].try_emplace(std::int64_t(map.geometry().index(frontier)) * 4 + kind, false);
+    if (added) {
+      it->second =
+          frontier_cells_near(own_map, frontier, options_.targets.piece_radius_m, options_.targets.frontiers, kind) > 0;
+    }
     return it->second;
   };
   const TargetSet found = find_targets(map, passage, [&](const Cell& frontier, const Cell& goal) {
@@ -456,7 +462,8 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
     ar.position_m = robots[std::size_t(i)].pose.position();
     ar.cost_m.resize(targets.size());
     for (std::size_t t = 0; t < targets.size(); ++t) {
-      ar.cost_m[t] = usable_by(k, targets[t].frontier, targets[t].goal) ? double(waves[k].cost(targets[t].goal)) * res
+      ar.cost_m[t] = usable_by(k, targets[t].frontier, targets[t].goal, targets[t].kind)
+                         ? double(waves[k].cost(targets[t].goal)) * res
                                                                         : std::numeric_limits<double>::infinity();
     }
     input.robots.push_back(std::move(ar));

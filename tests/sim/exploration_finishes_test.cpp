@@ -1,7 +1,8 @@
 // Exploration always finishes: on maps with cells from 0.02 to 0.1 m, with sparse scans (8 to 360
 // beams) and short ranges (from 0.5 m), and in the maze runs that used to stop early, the team
 // explores 99% of the observable space and stops by itself; a sensor that cannot observe anything
-// is refused with a clear error; a run that ends short says where and why.
+// is refused with a clear error; a run that ends short says where and why; a robot never waits at a
+// target it cannot see from.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -91,6 +92,20 @@ TEST(ExplorationFinishes, InTheMaze) {
     s.exploration.strategy = strategy;
     expect_finished(Simulation(s, grid).run(), fmt::format("{}, {} robots, seed {}", strategy, robots, seed));
   }
+}
+
+// A target whose goal the robot stands on, with its unseen cell still unseen, is a failed approach
+// even when no frontier cell of the target's kind is left right beside it; and a robot is handed only
+// targets whose kind of frontier its own map shows. Both used to hand a robot the target it was at,
+// every round, until the step limit (73% here).
+TEST(ExplorationFinishes, WhenTheTargetARobotStandsOnStaysUnseen) {
+  const auto grid = maps::load_map_source("unstructured");
+  Scenario s;
+  s.map = "unstructured";
+  s.robot_count = 2;
+  s.seed = 2;
+  s.exploration.strategy = "coordinated";
+  expect_finished(Simulation(s, grid).run(), "unstructured, coordinated, 2 robots, seed 2");
 }
 
 TEST(ExplorationFinishes, ASensorThatSeesNothingIsRefused) {
