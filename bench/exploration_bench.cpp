@@ -81,7 +81,7 @@ const WaveCase& campus() {
 void wave_benchmark(benchmark::State& state, const WaveOptions& options, bool weighted, int sources) {
   const WaveCase& c = campus();
   const WaveGrid grid{c.truth.width(), c.truth.height(), c.passable,
-                      weighted ? std::span<const float>(c.occupancy) : std::span<const float>()};
+                      weighted ? std::span<const float>(c.occupancy) : std::span<const float>(), {}};
   const std::span<const Cell> from = sources == 1 ? std::span<const Cell>(c.one_source) : std::span<const Cell>(c.nine_sources);
   WaveField field;
   compute_wave(grid, from, options, field);  // sizes the reused storage

@@ -71,10 +71,8 @@ std::int64_t MapExchange::tile_bytes(const Tiles& t, int tile) const {
   return kTileHeaderBytes + std::int64_t(x1 - tx * kTileSize) * (y1 - ty * kTileSize);
 }
 
-std::int64_t MapExchange::send(int from, int to, const std::vector<int>& tiles,
-                               std::vector<mapping::OccupancyGrid>& maps) {
-  const auto& src = maps[std::size_t(from)];
-  auto& dst = maps[std::size_t(to)];
+std::int64_t MapExchange::send(int from, const mapping::OccupancyGrid& src, int to, mapping::OccupancyGrid& dst,
+                               const std::vector<int>& tiles) {
   const Tiles& t = tiles_[std::size_t(from)];
   std::int64_t bytes = 0;
   for (const int tile : tiles) {
@@ -96,8 +94,8 @@ std::int64_t MapExchange::send(int from, int to, const std::vector<int>& tiles,
   return bytes;
 }
 
-std::int64_t MapExchange::exchange(int i, int j, std::vector<mapping::OccupancyGrid>& maps) {
-  if (!(maps[std::size_t(i)].geometry() == maps[std::size_t(j)].geometry())) {
+std::int64_t MapExchange::exchange(int i, mapping::OccupancyGrid& map_i, int j, mapping::OccupancyGrid& map_j) {
+  if (!(map_i.geometry() == map_j.geometry())) {
     throw Error("MapExchange::exchange: robots " + std::to_string(i) + " and " + std::to_string(j) +
                 " do not share a map frame");
   }
@@ -105,7 +103,7 @@ std::int64_t MapExchange::exchange(int i, int j, std::vector<mapping::OccupancyG
   // Both directions are chosen before either is applied: what one just got is not echoed back, and
   // what each changed before talking is never hidden by what it receives.
   const std::vector<int> from_i = changed_tiles(i, since), from_j = changed_tiles(j, since);
-  const std::int64_t bytes = send(i, j, from_i, maps) + send(j, i, from_j, maps);
+  const std::int64_t bytes = send(i, map_i, j, map_j, from_i) + send(j, map_j, i, map_i, from_j);
   last_exchange_[std::size_t(i)][std::size_t(j)] = last_exchange_[std::size_t(j)][std::size_t(i)] = clock_;
   return bytes;
 }

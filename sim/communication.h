@@ -49,7 +49,7 @@ class MapExchange {
   // cell fills only a cell the receiver has never observed: a robot's own evidence is never
   // overwritten, repeated exchanges never count the same evidence twice, and one robot's noise
   // cannot spread over another's clean map. Returns the bytes sent in both directions.
-  std::int64_t exchange(int i, int j, std::vector<mapping::OccupancyGrid>& maps);
+  std::int64_t exchange(int i, mapping::OccupancyGrid& map_i, int j, mapping::OccupancyGrid& map_j);
 
   // `from` sends `to` what changed since they last talked, for `to` to use on its own (e.g. an
   // overlap search between maps in different frames); nothing is fused. Returns the bytes.
@@ -63,7 +63,8 @@ class MapExchange {
   std::vector<int> changed_tiles(int robot, std::uint64_t since) const;
   std::int64_t tile_bytes(const Tiles& t, int tile) const;
   // Sends these tiles of `from`; returns the bytes.
-  std::int64_t send(int from, int to, const std::vector<int>& tiles, std::vector<mapping::OccupancyGrid>& maps);
+  std::int64_t send(int from, const mapping::OccupancyGrid& src, int to, mapping::OccupancyGrid& dst,
+                    const std::vector<int>& tiles);
 
   std::uint64_t clock_ = 0;
   std::vector<Tiles> tiles_;                               // per robot

@@ -12,11 +12,8 @@
 
 #include "core/error.h"
 #include "core/format.h"
-#include "core/angle.h"
 #include "localization/localizers.h"
 #include "mapping/range_scan.h"
-#include "merging/merge.h"
-#include "merging/rendezvous.h"
 #include "planning/planner.h"
 #include "sim/motion.h"
 #include "sim/sensors.h"
@@ -32,103 +29,6 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 std::string point_text(const Eigen::Vector2d& p) { return core::format_point(p); }
 
 std::string extent_text(const core::GridGeometry& g) { return core::format_extent(g); }
-
-// Free cells in order of 4-connected BFS distance from the free cell nearest to `centre`.
-std::vector<Cell> free_cells_from(const World& world, const Eigen::Vector2d& centre, std::size_t enough) {
-  const auto& g = world.geometry();
-  const int w = g.width(), h = g.height();
-  Cell start = g.world_to_cell_unbounded(centre);
-  start.x = std::clamp(start.x, 0, w - 1);
-  start.y = std::clamp(start.y, 0, h - 1);
-  std::vector<std::uint8_t> seen(std::size_t(w) * std::size_t(h), 0);
-  std::vector<Cell> queue = {start}, out;
-  seen[std::size_t(g.index(start))] = 1;
-  // Through any cell until the first free one, then through free cells only.
-  bool in_free = false;
-  for (std::size_t head = 0; head < queue.size() && out.size() < enough; ++head) {
-    const Cell c = queue[head];
-    const bool free = !world.blocked(c);
-    if (free && !in_free) {
-      in_free = true;
-      queue.erase(queue.begin() + std::ptrdiff_t(head) + 1, queue.end());
-      std::fill(seen.begin(), seen.end(), 0);
-      seen[std::size_t(g.index(c))] = 1;
-    }
-    if (in_free && !free) continue;
-    if (free) out.push_back(c);
-    const Cell n[4] = {{c.x + 1, c.y}, {c.x - 1, c.y}, {c.x, c.y + 1}, {c.x, c.y - 1}};
-    for (const Cell& m : n) {
-      if (!g.contains(m) || seen[std::size_t(g.index(m))]) continue;
-      seen[std::size_t(g.index(m))] = 1;
-      queue.push_back(m);
-    }
-  }
-  return out;
-}
-
-}  // namespace
-
-std::vector<core::Pose2> place_robots(const Scenario& s, const World& world, core::Random& rng) {
-  const double r = s.robot.radius_m;
-  const auto& g = world.geometry();
-  if (s.placement == Placement::List) {
-    for (std::size_t i = 0; i < s.starts.size(); ++i) {
-      const Eigen::Vector2d p = s.starts[i].position();
-      const std::string who = "robot " + std::to_string(i + 1) + " starts at " + point_text(p);
-      const auto cell = g.world_to_cell(p);
-      if (!cell) throw InputError(who + ", outside the map (" + extent_text(g) + ")");
-      if (world.blocked(*cell)) throw InputError(who + ", inside a wall");
-      if (!world.disc_free(p, r)) {
-        const double clearance = world.clearance(p, 2.0 * r);
-        throw InputError(who + fmt::format(", too close to a wall (clearance {:.2f} m, radius {:.2f} m)", clearance, r));
-      }
-      for (std::size_t j = 0; j < i; ++j) {
-        if ((s.starts[j].position() - p).norm() < 2.0 * r) {
-          throw InputError(who + ", on robot " + std::to_string(j + 1) + " (centres closer than two radii, " +
-                           std::to_string(2.0 * r).substr(0, 4) + " m)");
-        }
-      }
-    }
-    return s.starts;
-  }
-
-  Eigen::Vector2d centre = g.grid_to_world({0.5 * g.width(), 0.5 * g.height()});
-  if (s.cluster_at) {
-    centre = *s.cluster_at;
-    const auto cell = g.world_to_cell(centre);
-    if (!cell) throw InputError("robots.cluster_at " + point_text(centre) + " is outside the map (" + extent_text(g) + ")");
-    if (world.blocked(*cell)) throw InputError("robots.cluster_at " + point_text(centre) + " is inside a wall");
-  }
-  const double separation = std::max(s.min_separation_m, 2.0 * r + 0.05);
-  const double need = r + 0.05;
-  std::vector<Cell> candidates;
-  if (s.placement == Placement::Cluster) {
-    candidates = free_cells_from(world, centre, std::size_t(-1) / 2);
-  } else {
-    candidates = free_cells_from(world, centre, std::size_t(-1) / 2);
-    std::shuffle(candidates.begin(), candidates.end(), rng.engine());
-  }
-  std::vector<core::Pose2> starts;
-  for (const Cell& c : candidates) {
-    if (int(starts.size()) == s.robot_count) break;
-    const Eigen::Vector2d p = g.cell_center(c);
-    if (world.clearance(p, need) < need) continue;
-    const bool apart = std::all_of(starts.begin(), starts.end(), [&](const core::Pose2& q) {
-      return (q.position() - p).norm() >= separation;
-    });
-    if (!apart) continue;
-    const double heading = s.placement == Placement::Random ? rng.uniform(-M_PI, M_PI) : 0.0;
-    starts.emplace_back(p.x(), p.y(), heading);
-  }
-  if (int(starts.size()) < s.robot_count) {
-    throw InputError("robots: only " + std::to_string(starts.size()) + " of " + std::to_string(s.robot_count) +
-                     " robots fit in the free space around " + point_text(centre) + " (radius " + std::to_string(r).substr(0, 4) +
-                     " m, separation " + std::to_string(separation).substr(0, 4) + " m)");
-  }
-  return starts;
-}
-
-namespace {
 
 // The explorer plans for the robots and the sensor the scenario describes: their radius, the range,
 // goals that see their unseen cell from well within range, and that count as reached close enough.
@@ -180,27 +80,28 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
     }
   }
   core::Random placement_rng = rng_.fork(1);
-  truths_ = place_robots(scenario_, world_, placement_rng);
-  scenario_.starts = truths_;
-  scenario_.robot_count = int(truths_.size());
+  scenario_.starts = place_robots(scenario_, world_, placement_rng);
+  scenario_.robot_count = int(scenario_.starts.size());
   const int n = scenario_.robot_count;
   if (n > 64) throw InputError("robots: at most 64 robots");
+  robots_.resize(std::size_t(n));
+  for (int i = 0; i < n; ++i) robots_[std::size_t(i)].truth = scenario_.starts[std::size_t(i)];
 
   // Map frames: one shared world frame, or one per robot, its origin at the robot's start.
   if (scenario_.merging == "known") {
-    frame_of_.assign(std::size_t(n), 0);
     frame_origin_ = {core::Transform2::identity()};
     frame_geometry_ = {world_.geometry()};
   } else {
     const auto& g = world_.geometry();
     for (int i = 0; i < n; ++i) {
-      frame_of_.push_back(i);
-      frame_origin_.push_back(truths_[std::size_t(i)].as_transform());
+      const core::Pose2& start = robots_[std::size_t(i)].truth;
+      robots_[std::size_t(i)].frame = i;
+      frame_origin_.push_back(start.as_transform());
       // Large enough to hold the whole world around the start, however the frame is turned.
       double reach = 0.0;
       for (const auto& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(g.width(), 0), Eigen::Vector2d(0, g.height()),
                                  Eigen::Vector2d(g.width(), g.height())}) {
-        reach = std::max(reach, (g.grid_to_world(corner) - truths_[std::size_t(i)].position()).norm());
+        reach = std::max(reach, (g.grid_to_world(corner) - start.position()).norm());
       }
       const int cells = 2 * int(std::ceil((reach + 1.0) / g.resolution()));
       const double half = 0.5 * cells * g.resolution();
@@ -209,7 +110,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   }
   {
     std::vector<core::GridGeometry> geometries;
-    for (int i = 0; i < n; ++i) geometries.push_back(frame_geometry_[std::size_t(frame_of_[std::size_t(i)])]);
+    for (const Robot& r : robots_) geometries.push_back(frame_geometry_[std::size_t(r.frame)]);
     exchange_ = MapExchange(geometries);
   }
   last_attempt_.assign(std::size_t(n), std::vector<int>(std::size_t(n), std::numeric_limits<int>::min() / 2));
@@ -225,20 +126,21 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   // `mcl` localizes on the known map, which is only meaningful in the world frame.
   if (scenario_.merging == "known") context.known_map = std::make_shared<const mapping::OccupancyGrid>(world_.truth());
   for (int i = 0; i < n; ++i) {
+    Robot& robot = robots_[std::size_t(i)];
     context.global_localization = std::find(scenario_.lost_robots.begin(), scenario_.lost_robots.end(), i + 1) !=
                                   scenario_.lost_robots.end();
-    motion_rng_.push_back(rng_.fork(100 + std::uint64_t(i)));
-    sensor_rng_.push_back(rng_.fork(200 + std::uint64_t(i)));
+    robot.motion_rng = rng_.fork(100 + std::uint64_t(i));
+    robot.sensor_rng = rng_.fork(200 + std::uint64_t(i));
     // Each robot knows its start and the landmark map in its own map frame.
     const core::Transform2 to_frame = frame_origin(i).inverse();
-    context.initial_pose = core::Pose2::from_transform(to_frame * truths_[std::size_t(i)].as_transform());
+    context.initial_pose = core::Pose2::from_transform(to_frame * robot.truth.as_transform());
     context.known_landmarks.clear();
     for (std::size_t k = 0; k < world_.landmarks().size(); ++k) {
       context.known_landmarks.push_back({int(k), to_frame.apply(world_.landmarks()[k]), Eigen::Matrix2d::Zero()});
     }
     context.seed = rng_.fork(300 + std::uint64_t(i)).seed();
-    localizers_.push_back(localization::make_localizer(scenario_.localization, context));
-    maps_.emplace_back(frame_geometry_[std::size_t(frame_of_[std::size_t(i)])]);
+    robot.localizer = localization::make_localizer(scenario_.localization, context);
+    robot.map = mapping::OccupancyGrid(frame_geometry_[std::size_t(robot.frame)]);
   }
   if (scenario_.path_planner != "wave") {
     planning::PlanPathOptions plan;
@@ -255,11 +157,8 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
       return r.success() ? r.path : std::vector<Eigen::Vector2d>{};
     });
   }
-  tracks_.resize(std::size_t(n));
-  was_finished_.assign(std::size_t(n), 0);
-  blocked_streak_.assign(std::size_t(n), 0);
   std::vector<Eigen::Vector2d> start_points;
-  for (const auto& p : truths_) start_points.push_back(p.position());
+  for (const auto& p : scenario_.starts) start_points.push_back(p.position());
   observable_ = world_.observable_space(start_points, scenario_.robot.radius_m, scenario_.range.max_range_m);
   sensed_by_.assign(std::size_t(world_.geometry().cell_count()), 0);
   previous_links_.assign(std::size_t(n), std::vector<char>(std::size_t(n), 0));
@@ -274,9 +173,15 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
 
 Simulation::~Simulation() = default;
 
+std::vector<core::Pose2> Simulation::true_poses() const {
+  std::vector<core::Pose2> out;
+  for (const Robot& r : robots_) out.push_back(r.truth);
+  return out;
+}
+
 std::vector<core::Pose2> Simulation::estimated_poses() const {
   std::vector<core::Pose2> out;
-  for (const auto& l : localizers_) out.push_back(l->pose());
+  for (const Robot& r : robots_) out.push_back(r.localizer->pose());
   return out;
 }
 
@@ -287,27 +192,29 @@ void Simulation::sense_and_map() {
   auto t0 = Clock::now();
   std::vector<localization::RangeScan> scans(static_cast<std::size_t>(n));
   std::vector<std::vector<localization::LandmarkObservation>> landmark_obs(static_cast<std::size_t>(n));
-  detections_.assign(std::size_t(n), {});
+  const std::vector<core::Pose2> truths = true_poses();
   for (int i = 0; i < n; ++i) {
-    auto& rng = sensor_rng_[std::size_t(i)];
-    scans[std::size_t(i)] = read_ranges(world_, truths_[std::size_t(i)], scenario_.range, rng);
+    Robot& robot = robots_[std::size_t(i)];
+    auto& rng = robot.sensor_rng;
+    scans[std::size_t(i)] = read_ranges(world_, robot.truth, scenario_.range, rng);
     if (!world_.landmarks().empty()) {
-      landmark_obs[std::size_t(i)] = read_landmarks(world_, truths_[std::size_t(i)], scenario_.landmark_sensor, rng);
+      landmark_obs[std::size_t(i)] = read_landmarks(world_, robot.truth, scenario_.landmark_sensor, rng);
     }
-    detections_[std::size_t(i)] = detect_robots(world_, i, truths_, scenario_.detector, rng);
+    robot.detections = detect_robots(world_, i, truths, scenario_.detector, rng);
   }
   timing_.sensing += seconds_since(t0);
 
   t0 = Clock::now();
   for (int i = 0; i < n; ++i) {
-    auto& loc = *localizers_[std::size_t(i)];
-    loc.observe_truth(core::Pose2::from_transform(frame_origin(i).inverse() * truths_[std::size_t(i)].as_transform()));
+    Robot& robot = robots_[std::size_t(i)];
+    auto& loc = *robot.localizer;
+    loc.observe_truth(core::Pose2::from_transform(frame_origin(i).inverse() * robot.truth.as_transform()));
     if (!landmark_obs[std::size_t(i)].empty()) loc.update_landmarks(landmark_obs[std::size_t(i)]);
-    loc.update_scan(scans[std::size_t(i)], maps_[std::size_t(i)]);
+    loc.update_scan(scans[std::size_t(i)], robot.map);
     if (scenario_.localization_options.use_robot_detections) {
-      for (const auto& d : detections_[std::size_t(i)]) {
-        if (frame_of_[std::size_t(d.other)] != frame_of_[std::size_t(i)]) continue;  // its estimate means nothing here
-        const auto& other = *localizers_[std::size_t(d.other)];
+      for (const auto& d : robot.detections) {
+        if (robots_[std::size_t(d.other)].frame != robot.frame) continue;  // its estimate means nothing here
+        const auto& other = *robots_[std::size_t(d.other)].localizer;
         loc.update_robot({d.other, d.range, d.bearing, other.pose(), other.covariance()});
       }
     }
@@ -315,10 +222,10 @@ void Simulation::sense_and_map() {
   // Collaborative localization (León et al., eq. (15)): the detected robot learns from its detector.
   if (scenario_.localization_options.use_robot_detections) {
     for (int i = 0; i < n; ++i) {
-      for (const auto& d : detections_[std::size_t(i)]) {
-        if (frame_of_[std::size_t(d.other)] != frame_of_[std::size_t(i)]) continue;
-        const auto& detector = *localizers_[std::size_t(i)];
-        localizers_[std::size_t(d.other)]->update_detected_by({i, d.range, d.bearing, scenario_.detector.range_noise_m,
+      for (const auto& d : robots_[std::size_t(i)].detections) {
+        if (robots_[std::size_t(d.other)].frame != robots_[std::size_t(i)].frame) continue;
+        const auto& detector = *robots_[std::size_t(i)].localizer;
+        robots_[std::size_t(d.other)].localizer->update_detected_by({i, d.range, d.bearing, scenario_.detector.range_noise_m,
                                                                scenario_.detector.bearing_noise_rad, detector.pose(),
                                                                detector.covariance()});
       }
@@ -328,10 +235,10 @@ void Simulation::sense_and_map() {
 
   t0 = Clock::now();
   for (int i = 0; i < n; ++i) {
-    const core::Pose2 est = localizers_[std::size_t(i)]->pose();
+    const core::Pose2 est = robots_[std::size_t(i)].localizer->pose();
     const auto& scan = scans[std::size_t(i)];
     const std::uint64_t bit = std::uint64_t{1} << i;
-    auto& own = maps_[std::size_t(i)];
+    auto& own = robots_[std::size_t(i)].map;
     const core::Pose2 world = in_world(i, est);
     mapping::for_each_beam(est, scan, [&](const Eigen::Vector2d& from, const Eigen::Vector2d& end, bool hit) {
       own.integrate_ray(from, end, hit, [&](int cell, bool changed) {
@@ -348,18 +255,21 @@ void Simulation::sense_and_map() {
 void Simulation::communicate() {
   const auto t0 = Clock::now();
   const int n = scenario_.robot_count;
-  links_ = communication_links(world_, truths_, detections_, scenario_.communication);
+  std::vector<std::vector<Detection>> detections;
+  for (const Robot& r : robots_) detections.push_back(r.detections);
+  links_ = communication_links(world_, true_poses(), detections, scenario_.communication);
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       if (!links_[std::size_t(i)][std::size_t(j)]) continue;
       const bool new_link = !previous_links_[std::size_t(i)][std::size_t(j)];
       if (new_link) ++meetings_;
-      if (frame_of_[std::size_t(i)] != frame_of_[std::size_t(j)]) try_merge(i, j);
-      if (frame_of_[std::size_t(i)] != frame_of_[std::size_t(j)]) {
+      Robot &a = robots_[std::size_t(i)], &b = robots_[std::size_t(j)];
+      if (a.frame != b.frame) try_merge(i, j);
+      if (a.frame != b.frame) {
         if (new_link) events_.push_back({step_, "meeting", i, j, "in different frames: no map exchanged"});
         continue;
       }
-      const std::int64_t bytes = exchange_.exchange(i, j, maps_);
+      const std::int64_t bytes = exchange_.exchange(i, a.map, j, b.map);
       bytes_sent_ += bytes;
       if (new_link) events_.push_back({step_, "meeting", i, j, std::to_string(bytes) + " bytes exchanged"});
     }
@@ -371,16 +281,17 @@ void Simulation::communicate() {
 void Simulation::decide() {
   const auto t0 = Clock::now();
   std::vector<exploration::ExplorerRobot> views;
-  for (int i = 0; i < scenario_.robot_count; ++i) views.push_back({&maps_[std::size_t(i)], localizers_[std::size_t(i)]->pose()});
+  for (const Robot& r : robots_) views.push_back({&r.map, r.localizer->pose()});
   // Robots coordinate only when they can talk and share a map frame.
   auto links = links_;
   for (std::size_t i = 0; i < links.size(); ++i)
-    for (std::size_t j = 0; j < links.size(); ++j) links[i][j] = links[i][j] && frame_of_[i] == frame_of_[j];
+    for (std::size_t j = 0; j < links.size(); ++j) links[i][j] = links[i][j] && robots_[i].frame == robots_[j].frame;
   explorer_.update(views, links);
   for (int i = 0; i < scenario_.robot_count; ++i) {
     const bool f = explorer_.finished(i);
-    if (f && !was_finished_[std::size_t(i)]) events_.push_back({step_, "finished", i, -1, "no reachable frontier left"});
-    was_finished_[std::size_t(i)] = f;
+    bool& was = robots_[std::size_t(i)].was_finished;
+    if (f && !was) events_.push_back({step_, "finished", i, -1, "no reachable frontier left"});
+    was = f;
   }
   timing_.exploration += seconds_since(t0);
 }
@@ -392,11 +303,11 @@ void Simulation::measure() {
   for (int idx : cells) known += merged_.log_odds_at(idx) != 0.0f;
   coverage_.push_back(cells.empty() ? 1.0 : double(known) / double(cells.size()));
   for (int i = 0; i < scenario_.robot_count; ++i) {
-    auto& t = tracks_[std::size_t(i)];
-    t.truth.push_back(truths_[std::size_t(i)]);
-    t.estimate.push_back(in_world(i, localizers_[std::size_t(i)]->pose()));
-    t.covariance.push_back(
-        localization::rotate_pose_covariance(localizers_[std::size_t(i)]->covariance(), frame_origin(i).rotation()));
+    const Robot& robot = robots_[std::size_t(i)];
+    RobotTrack& t = robots_[std::size_t(i)].track;
+    t.truth.push_back(robot.truth);
+    t.estimate.push_back(in_world(i, robot.localizer->pose()));
+    t.covariance.push_back(localization::rotate_pose_covariance(robot.localizer->covariance(), frame_origin(i).rotation()));
   }
   timing_.metrics += seconds_since(t0);
 }
@@ -405,114 +316,25 @@ core::Pose2 Simulation::in_world(int i, const core::Pose2& frame_pose) const {
   return core::Pose2::from_transform(frame_origin(i) * frame_pose.as_transform());
 }
 
-void Simulation::try_merge(int i, int j) {
-  // The robot in the lower-numbered frame receives: the other's group adopts its frame.
-  const int receiver = frame_of_[std::size_t(i)] < frame_of_[std::size_t(j)] ? i : j;
-  const int sender = receiver == i ? j : i;
-  MergeRecord record;
-  record.step = step_;
-  record.receiver = receiver;
-  record.sender = sender;
-  std::optional<core::Transform2> t;  // sender's frame (metres) into the receiver's
-  if (scenario_.merging == "rendezvous") {
-    // D'Alfonso et al. §3.2: both robots see each other and exchange their poses and what they measured.
-    const auto seen = [&](int a, int b) -> const Detection* {
-      for (const auto& d : detections_[std::size_t(a)])
-        if (d.other == b) return &d;
-      return nullptr;
-    };
-    const Detection* rs = seen(receiver, sender);
-    const Detection* sr = seen(sender, receiver);
-    if (rs == nullptr || sr == nullptr) return;  // no rendezvous yet
-    bytes_sent_ += 2 * 5 * 8;                    // each sends its pose and its reading: 5 doubles
-    t = merging::rendezvous_transform_matrices(localizers_[std::size_t(receiver)]->pose(),
-                                               localizers_[std::size_t(sender)]->pose(), 0.5 * (rs->range + sr->range),
-                                               rs->bearing, sr->bearing);
-    record.method = "rendezvous";
-    record.confidence = 1.0;
-  } else {
-    int& last = last_attempt_[std::size_t(receiver)][std::size_t(sender)];
-    if (step_ - last < scenario_.merge_attempt_every) return;
-    last = step_;
-    bytes_sent_ += exchange_.send_without_fusing(sender, receiver);
-    merging::MergeOptions o;
-    o.method = scenario_.merge_method;
-    o.min_confidence = scenario_.merge_min_confidence;
-    o.seed = scenario_.seed;
-    const merging::MergeResult m = merging::align_maps(maps_[std::size_t(receiver)], maps_[std::size_t(sender)], o);
-    record.method = m.method.empty() ? scenario_.merge_method : m.method;
-    record.confidence = m.confidence;
-    if (!m.merged) {
-      record.reason = m.reason;
-      merges_.push_back(record);
-      return;
-    }
-    t = merging::world_from_cells(maps_[std::size_t(receiver)].geometry(), maps_[std::size_t(sender)].geometry(),
-                                  m.transform);
-  }
-  // Against the truth: where the sender's frame really lies in the receiver's.
-  const core::Transform2 truth = frame_origin(receiver).inverse() * frame_origin(sender);
-  const Eigen::Vector2d at = localizers_[std::size_t(sender)]->pose().position();
-  record.merged = true;
-  record.rotation_error_deg = core::rad2deg(std::abs(core::normalize_angle(t->rotation() - truth.rotation())));
-  record.position_error_m = (t->apply(at) - truth.apply(at)).norm();
-  merges_.push_back(record);
-  events_.push_back({step_, "merge", receiver, sender,
-                     fmt::format("{} merge, confidence {:.2f}: rotation error {:.2f} deg, position error {:.3f} m",
-                                 record.method, record.confidence, record.rotation_error_deg, record.position_error_m)});
-  adopt_frame(frame_of_[std::size_t(sender)], frame_of_[std::size_t(receiver)], *t);
-}
-
-void Simulation::adopt_frame(int from, int to, const core::Transform2& t) {
-  const core::GridGeometry& target = frame_geometry_[std::size_t(to)];
-  const core::Transform2 back = t.inverse();
-  for (int k = 0; k < scenario_.robot_count; ++k) {
-    if (frame_of_[std::size_t(k)] != from) continue;
-    // Resample the map into the new frame: each target cell takes the source cell under its centre.
-    const mapping::OccupancyGrid& old = maps_[std::size_t(k)];
-    mapping::OccupancyGrid moved(target, old.options());
-    Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
-    for (const auto& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(old.width(), 0), Eigen::Vector2d(0, old.height()),
-                               Eigen::Vector2d(old.width(), old.height())}) {
-      const Eigen::Vector2d g = target.world_to_grid(t.apply(old.geometry().grid_to_world(corner)));
-      lo = lo.cwiseMin(g);
-      hi = hi.cwiseMax(g);
-    }
-    const int x0 = std::max(0, int(std::floor(lo.x()))), x1 = std::min(target.width(), int(std::ceil(hi.x())) + 1);
-    const int y0 = std::max(0, int(std::floor(lo.y()))), y1 = std::min(target.height(), int(std::ceil(hi.y())) + 1);
-    for (int y = y0; y < y1; ++y) {
-      for (int x = x0; x < x1; ++x) {
-        const auto source = old.geometry().world_to_cell(back.apply(target.cell_center({x, y})));
-        if (!source) continue;
-        const float l = old.log_odds(*source);
-        if (l != 0.0f) moved.set_log_odds({x, y}, l);
-      }
-    }
-    maps_[std::size_t(k)] = std::move(moved);
-    localizers_[std::size_t(k)]->change_frame(t);
-    exchange_.reset(k, target);
-    explorer_.reset_robot(k);
-    frame_of_[std::size_t(k)] = to;
-  }
-}
-
 void Simulation::step() {
   if (done()) return;
   const auto t_step = Clock::now();
   ++step_;
   const auto t0 = Clock::now();
+  std::vector<core::Pose2> truths = true_poses();
   for (int i = 0; i < scenario_.robot_count; ++i) {
+    Robot& robot = robots_[std::size_t(i)];
     const auto path = explorer_.path(i);
-    auto& loc = *localizers_[std::size_t(i)];
+    auto& loc = *robot.localizer;
     // Two blocked moves in a row: back away from the obstacle before following the path again.
-    int& streak = blocked_streak_[std::size_t(i)];
-    const Command cmd = streak >= 2 ? escape_command(loc.pose(), maps_[std::size_t(i)], scenario_.period_s)
-                                    : follow_path(loc.pose(), path, maps_[std::size_t(i)], scenario_.robot,
-                                                  scenario_.period_s, scenario_.lookahead_m);
-    const MoveResult mv = move_robot(world_, i, truths_, scenario_.robot, cmd, scenario_.period_s, scenario_.noise,
-                                     motion_rng_[std::size_t(i)]);
-    truths_[std::size_t(i)] = mv.pose;
-    auto& t = tracks_[std::size_t(i)];
+    int& streak = robot.blocked_streak;
+    const Command cmd = streak >= 2 ? escape_command(loc.pose(), robot.map, scenario_.period_s)
+                                    : follow_path(loc.pose(), path, robot.map, scenario_.robot, scenario_.period_s,
+                                                  scenario_.lookahead_m);
+    const MoveResult mv =
+        move_robot(world_, i, truths, scenario_.robot, cmd, scenario_.period_s, scenario_.noise, robot.motion_rng);
+    robot.truth = truths[std::size_t(i)] = mv.pose;
+    auto& t = robot.track;
     t.distance_m += mv.distance_m;
     streak = mv.blocked ? streak + 1 : (streak >= 2 ? 0 : streak);
     if (streak > 3) streak = 0;  // the escape did not help either: follow the path again
@@ -613,17 +435,18 @@ RunResult Simulation::result() const {
   for (int idx : observable_.unreachable)
     if (merged_.log_odds_at(idx) != 0.0f) r.space.seen_unreachable.push_back(idx);
   r.unexplored = unexplored_regions();
-  r.robots = tracks_;
+  for (const Robot& robot : robots_) r.robots.push_back(robot.track);
   for (int i = 0; i < scenario_.robot_count; ++i) r.robot_frames.push_back(frame_origin(i));
   r.merges = merges_;
-  for (std::size_t i = 0; i < r.robots.size(); ++i) r.robots[i].localizer_counters = localizers_[i]->counters();
+  for (std::size_t i = 0; i < r.robots.size(); ++i) r.robots[i].localizer_counters = robots_[i].localizer->counters();
   r.events = events_;
   r.landmarks = world_.landmarks();
   r.merged = merged_;
-  r.robot_maps = maps_;
+  for (const Robot& robot : robots_) r.robot_maps.push_back(robot.map);
   r.map_quality = mapping::map_quality(merged_, world_.truth());
   for (int i = 0; i < scenario_.robot_count; ++i) {
-    r.robot_map_quality.push_back(mapping::map_quality(maps_[std::size_t(i)], world_.truth(), r.robot_frames[std::size_t(i)]));
+    r.robot_map_quality.push_back(
+        mapping::map_quality(robots_[std::size_t(i)].map, world_.truth(), r.robot_frames[std::size_t(i)]));
   }
   r.exploration = explorer_.stats();
   r.timing = timing_;

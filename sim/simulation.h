@@ -12,9 +12,9 @@
 #include "exploration/team_explorer.h"
 #include "localization/localizer.h"
 #include "mapping/map_quality.h"
-#include "mapping/map_quality.h"
 #include "mapping/occupancy_grid.h"
 #include "sim/communication.h"
+#include "sim/placement.h"
 #include "sim/scenario.h"
 #include "sim/world.h"
 
@@ -122,14 +122,14 @@ class Simulation {
   const World& world() const { return world_; }
   const Scenario& scenario() const { return scenario_; }
   const mapping::OccupancyGrid& merged_map() const { return merged_; }
-  const mapping::OccupancyGrid& robot_map(int i) const { return maps_[std::size_t(i)]; }
-  const std::vector<core::Pose2>& true_poses() const { return truths_; }
+  const mapping::OccupancyGrid& robot_map(int i) const { return robots_[std::size_t(i)].map; }
+  std::vector<core::Pose2> true_poses() const;
   std::vector<core::Pose2> estimated_poses() const;
-  const RobotTrack& track(int i) const { return tracks_[std::size_t(i)]; }
+  const RobotTrack& track(int i) const { return robots_[std::size_t(i)].track; }
   std::vector<Eigen::Vector2d> path(int i) const { return explorer_.path(i); }
   double coverage() const { return coverage_.empty() ? 0.0 : coverage_.back(); }
   // Where robot i's map frame lies in the world (identity with merging: known).
-  const core::Transform2& frame_origin(int i) const { return frame_origin_[std::size_t(frame_of_[std::size_t(i)])]; }
+  const core::Transform2& frame_origin(int i) const { return frame_origin_[std::size_t(robots_[std::size_t(i)].frame)]; }
 
   RunResult result() const;
   // The observable cells the merged map has not observed, in regions, with the reason each was left.
@@ -145,29 +145,36 @@ class Simulation {
   void decide();
   void measure();
 
+  // One robot of the run: where it truly is, what it knows (estimate, map in its map frame), its
+  // random streams, and what the run records about it.
+  struct Robot {
+    core::Pose2 truth;
+    std::unique_ptr<localization::Localizer> localizer;
+    mapping::OccupancyGrid map;
+    // Its map and pose estimate are in map frame `frame`, which lies at frame_origin_[frame] in the
+    // world (known to the simulator only, for evaluation). With merging: known every robot is in
+    // frame 0, the world's.
+    int frame = 0;
+    core::Random motion_rng{0}, sensor_rng{0};
+    std::vector<Detection> detections;  // this step's
+    RobotTrack track;
+    bool was_finished = false;
+    int blocked_streak = 0;  // consecutive blocked moves
+  };
+
   Scenario scenario_;
   World world_;
   core::Random rng_;
-  std::vector<core::Random> motion_rng_, sensor_rng_;
-  std::vector<core::Pose2> truths_;
-  std::vector<std::unique_ptr<localization::Localizer>> localizers_;
-  std::vector<mapping::OccupancyGrid> maps_;
+  std::vector<Robot> robots_;
   mapping::OccupancyGrid merged_;
   MapExchange exchange_;
   exploration::TeamExplorer explorer_;
-  std::vector<std::vector<Detection>> detections_;
   std::vector<std::vector<char>> links_, previous_links_;
   ObservableSpace observable_;         // the cells coverage is measured on
   std::vector<std::uint64_t> sensed_by_;  // per cell, a bit per robot
   std::vector<double> coverage_;
-  std::vector<RobotTrack> tracks_;
   std::vector<Event> events_;
-  std::vector<char> was_finished_;
-  std::vector<int> blocked_streak_;  // consecutive blocked moves per robot
-  // Map frames: robot i's map and pose estimate are in frame frame_of_[i]; frame f lies at
-  // frame_origin_[f] in the world (known to the simulator only, for evaluation) with a grid of
-  // frame_geometry_[f]. With merging: known there is one frame, the world's.
-  std::vector<int> frame_of_;
+  // Map frame f lies at frame_origin_[f] in the world, with a grid of frame_geometry_[f].
   std::vector<core::Transform2> frame_origin_;
   std::vector<core::GridGeometry> frame_geometry_;
   std::vector<std::vector<int>> last_attempt_;  // overlap: step of the last attempt per pair
@@ -177,8 +184,5 @@ class Simulation {
   int step_ = 0;
   Timings timing_;
 };
-
-// Robot start poses for a scenario on a map (also used to check a scenario before a run).
-std::vector<core::Pose2> place_robots(const Scenario& scenario, const World& world, core::Random& rng);
 
 }  // namespace fleetmap::sim

@@ -53,18 +53,18 @@ TEST(MapExchange, SendsOnlyWhatChangedAndNeverOverwritesOwnEvidence) {
   ex.touched(0, g.index({4, 3}));
   maps[1].set_state({3, 3}, mapping::CellState::Free);
   ex.touched(1, g.index({3, 3}));
-  const std::int64_t bytes = ex.exchange(0, 1, maps);
+  const std::int64_t bytes = ex.exchange(0, maps[0], 1, maps[1]);
   // One 16 x 16 tile each way: 2 x (4 + 256) bytes.
   EXPECT_EQ(bytes, 2 * (MapExchange::kTileHeaderBytes + 16 * 16));
   EXPECT_EQ(maps[1].state({4, 3}), mapping::CellState::Free);   // filled in
   EXPECT_EQ(maps[1].state({3, 3}), mapping::CellState::Free);   // its own evidence kept
   EXPECT_EQ(maps[0].state({3, 3}), mapping::CellState::Occupied);
   // Nothing new: nothing sent.
-  EXPECT_EQ(ex.exchange(0, 1, maps), 0);
+  EXPECT_EQ(ex.exchange(0, maps[0], 1, maps[1]), 0);
   // A change in another tile: only that tile travels.
   maps[1].set_state({40, 40}, mapping::CellState::Occupied);
   ex.touched(1, g.index({40, 40}));
-  EXPECT_EQ(ex.exchange(1, 0, maps), MapExchange::kTileHeaderBytes + 16 * 16);
+  EXPECT_EQ(ex.exchange(1, maps[1], 0, maps[0]), MapExchange::kTileHeaderBytes + 16 * 16);
   EXPECT_EQ(maps[0].state({40, 40}), mapping::CellState::Occupied);
 }
 
@@ -74,8 +74,8 @@ TEST(MapExchange, WhatWasReceivedIsRelayed) {
   MapExchange ex(3, g);
   maps[0].set_state({1, 1}, mapping::CellState::Occupied);
   ex.touched(0, g.index({1, 1}));
-  ex.exchange(0, 1, maps);
-  ex.exchange(1, 2, maps);  // robot 2 never met robot 0
+  ex.exchange(0, maps[0], 1, maps[1]);
+  ex.exchange(1, maps[1], 2, maps[2]);  // robot 2 never met robot 0
   EXPECT_EQ(maps[2].state({1, 1}), mapping::CellState::Occupied);
 }
 

@@ -126,7 +126,9 @@ TEST(ExplorationFinishes, ARunEndingShortSaysWhereAndWhy) {
   for (std::size_t k = 0; k < r.unexplored.size(); ++k) {
     area += r.unexplored[k].area_m2;
     EXPECT_NE(r.unexplored[k].reason.find("step limit"), std::string::npos);
-    if (k > 0) EXPECT_LE(r.unexplored[k].area_m2, r.unexplored[k - 1].area_m2);
+    if (k > 0) {
+      EXPECT_LE(r.unexplored[k].area_m2, r.unexplored[k - 1].area_m2);
+    }
   }
   const double observable_m2 = double(r.space.observable_cells) * r.space.cell_area_m2;
   EXPECT_NEAR(area, (1.0 - r.coverage.back()) * observable_m2, 0.5 * r.space.cell_area_m2);

@@ -21,7 +21,7 @@ using fleetmap::testing::expect_input_error;
 RunRecord record(const std::string& map, const std::string& strategy, int robots, std::uint64_t seed,
                  std::optional<int> steps_to_99, double distance_m) {
   RunRecord r;
-  r.key = {map, strategy, robots, seed};
+  r.key = {map, strategy, robots, seed, ""};
   r.localization = "ideal";
   r.comm_range_m = std::numeric_limits<double>::infinity();
   r.sensor_range_m = 4.0;

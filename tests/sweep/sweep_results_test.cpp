@@ -22,7 +22,7 @@ std::string slurp(const std::filesystem::path& p) {
 
 RunRecord sample(const std::string& strategy, int robots, std::uint64_t seed) {
   RunRecord r;
-  r.key = {"office", strategy, robots, seed};
+  r.key = {"office", strategy, robots, seed, ""};
   r.localization = "ideal";
   r.comm_range_m = std::numeric_limits<double>::infinity();
   r.sensor_range_m = 4.0;

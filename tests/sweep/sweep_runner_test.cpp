@@ -47,7 +47,7 @@ TEST(SweepRunner, SameRecordsWhateverTheNumberOfThreads) {
   const auto two = run_all(t, 2);
   EXPECT_EQ(one, two);
   // Different seeds are different runs.
-  EXPECT_NE(one.at({"roomA", "coordinated", 2, 1}), one.at({"roomA", "coordinated", 2, 2}));
+  EXPECT_NE(one.at({"roomA", "coordinated", 2, 1, ""}), one.at({"roomA", "coordinated", 2, 2, ""}));
 }
 
 TEST(SweepRunner, RunOneIsTheRunOfItsScenario) {
@@ -56,7 +56,7 @@ TEST(SweepRunner, RunOneIsTheRunOfItsScenario) {
   const SweepRun& run = runs[5];
   const RunRecord r = run_one(t.sweep, run, t.maps.at(run.map));
   const sim::RunResult direct = sim::Simulation(run_scenario(t.sweep, run), t.maps.at(run.map)).run();
-  EXPECT_EQ(r.key, (RunKey{run.map, run.strategy, run.robots, run.seed}));
+  EXPECT_EQ(r.key, (RunKey{run.map, run.strategy, run.robots, run.seed, ""}));
   EXPECT_EQ(r.steps, direct.steps);
   EXPECT_EQ(r.steps_to_95, direct.steps_to_95);
   EXPECT_EQ(r.bytes_sent, direct.bytes_sent);
