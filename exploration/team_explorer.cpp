@@ -142,6 +142,19 @@ bool TeamExplorer::blocked(const RobotState& r, const Cell& frontier, const Cell
   return false;
 }
 
+std::vector<std::uint8_t> TeamExplorer::wave_from(const mapping::OccupancyGrid& map, const Cell& from, WaveField& out,
+                                                  const std::function<void(std::vector<std::uint8_t>&)>& block) {
+  std::vector<std::uint8_t> passable, factor;
+  passage_grid(passage_cells(map, options_.traversability), passable, factor);
+  if (block) block(passable);
+  open_around(map, from, options_.traversability, passable);
+  std::vector<float> occupancy;
+  compute_wave(wave_grid(map, passable, factor, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave,
+               out);
+  ++stats_.waves;
+  return passable;
+}
+
 void TeamExplorer::set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const {
   r.path = std::move(path);
   r.was_clear.resize(r.path.size());
@@ -181,22 +194,7 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
   const double res = map.resolution();
   const Eigen::Vector2d p = robot.pose.position();
 
-  // Progress: the furthest path cell near the robot, looking a little ahead.
-  const std::size_t look = std::min(r.path.size(), r.next + 12);
-  std::size_t passed = r.next;
-  for (std::size_t k = r.next; k < look; ++k) {
-    if ((map.geometry().cell_center(r.path[k]) - p).norm() <= 1.5 * res) passed = k + 1;
-  }
-  r.next = std::max(r.next, passed);
-  // Progress means fewer path cells left than ever before on this task; a replanned path that
-  // starts where the robot stands does not count.
-  const std::size_t remaining = r.path.size() - std::min(r.next, r.path.size());
-  if (remaining < r.best_remaining) {
-    r.best_remaining = remaining;
-    r.steps_since_progress = 0;
-  } else {
-    ++r.steps_since_progress;
-  }
+  track_progress(r, map, p);
 
   if (r.yielding) {
     if ((map.geometry().cell_center(r.goal) - p).norm() <= options_.reach_tolerance_m || r.next >= r.path.size() ||
@@ -231,15 +229,9 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
   }
   // Stuck, most likely behind or facing another robot: plan a way around the robots it knows of.
   if (r.steps_since_progress > 0 && r.steps_since_progress % options_.detour_after_steps == 0) {
-    std::vector<std::uint8_t> passable, factor;
-    passage_grid(passage_cells(map, options_.traversability), passable, factor);
-    mark_robots(map, robots, i, links, options_.traversability, passable);
-    const Cell from = robot_cell(robot);
-    open_around(map, from, options_.traversability, passable);
-    std::vector<float> occupancy;
-    compute_wave(wave_grid(map, passable, factor, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave,
-                 wave_);
-    ++stats_.waves;
+    wave_from(map, robot_cell(robot), wave_, [&](std::vector<std::uint8_t>& passable) {
+      mark_robots(map, robots, i, links, options_.traversability, passable);
+    });
     if (wave_.reached(r.goal)) {
       ++stats_.detours;
       set_path(r, wave_.path_to(r.goal), map);
@@ -251,8 +243,32 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
     fail_approach(i, Failure::Stalled, map.observed_count());
     return false;
   }
-  // New obstacles on the path ahead (cells clear when planned, blocked now): plan again to the same
-  // goal, or give it up.
+  return replan_around_new_obstacles(i, robot);
+}
+
+void TeamExplorer::track_progress(RobotState& r, const mapping::OccupancyGrid& map, const Eigen::Vector2d& p) {
+  // The furthest path cell near the robot, looking a little ahead.
+  const std::size_t look = std::min(r.path.size(), r.next + 12);
+  std::size_t passed = r.next;
+  for (std::size_t k = r.next; k < look; ++k) {
+    if ((map.geometry().cell_center(r.path[k]) - p).norm() <= 1.5 * map.resolution()) passed = k + 1;
+  }
+  r.next = std::max(r.next, passed);
+  // Progress means fewer path cells left than ever before on this task; a replanned path that
+  // starts where the robot stands does not count.
+  const std::size_t remaining = r.path.size() - std::min(r.next, r.path.size());
+  if (remaining < r.best_remaining) {
+    r.best_remaining = remaining;
+    r.steps_since_progress = 0;
+  } else {
+    ++r.steps_since_progress;
+  }
+}
+
+bool TeamExplorer::replan_around_new_obstacles(int i, const ExplorerRobot& robot) {
+  RobotState& r = robots_[std::size_t(i)];
+  const auto& map = *robot.map;
+  // Cells clear when planned, blocked now, on the path ahead: plan again to the same goal, or give it up.
   const std::size_t end = std::min(r.path.size(), r.next + std::size_t(options_.path_check_cells));
   for (std::size_t k = r.next; k < end; ++k) {
     if (!r.was_clear[k] || cell_fits(map, r.path[k], options_.traversability)) continue;
@@ -260,14 +276,7 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
       r.has_task = false;  // the goal itself turned out too close to a wall: a new target, not a failure
       return false;
     }
-    std::vector<std::uint8_t> passable, factor;
-    passage_grid(passage_cells(map, options_.traversability), passable, factor);
-    std::vector<float> occupancy;
-    const Cell from = robot_cell(robot);
-    open_around(map, from, options_.traversability, passable);
-    compute_wave(wave_grid(map, passable, factor, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave,
-                 wave_);
-    ++stats_.waves;
+    wave_from(map, robot_cell(robot), wave_);
     ++stats_.paths_replanned;
     if (!wave_.reached(r.goal)) {
       ++stats_.given_up_unreachable;
@@ -304,13 +313,7 @@ void TeamExplorer::make_way(int stuck, const std::vector<ExplorerRobot>& robots,
     if (!near_path(at)) continue;
     // The nearest place (by wave cost on its own map) that is clear of the stuck robot's way.
     const auto& map = *robots[j].map;
-    std::vector<std::uint8_t> passable, factor;
-    passage_grid(passage_cells(map, options_.traversability), passable, factor);
-    open_around(map, at, options_.traversability, passable);
-    std::vector<float> occupancy;
-    compute_wave(wave_grid(map, passable, factor, occupancy, options_.wave), std::span<const Cell>(&at, 1), options_.wave,
-                 wave_);
-    ++stats_.waves;
+    const std::vector<std::uint8_t> passable = wave_from(map, at, wave_);
     const int window = int(std::ceil(4.0 / res));
     float best = WaveField::kUnreached;
     Cell goal = at;

@@ -143,6 +143,16 @@ class TeamExplorer {
   // Passable cells (Fits or Clear) of passage_cells and their wave step factors.
   void passage_grid(const std::vector<std::uint8_t>& passage, std::vector<std::uint8_t>& passable,
                     std::vector<std::uint8_t>& factor) const;
+  // Moves r.next past the path cells the robot has reached; counts steps without progress.
+  static void track_progress(RobotState& r, const mapping::OccupancyGrid& map, const Eigen::Vector2d& p);
+  // New obstacles on robot i's path ahead: a new path to the same goal, or the task given up
+  // (false).
+  bool replan_around_new_obstacles(int i, const ExplorerRobot& robot);
+  // A wave on `map` from `from` into `out`, over the passage grid opened around `from` (after
+  // `block` closed what it wants closed, e.g. the cells around other robots). Returns the grid's
+  // passable cells.
+  std::vector<std::uint8_t> wave_from(const mapping::OccupancyGrid& map, const Cell& from, WaveField& out,
+                                      const std::function<void(std::vector<std::uint8_t>&)>& block = {});
   void set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const;
   // The provider's path to the goal as cells, or the wave's when the provider has none.
   std::vector<Cell> plan(const mapping::OccupancyGrid& map, const ExplorerRobot& robot, const Cell& goal,

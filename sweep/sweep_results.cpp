@@ -192,7 +192,8 @@ std::string row_text(const RunRecord& r, bool wall_time) {
   std::string line;
   for (const auto& c : columns()) {
     if (!wall_time && std::string_view(c.name) == "wall_time_s") continue;
-    line += (line.empty() ? "" : ",") + c.write(r);
+    if (!line.empty()) line += ',';
+    line += c.write(r);
   }
   return line;
 }
