@@ -15,10 +15,11 @@
 #include "core/error.h"
 #include "core/format.h"
 #include "exploration/strategy.h"
-#include "localization/localizer.h"
 #include "io/file_io.h"
 #include "io/map_io.h"
+#include "localization/localizer.h"
 #include "maps/builtin_maps.h"
+#include "merging/map_aligner.h"
 #include "planning/planner.h"
 #include "sim/run_metrics.h"
 #include "sim/run_output.h"
@@ -281,12 +282,9 @@ Command add_explore_command(CLI::App& root) {
       "Flags override the scenario file; without one, the defaults above apply.\n\n"
       "Strategies (--strategy):\n" +
       exploration::strategy_help() + "\nLocalization (--localization):\n" + localization::localizer_help() +
-      "\nMerging (--merging): how robots bring each other's maps into their own frame\n"
-      "  known       every robot knows its start pose in one shared frame (default)\n"
-      "  rendezvous  each robot maps in its own frame; robots that detect each other take the\n"
-      "              relative transform from the detection (D'Alfonso et al., section 3.2)\n"
-      "  overlap     each robot maps in its own frame; robots that can talk search their maps for\n"
-      "              the best overlap (as `fleetmap merge`) and merge only above a confidence\n");
+      "\nMerging (--merging): how robots bring each other's maps into their own frame (all but known: each "
+      "robot maps in its own frame until it merges)\n" +
+      merging::map_aligner_registry().help());
   auto f = std::make_shared<ExploreFlags>();
   app->add_option("--scenario", f->scenario, "Scenario YAML file (see scenarios/); flags below override it")
       ->check(CLI::ExistingFile);
@@ -307,7 +305,7 @@ Command add_explore_command(CLI::App& root) {
       ->check(CLI::IsMember(exploration::strategy_names()));
   app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]")
       ->check(CLI::IsMember(localization::localizer_names()));
-  app->add_option("--merging", f->merging, "known, rendezvous or overlap (see below) [default: known]")
+  app->add_option("--merging", f->merging, "known, rendezvous, overlap or landmarks (see below) [default: known]")
       ->check(CLI::IsMember(sim::merging_names()));
   app->add_option("--comm-range", f->comm_range,
                   "Communication range in metres; 0 = only when robots see each other; inf = always [default: inf]")

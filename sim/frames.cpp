@@ -1,14 +1,14 @@
-// Map frames of a run (Simulation's second part): a robot that merges with a teammate in another
-// frame moves its whole group into the receiver's frame, by rendezvous (D'Alfonso et al. 2013, §3.2)
-// or by searching the two maps for their overlap (merging/).
+// Map frames of a run (Simulation's second part): two robots in different frames that can talk ask
+// the scenario's merging::MapAligner (rendezvous, overlap, landmarks, or a registered one) for the
+// transform between their frames; on success the sender's whole group moves into the receiver's
+// frame.
 #include <cmath>
 #include <optional>
 
 #include <fmt/format.h>
 
 #include "core/angle.h"
-#include "merging/merge.h"
-#include "merging/rendezvous.h"
+#include "merging/map_aligner.h"
 #include "sim/simulation.h"
 
 namespace fleetmap::sim {
@@ -21,43 +21,42 @@ void Simulation::try_merge(int i, int j) {
   record.step = step_;
   record.receiver = receiver;
   record.sender = sender;
-  std::optional<core::Transform2> t;  // sender's frame (metres) into the receiver's
-  if (scenario_.merging == "rendezvous") {
-    // D'Alfonso et al. §3.2: both robots see each other and exchange their poses and what they measured.
-    const auto seen = [&](int a, int b) -> const Detection* {
-      for (const auto& d : robots_[std::size_t(a)].detections)
-        if (d.other == b) return &d;
-      return nullptr;
-    };
-    const Detection* rs = seen(receiver, sender);
-    const Detection* sr = seen(sender, receiver);
-    if (rs == nullptr || sr == nullptr) return;  // no rendezvous yet
-    bytes_sent_ += 2 * 5 * 8;                    // each sends its pose and its reading: 5 doubles
-    t = merging::rendezvous_transform_matrices(robots_[std::size_t(receiver)].localizer->pose(),
-                                               robots_[std::size_t(sender)].localizer->pose(), 0.5 * (rs->range + sr->range),
-                                               rs->bearing, sr->bearing);
-    record.method = "rendezvous";
-    record.confidence = 1.0;
-  } else {
+  const Robot &r = robots_[std::size_t(receiver)], &s = robots_[std::size_t(sender)];
+  if (aligner_->costly()) {
     int& last = last_attempt_[std::size_t(receiver)][std::size_t(sender)];
     if (step_ - last < scenario_.merge_attempt_every) return;
     last = step_;
-    bytes_sent_ += exchange_.send_without_fusing(sender, receiver);
-    merging::MergeOptions o;
-    o.method = scenario_.merge_method;
-    o.min_confidence = scenario_.merge_min_confidence;
-    o.seed = scenario_.seed;
-    const merging::MergeResult m = merging::align_maps(robots_[std::size_t(receiver)].map, robots_[std::size_t(sender)].map, o);
-    record.method = m.method.empty() ? scenario_.merge_method : m.method;
-    record.confidence = m.confidence;
-    if (!m.merged) {
-      record.reason = m.reason;
-      merges_.push_back(record);
-      return;
-    }
-    t = merging::world_from_cells(robots_[std::size_t(receiver)].map.geometry(), robots_[std::size_t(sender)].map.geometry(),
-                                  m.transform);
   }
+  merging::AlignmentRequest request;
+  request.receiver_map = &r.map;
+  request.sender_map = &s.map;
+  request.receiver_pose = r.localizer->pose();
+  request.sender_pose = s.localizer->pose();
+  const auto seen = [&](const Robot& a, int b) -> const Detection* {
+    for (const auto& d : a.detections)
+      if (d.other == b) return &d;
+    return nullptr;
+  };
+  const Detection* rs = seen(r, sender);
+  const Detection* sr = seen(s, receiver);
+  if (rs != nullptr && sr != nullptr) request.detection = merging::MutualObservation{rs->range, rs->bearing, sr->range, sr->bearing};
+  request.receiver_landmarks = r.localizer->landmark_estimates();
+  request.sender_landmarks = s.localizer->landmark_estimates();
+  request.method = scenario_.merge_method;
+  request.min_confidence = scenario_.merge_min_confidence;
+  request.seed = scenario_.seed;
+  if (aligner_->sends_map()) bytes_sent_ += exchange_.send_without_fusing(sender, receiver);
+  const merging::FrameAlignment m = aligner_->align(request);
+  if (!m.attempted) return;
+  bytes_sent_ += m.bytes_sent;
+  record.method = m.method.empty() ? scenario_.merging : m.method;
+  record.confidence = m.confidence;
+  if (!m.merged) {
+    record.reason = m.reason;
+    merges_.push_back(record);
+    return;
+  }
+  const core::Transform2* t = &m.sender_to_receiver;  // sender's frame (metres) into the receiver's
   // Against the truth: where the sender's frame really lies in the receiver's.
   const core::Transform2 truth = frame_origin(receiver).inverse() * frame_origin(sender);
   const Eigen::Vector2d at = robots_[std::size_t(sender)].localizer->pose().position();

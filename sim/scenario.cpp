@@ -14,6 +14,7 @@
 #include "io/yaml_reader.h"
 #include "exploration/strategy.h"
 #include "maps/builtin_maps.h"
+#include "merging/map_aligner.h"
 #include "merging/merge.h"
 #include "planning/planner.h"
 
@@ -60,7 +61,7 @@ std::string fmt(double v) {
 
 }  // namespace
 
-std::vector<std::string> merging_names() { return {"known", "rendezvous", "overlap"}; }
+std::vector<std::string> merging_names() { return merging::map_aligner_registry().names(); }
 
 std::vector<std::string> path_planner_names() {
   // OMPL's PRM* grows its roadmap for fixed wall-clock times in two threads: runs would not repeat.

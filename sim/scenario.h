@@ -86,14 +86,15 @@ struct Scenario {
   std::vector<int> lost_robots;
   CommunicationOptions communication;
   exploration::ExplorationOptions exploration;
-  // How robots bring others' maps into their frame: "known" (every robot knows its start pose in a
-  // common frame), "rendezvous" (each robot maps in its own frame; robots that detect each other
-  // compute the relative transform from the detection, D'Alfonso et al. §3.2) or "overlap" (robots that can
-  // talk search their maps for the best overlap, merging/).
+  // How robots bring others' maps into their frame, a merging::MapAligner by name: "known" (every
+  // robot knows its start pose in a common frame), "rendezvous" (each robot maps in its own frame;
+  // robots that detect each other compute the relative transform from the detection, D'Alfonso et
+  // al. §3.2), "overlap" (robots that can talk search their maps for the best overlap, merging/) or
+  // "landmarks" (they associate their estimated landmark maps by RANSAC).
   std::string merging = "known";
   std::string merge_method = "auto";         // overlap: a method of `fleetmap merge`
-  double merge_min_confidence = 0.5;         // overlap: below, no merge
-  int merge_attempt_every = 20;              // overlap: steps between attempts of the same pair
+  double merge_min_confidence = 0.5;         // overlap, landmarks: below, no merge
+  int merge_attempt_every = 20;              // overlap, landmarks: steps between attempts of the same pair
   double lookahead_m = 0.5;                  // path following
   // How robots get a path to their target: "wave" (the wave's steepest descent) or a planner of
   // planning/ by name (astar, rrtconnect, rrtstar, ...). A sampling planner stops after
@@ -104,6 +105,7 @@ struct Scenario {
   int planner_iterations = 2000;
 };
 
+// Every registered merging::MapAligner: known, rendezvous, overlap, landmarks, and any added since.
 std::vector<std::string> merging_names();
 // "wave" and every planner of planning/.
 std::vector<std::string> path_planner_names();

@@ -88,7 +88,8 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   for (int i = 0; i < n; ++i) robots_[std::size_t(i)].truth = scenario_.starts[std::size_t(i)];
 
   // Map frames: one shared world frame, or one per robot, its origin at the robot's start.
-  if (scenario_.merging == "known") {
+  aligner_ = merging::make_map_aligner(scenario_.merging);
+  if (aligner_->shared_frame()) {
     frame_origin_ = {core::Transform2::identity()};
     frame_geometry_ = {world_.geometry()};
   } else {
@@ -124,7 +125,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   context.options.scan_range_noise = scenario_.range.noise_m;
   context.options.known_associations = scenario_.landmark_sensor.report_ids && scenario_.localization_options.known_associations;
   // `mcl` localizes on the known map, which is only meaningful in the world frame.
-  if (scenario_.merging == "known") context.known_map = std::make_shared<const mapping::OccupancyGrid>(world_.truth());
+  if (aligner_->shared_frame()) context.known_map = std::make_shared<const mapping::OccupancyGrid>(world_.truth());
   for (int i = 0; i < n; ++i) {
     Robot& robot = robots_[std::size_t(i)];
     context.global_localization = std::find(scenario_.lost_robots.begin(), scenario_.lost_robots.end(), i + 1) !=

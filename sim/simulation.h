@@ -13,6 +13,7 @@
 #include "localization/localizer.h"
 #include "mapping/map_quality.h"
 #include "mapping/occupancy_grid.h"
+#include "merging/map_aligner.h"
 #include "sim/communication.h"
 #include "sim/placement.h"
 #include "sim/scenario.h"
@@ -169,6 +170,7 @@ class Simulation {
   mapping::OccupancyGrid merged_;
   MapExchange exchange_;
   exploration::TeamExplorer explorer_;
+  std::unique_ptr<merging::MapAligner> aligner_;  // how robots in different frames align them
   std::vector<std::vector<char>> links_, previous_links_;
   ObservableSpace observable_;         // the cells coverage is measured on
   std::vector<std::uint64_t> sensed_by_;  // per cell, a bit per robot

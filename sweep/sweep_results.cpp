@@ -279,7 +279,10 @@ double coverage_at(const RunRecord& r, int step) {
 
 std::string results_header() {
   std::string h;
-  for (const auto& c : columns()) h += (h.empty() ? "" : ",") + std::string(c.name);
+  for (const auto& c : columns()) {
+    if (!h.empty()) h += ',';
+    h += c.name;
+  }
   return h;
 }
 

@@ -1,7 +1,12 @@
-// Robots in their own map frames bring each other's maps in by rendezvous or by overlap search.
+// Robots in their own map frames bring each other's maps in by rendezvous, by overlap search or by
+// associating their landmark maps; a program registers an aligner of its own.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "maps/builtin_maps.h"
+#include "merging/map_aligner.h"
+#include "sim/scenario.h"
 #include "sim/run_output.h"
 #include "sim/simulation.h"
 
@@ -66,6 +71,66 @@ TEST(MergingRuns, OverlapSearchMergesOnlyWithConfidence) {
     EXPECT_LT(m.position_error_m, 0.3);
   }
   EXPECT_GT(made, 0) << "three robots exploring one office should find an overlap";
+}
+
+// EKF-SLAM robots in the warehouse with landmarks along the walls (0.3 per metre), who can always
+// talk: they associate their estimated landmark maps (RANSAC) and merge once enough landmarks agree.
+TEST(MergingRuns, LandmarkMapsMergeOnlyWhenEnoughLandmarksAgree) {
+  Scenario s;
+  s.map = "warehouse";
+  s.seed = 2;
+  s.robot_count = 3;
+  s.placement = Placement::Random;
+  s.min_separation_m = 4.0;
+  s.landmarks_along_walls = 0.3;
+  s.landmark_sensor.range_noise_m = 0.05;
+  s.localization = "ekf-slam";
+  s.merging = "landmarks";
+  s.exploration.strategy = "market";
+  s.steps = 260;
+  const RunResult r = Simulation(s, maps::load_map_source("warehouse")).run();
+  int made = 0;
+  for (const auto& m : r.merges) {
+    EXPECT_EQ(m.method, "landmarks");
+    if (!m.merged) {
+      EXPECT_LT(m.confidence, s.merge_min_confidence);
+      continue;
+    }
+    ++made;
+    // EKF-SLAM landmark estimates are good to centimetres; supports count within 0.3 m.
+    EXPECT_LT(m.rotation_error_deg, 2.0);
+    EXPECT_LT(m.position_error_m, 0.3);
+  }
+  EXPECT_GT(made, 0) << "three robots mapping the warehouse's landmarks should find a common part";
+}
+
+// A program's own aligner, by name: here one that never trusts anything, so robots keep their frames
+// and every attempt is recorded under its name.
+class NeverAligner final : public merging::MapAligner {
+ public:
+  merging::FrameAlignment align(const merging::AlignmentRequest&) const override {
+    ++calls;
+    merging::FrameAlignment out;
+    out.attempted = true;
+    out.method = "never";
+    out.reason = "this aligner trusts nothing";
+    return out;
+  }
+  static inline int calls = 0;
+};
+
+TEST(MergingRuns, ARegisteredAlignerRunsByName) {
+  merging::register_map_aligner("never", "refuses every merge (a test's own)", [] { return std::make_unique<NeverAligner>(); });
+  const auto names = merging_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "never"), names.end());
+  const Scenario s = parse_scenario("map: office\nrobots: 2\nsteps: 30\nmerging: never\n", "never.yaml", "");
+  const RunResult r = Simulation(s, maps::load_map_source("office")).run();
+  EXPECT_GT(NeverAligner::calls, 0);
+  ASSERT_FALSE(r.merges.empty());
+  for (const auto& m : r.merges) {
+    EXPECT_FALSE(m.merged);
+    EXPECT_EQ(m.reason, "this aligner trusts nothing");
+  }
 }
 
 }  // namespace
