@@ -65,6 +65,36 @@ class Search {
     }
     std::stable_sort(rest.begin(), rest.end(), [&](int a, int b) { return nearest[std::size_t(a)] > nearest[std::size_t(b)]; });
     for (int t : rest) insert(t);
+    if (o_.every_robot_busy) give_idle_robots_a_target();
+  }
+
+  // Each robot without a target takes one from a tour of two or more, where the tours get the best
+  // score; robots in team order.
+  void give_idle_robots_a_target() {
+    for (int r = 0; r < n_; ++r) {
+      if (!tours_[std::size_t(r)].empty()) continue;
+      int donor = -1;
+      std::size_t at = 0;
+      double best_longest = 0.0, best_sum = 0.0;
+      const double sum = total();
+      for (int d = 0; d < n_; ++d) {
+        const auto& tour = tours_[std::size_t(d)];
+        if (tour.size() < 2) continue;
+        for (std::size_t p = 0; p < tour.size(); ++p) {
+          if (!reachable(r, tour[p])) continue;
+          const double new_d = length_[std::size_t(d)] + remove_delta(d, tour, p), new_r = leg(r, kStart, tour[p]);
+          const double longest = std::max({longest_except(d, r), new_d, new_r});
+          const double new_sum = sum - length_[std::size_t(d)] + new_d + new_r;
+          if (donor < 0 || better(longest, new_sum, best_longest, best_sum)) donor = d, at = p, best_longest = longest, best_sum = new_sum;
+        }
+      }
+      if (donor < 0) continue;
+      auto& from = tours_[std::size_t(donor)];
+      tours_[std::size_t(r)].push_back(from[at]);
+      from.erase(from.begin() + std::ptrdiff_t(at));
+      length_[std::size_t(donor)] = length_of(donor, from);
+      length_[std::size_t(r)] = length_of(r, tours_[std::size_t(r)]);
+    }
   }
 
   // Cheapest min-max insertion of target t.
@@ -180,7 +210,7 @@ class Search {
     const double removed = remove_delta(a, from, p);
     const double current_longest = longest_except(-1, -1), current_sum = total();
     for (int b = 0; b < n_; ++b) {
-      if (!reachable(b, t)) continue;
+      if (!reachable(b, t) || (b != a && o_.every_robot_busy && from.size() == 1)) continue;
       if (b == a) {
         // Insert into the tour without t: position k of the reduced tour is from[k < p ? k : k + 1].
         const auto reduced = [&](std::size_t k) { return from[k < p ? k : k + 1]; };

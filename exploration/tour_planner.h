@@ -24,6 +24,11 @@ struct TourOptions {
   // A move must shorten the longest tour, or the tours' total with the longest no longer, by more
   // than this (in cost units): floating-point noise never swaps two equal solutions.
   double tolerance = 1e-6;
+  // Every robot that can reach a target gets one while there are enough to go round (taken from a
+  // tour of two or more where the longest tour grows least), and no move empties a tour: the
+  // min-max split alone leaves a robot idle whenever it is farther from every target than the
+  // longest tour, yet an exploring robot finds new frontiers on its way.
+  bool every_robot_busy = true;
 };
 
 // Per robot, its targets in visiting order (indices into the problem's targets).
@@ -38,7 +43,8 @@ double tour_length(const TourProblem& problem, int robot, const std::vector<int>
 // starting solution: its targets stay where they are unless a move improves the tours (targets
 // out of range, repeated, or not reachable by their robot are dropped from it), and the
 // targets it lacks are inserted, one at a time, farthest from every robot first, where the
-// longest tour grows least (then the total). The same problem and initial tours give the same
+// longest tour grows least (then the total); then idle robots are given a target (see
+// every_robot_busy). The same problem and initial tours give the same
 // tours. The objective, compared in this order: the longest tour, then the sum of the tours.
 Tours plan_tours(const TourProblem& problem, const Tours& initial = {}, const TourOptions& options = {});
 
