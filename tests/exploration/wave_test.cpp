@@ -178,10 +178,10 @@ TEST(Wave, PairwiseCostsFromOneLabelledWave) {
     o.eight_connected = trial % 2 == 0;
     const std::size_t m = goals.size();
     WaveField scratch;
-    const auto pairwise = pairwise_wave_costs({g.w, g.h, g.passable, {}}, goals, o, scratch);
+    const auto pairwise = pairwise_wave_costs({g.w, g.h, g.passable, {}, {}}, goals, o, scratch);
     ASSERT_EQ(pairwise.size(), m * m);
     for (std::size_t a = 0; a < m; ++a) {
-      const WaveField from_a = compute_wave({g.w, g.h, g.passable, {}}, std::span<const Cell>(&goals[a], 1), o);
+      const WaveField from_a = compute_wave({g.w, g.h, g.passable, {}, {}}, std::span<const Cell>(&goals[a], 1), o);
       float nearest_exact = WaveField::kUnreached, nearest_pairwise = WaveField::kUnreached;
       for (std::size_t b = 0; b < m; ++b) {
         const float exact = from_a.cost(goals[b]), c = pairwise[a * m + b];
