@@ -12,5 +12,6 @@ std::unique_ptr<CoordinationStrategy> make_coordinated_strategy(const StrategyOp
 std::unique_ptr<CoordinationStrategy> make_optimized_strategy(const StrategyOptions& options);
 std::unique_ptr<CoordinationStrategy> make_directional_strategy(const StrategyOptions& options);
 std::unique_ptr<CoordinationStrategy> make_market_strategy(const StrategyOptions& options);
+std::unique_ptr<CoordinationStrategy> make_tour_strategy(const StrategyOptions& options);
 
 }  // namespace fleetmap::exploration

@@ -26,6 +26,11 @@ core::Registry<StrategyFactory>& strategy_registry() {
           make_directional_strategy);
     r.add("market", "sequential single-item auction, min-max bids on wave cost (Koenig et al. 2006; Zlot et al. 2002)",
           make_market_strategy);
+    r.add("tour",
+          "an open tour per robot through every frontier target, split so that the longest tour is shortest, "
+          "repaired between rounds; each robot drives to its tour's first target (after TARE, Cao et al. 2021, "
+          "and RACER, Zhou et al. 2023)",
+          make_tour_strategy);
     return true;
   }();
   (void)built_in;
@@ -63,6 +68,15 @@ double cost_scale(const AssignmentInput& input) {
     for (double c : r.cost_m)
       if (std::isfinite(c)) m = std::max(m, c);
   return m > 0.0 ? m : 1.0;
+}
+
+Eigen::MatrixXd target_costs(const AssignmentInput& input) {
+  if (input.target_costs_m) return input.target_costs_m();
+  const auto m = Eigen::Index(input.targets.size());
+  Eigen::MatrixXd c(m, m);
+  for (Eigen::Index a = 0; a < m; ++a)
+    for (Eigen::Index b = 0; b < m; ++b) c(a, b) = (input.targets[std::size_t(a)].goal_m - input.targets[std::size_t(b)].goal_m).norm();
+  return c;
 }
 
 void nearest_targets(const AssignmentInput& input, std::vector<int>& assignment) {

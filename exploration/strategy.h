@@ -32,6 +32,10 @@ struct AssignmentInput {
   std::vector<AssignmentRobot> robots;       // the robots to assign now
   std::vector<Eigen::Vector2d> claimed;      // goals other robots already drive to (known by talking)
   double sensor_range_m = 4.0;               // utility of targets near an assigned one drops within it
+  // Wave costs between the targets' goals in metres (targets x targets, +inf between goals that are
+  // not connected), for strategies that plan tours through several targets; computed only when
+  // called, during assign(). Empty: target_costs() uses straight lines.
+  std::function<Eigen::MatrixXd()> target_costs_m;
 };
 
 class CoordinationStrategy {
@@ -70,6 +74,8 @@ double visibility_overlap(double distance_m, double sensor_range_m);
 std::vector<double> initial_utilities(const AssignmentInput& input);
 // The largest finite cost in the input (1 when there is none), to scale costs into [0, 1].
 double cost_scale(const AssignmentInput& input);
+// input.target_costs_m() when the input has it, else the straight-line distances between the goals.
+Eigen::MatrixXd target_costs(const AssignmentInput& input);
 // Each robot without a target takes its cheapest reachable one (taken or not).
 void nearest_targets(const AssignmentInput& input, std::vector<int>& assignment);
 

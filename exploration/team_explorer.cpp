@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <unordered_map>
 
 #include "mapping/grid_traversal.h"
@@ -471,6 +472,23 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
     }
     input.robots.push_back(std::move(ar));
   }
+  // Wave costs between the targets' goals on the same grid, for strategies that plan tours.
+  input.target_costs_m = [&] {
+    std::vector<Cell> goals;
+    goals.reserve(targets.size());
+    for (const Target& t : targets) goals.push_back(t.goal);
+    const std::vector<float> cells = pairwise_wave_costs(grid, goals, options_.wave, wave_);
+    ++stats_.waves;
+    const auto m = Eigen::Index(targets.size());
+    Eigen::MatrixXd costs(m, m);
+    for (Eigen::Index a = 0; a < m; ++a) {
+      for (Eigen::Index b = 0; b < m; ++b) {
+        const float c = cells[std::size_t(a * m + b)];
+        costs(a, b) = c == WaveField::kUnreached ? std::numeric_limits<double>::infinity() : double(c) * res;
+      }
+    }
+    return costs;
+  };
   const std::vector<int> choice = strategy_->assign(input);
   for (std::size_t k = 0; k < members.size(); ++k) {
     RobotState& r = robots_[std::size_t(members[k])];

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <queue>
+#include <utility>
 
 #include "core/error.h"
 
@@ -24,7 +27,8 @@ std::uint32_t WaveField::step_units(int dir, int entered_index) const {
   return step_units_[2 * std::size_t(entered_index) + (dir < 4 ? 0 : 1)];
 }
 
-void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options, WaveField& out) {
+void compute_wave_into(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options, WaveField& out,
+                       bool label) {
   const std::size_t n = std::size_t(grid.width) * std::size_t(grid.height);
   if (grid.passable.size() != n || (!grid.occupancy.empty() && grid.occupancy.size() != n) ||
       (!grid.step_factor.empty() && grid.step_factor.size() != n)) {
@@ -55,6 +59,9 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
   std::uint32_t* units = out.units_.data();
   const std::uint8_t* passable = out.passable_.data();
   constexpr std::uint32_t kNone = WaveField::kUnreachedUnits;
+  if (label) out.source_.assign(n, -1);
+  else out.source_.clear();
+  std::int32_t* source = label ? out.source_.data() : nullptr;
 
   if (!options.eight_connected && !weighted) {
     // Unit costs: a plain BFS over a flat queue (wave-algorithm paper, Table 1).
@@ -66,6 +73,7 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
       const int i = s.y * w + s.x;
       if (units[i] == 0) continue;
       units[i] = 0;
+      if (source) source[i] = std::int32_t(&s - sources.data());
       queue[tail++] = i;
     }
     constexpr std::uint32_t step = WaveField::kUnitsPerCell;
@@ -73,10 +81,15 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
       const int i = queue[head++];
       const int x = i % w, y = i / w;
       const std::uint32_t next = units[i] + step;
-      if (x + 1 < w && passable[i + 1] && units[i + 1] == kNone) units[i + 1] = next, queue[tail++] = i + 1;
-      if (x > 0 && passable[i - 1] && units[i - 1] == kNone) units[i - 1] = next, queue[tail++] = i - 1;
-      if (y + 1 < h && passable[i + w] && units[i + w] == kNone) units[i + w] = next, queue[tail++] = i + w;
-      if (y > 0 && passable[i - w] && units[i - w] == kNone) units[i - w] = next, queue[tail++] = i - w;
+      const auto visit = [&](int j) {
+        units[j] = next;
+        if (source) source[j] = source[i];
+        queue[tail++] = j;
+      };
+      if (x + 1 < w && passable[i + 1] && units[i + 1] == kNone) visit(i + 1);
+      if (x > 0 && passable[i - 1] && units[i - 1] == kNone) visit(i - 1);
+      if (y + 1 < h && passable[i + w] && units[i + w] == kNone) visit(i + w);
+      if (y > 0 && passable[i - w] && units[i - w] == kNone) visit(i - w);
     }
   } else {
     // Dial's algorithm: a circular array of buckets, one per cost value, wide enough for the
@@ -91,6 +104,7 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
       const int i = s.y * w + s.x;
       if (units[i] == 0) continue;
       units[i] = 0;
+      if (source) source[i] = std::int32_t(&s - sources.data());
       buckets[0].push_back(i);
       ++pending;
     }
@@ -115,6 +129,7 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
           const std::uint32_t c = d + step;
           if (c < units[j]) {
             units[j] = c;
+            if (source) source[j] = source[i];
             buckets[c % bucket_count].push_back(j);
             ++pending;
           }
@@ -126,6 +141,99 @@ void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const Wav
   for (std::size_t i = 0; i < n; ++i) {
     out.cost_[i] = units[i] == kNone ? WaveField::kUnreached : float(units[i]) / float(WaveField::kUnitsPerCell);
   }
+}
+
+void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options, WaveField& out) {
+  compute_wave_into(grid, sources, options, out, false);
+}
+
+void compute_labelled_wave(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options, WaveField& out) {
+  compute_wave_into(grid, sources, options, out, true);
+}
+
+std::vector<float> pairwise_wave_costs(const WaveGrid& grid, std::span<const Cell> goals, const WaveOptions& options,
+                                       WaveField& scratch) {
+  const std::size_t m = goals.size();
+  constexpr double kNone = std::numeric_limits<double>::infinity();
+  std::vector<double> cost(m * m, kNone);
+  for (std::size_t a = 0; a < m; ++a) cost[a * m + a] = 0.0;
+  compute_labelled_wave(grid, goals, options, scratch);
+  const int w = scratch.width_, h = scratch.height_;
+  const std::uint32_t* units = scratch.units_.data();
+  const std::int32_t* source = scratch.source_.data();
+  // A goal on another goal's cell (or outside the grid) has no region of its own: it stands in for
+  // the goal whose wave holds its cell.
+  std::vector<int> region(m, -1);
+  for (std::size_t a = 0; a < m; ++a) {
+    if (goals[a].x >= 0 && goals[a].y >= 0 && goals[a].x < w && goals[a].y < h) region[a] = source[goals[a].y * w + goals[a].x];
+  }
+  // Joins between touching regions: the cheapest crossing of their border. Each neighbour pair is
+  // looked at once (right, down, and the two lower diagonals, which may not cut a corner).
+  std::vector<double> join(m * m, kNone);
+  const int neighbours = options.eight_connected ? 4 : 2;
+  constexpr int kNx[4] = {1, 0, 1, -1}, kNy[4] = {0, 1, 1, 1};
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int i = y * w + x;
+      const int si = source[i];
+      if (si < 0) continue;
+      for (int k = 0; k < neighbours; ++k) {
+        const int nx = x + kNx[k], ny = y + kNy[k];
+        if (nx < 0 || nx >= w || ny >= h) continue;
+        const int j = ny * w + nx;
+        const int sj = source[j];
+        if (sj < 0 || sj == si) continue;
+        if (k >= 2 && (!scratch.passable_[std::size_t(y * w + nx)] || !scratch.passable_[std::size_t(ny * w + x)])) continue;
+        const int dir = k < 2 ? 0 : 4;
+        // Across the border into j (the wave's step into j) and into i (for the other direction);
+        // the dearer of the two, so that the join is a path either way.
+        const double step = double(std::max(scratch.step_units(dir, j), scratch.step_units(dir, i)));
+        const double c = double(units[i]) + step + double(units[j]);
+        const std::size_t ab = std::size_t(si) * m + std::size_t(sj);
+        if (c < join[ab]) join[ab] = join[std::size_t(sj) * m + std::size_t(si)] = c;
+      }
+    }
+  }
+  std::vector<std::vector<std::pair<int, double>>> adjacent(m);
+  for (std::size_t a = 0; a < m; ++a)
+    for (std::size_t b = 0; b < m; ++b)
+      if (a != b && join[a * m + b] < kNone) adjacent[a].push_back({int(b), join[a * m + b]});
+  // Dijkstra over the joins from every region's goal.
+  std::vector<double> dist(m);
+  using Item = std::pair<double, int>;
+  for (std::size_t a = 0; a < m; ++a) {
+    if (region[a] != int(a)) continue;
+    std::fill(dist.begin(), dist.end(), kNone);
+    dist[a] = 0.0;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+    open.push({0.0, int(a)});
+    while (!open.empty()) {
+      const auto [d, u] = open.top();
+      open.pop();
+      if (d > dist[std::size_t(u)]) continue;
+      for (const auto& [v, c] : adjacent[std::size_t(u)]) {
+        if (d + c < dist[std::size_t(v)]) {
+          dist[std::size_t(v)] = d + c;
+          open.push({d + c, v});
+        }
+      }
+    }
+    for (std::size_t b = 0; b < m; ++b) cost[a * m + b] = dist[b];
+  }
+  // Goals without a region of their own take their stand-in's costs.
+  std::vector<float> out(m * m, WaveField::kUnreached);
+  for (std::size_t a = 0; a < m; ++a) {
+    for (std::size_t b = 0; b < m; ++b) {
+      if (a == b) {
+        out[a * m + b] = 0.0f;
+        continue;
+      }
+      if (region[a] < 0 || region[b] < 0) continue;
+      const double c = cost[std::size_t(region[a]) * m + std::size_t(region[b])];
+      if (c < kNone) out[a * m + b] = float(c / double(WaveField::kUnitsPerCell));
+    }
+  }
+  return out;
 }
 
 std::vector<Cell> WaveField::path_to(const Cell& target) const {

@@ -53,13 +53,17 @@ class WaveField {
   std::int64_t reached_count() const;
   // The exact cost in units of 1/kUnitsPerCell cell.
   std::uint32_t units_at(int index) const { return units_[std::size_t(index)]; }
+  // After compute_labelled_wave: the index (into its sources) of the source whose wave reached the
+  // cell first, i.e. the nearest source; -1 where the wave never came.
+  int source_at(int index) const { return source_.empty() ? -1 : source_[std::size_t(index)]; }
 
   // The cells from the nearest source to `target` (both included), descending the wave; empty when
   // `target` was not reached.
   std::vector<Cell> path_to(const Cell& target) const;
 
  private:
-  friend void compute_wave(const WaveGrid&, std::span<const Cell>, const WaveOptions&, WaveField&);
+  friend void compute_wave_into(const WaveGrid&, std::span<const Cell>, const WaveOptions&, WaveField&, bool);
+  friend std::vector<float> pairwise_wave_costs(const WaveGrid&, std::span<const Cell>, const WaveOptions&, WaveField&);
   int width_ = 0;
   int height_ = 0;
   bool eight_connected_ = true;
@@ -68,11 +72,27 @@ class WaveField {
   std::vector<std::uint32_t> units_;
   std::vector<std::uint8_t> passable_;  // copy kept for path extraction
   std::vector<std::uint32_t> step_units_;  // weighted: units to enter cell i straight [2i] and diagonally [2i+1]
+  std::vector<std::int32_t> source_;       // labelled waves only: the nearest source per cell
 };
 
 // Fills `out` (its storage is reused between calls). Sources outside the grid are ignored; a source
 // on an impassable cell still starts the wave (a robot may stand in inflated space).
 void compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options, WaveField& out);
+
+// The same wave, also recording for every cell which source is nearest (WaveField::source_at): the
+// sources' geodesic Voronoi regions.
+void compute_labelled_wave(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options, WaveField& out);
+
+// Wave costs in cells between every pair of `goals` (row-major, goals.size() squared; kUnreached
+// between goals the grid does not connect), without a wave per goal: one labelled wave from all of
+// them splits the grid into their geodesic Voronoi regions; two regions that touch are joined by the
+// cheapest path through their border (the cost to the border from each side plus the step across),
+// and shortest paths over these joins give the costs. Each cost is the length of a path of the wave,
+// so never below the wave's cost between the two goals; it equals it when the cheapest path between
+// them crosses no third goal's region, and is otherwise that path bent through the sources of the
+// regions it crosses. Goals on one cell are 0 apart. `scratch` holds the labelled wave afterwards.
+std::vector<float> pairwise_wave_costs(const WaveGrid& grid, std::span<const Cell> goals, const WaveOptions& options,
+                                       WaveField& scratch);
 
 inline WaveField compute_wave(const WaveGrid& grid, std::span<const Cell> sources, const WaveOptions& options = {}) {
   WaveField f;

@@ -152,5 +152,47 @@ TEST(Strategies, MarketBalancesBundles) {
   EXPECT_EQ(make_strategy("market")->assign(in), (std::vector<int>{1, 2}));
 }
 
+// Targets on a line between two robots: each drives to the near end of its own half, and the next
+// round, with the targets each robot reached gone and the robots moved, the plan carries on.
+TEST(Strategies, TourRobotsWorkTheirOwnHalfAndKeepTheirPlan) {
+  const auto s = make_strategy("tour");
+  const auto line = [](double from, double to) {
+    AssignmentInput in;
+    for (double x = from; x <= to + 1e-9; x += 1.0) in.targets.push_back(target_at(x, 0));
+    return in;
+  };
+  const auto costs_from = [](const AssignmentInput& in, double x) {
+    std::vector<double> c;
+    for (const auto& t : in.targets) c.push_back(std::abs(t.goal_m.x() - x));
+    return c;
+  };
+  AssignmentInput in = line(1, 10);
+  in.robots = {robot(0, 2, {0, 0}, costs_from(in, 0)), robot(1, 2, {11, 0}, costs_from(in, 11))};
+  EXPECT_EQ(s->assign(in), (std::vector<int>{0, 9}));  // x = 1 and x = 10
+  // Both reached their first target (x = 1 and x = 10 are gone) and a target appeared in robot 0's
+  // half (x = 4.6).
+  AssignmentInput next = line(2, 9);
+  next.targets.push_back(target_at(4.6, 0.5));
+  next.robots = {robot(0, 2, {1, 0}, costs_from(next, 1)), robot(1, 2, {10, 0}, costs_from(next, 10))};
+  EXPECT_EQ(s->assign(next), (std::vector<int>{0, 7}));  // x = 2 and x = 9: each carries on along its half
+  // The same round again gives the same answer.
+  EXPECT_EQ(s->assign(next), (std::vector<int>{0, 7}));
+}
+
+TEST(Strategies, TourUsesTheWaveCostsBetweenTargets) {
+  // Targets 1 m apart in straight line, but 10 apart by the wave (a wall between them); the robot
+  // reaches the first at 5 and the second at 2. Either tour crosses the wall once, so the robot
+  // starts with the cheaper first leg: 2 + 10 against 5 + 10.
+  const auto s = make_strategy("tour");
+  AssignmentInput in;
+  in.targets = {target_at(1, 0), target_at(2, 0)};
+  in.robots = {robot(0, 1, {0, 0}, {5, 2})};
+  in.target_costs_m = [] { return Eigen::MatrixXd{{0, 10}, {10, 0}}; };
+  EXPECT_EQ(s->assign(in), (std::vector<int>{1}));
+  EXPECT_EQ(target_costs(in)(0, 1), 10.0);
+  in.target_costs_m = nullptr;
+  EXPECT_DOUBLE_EQ(target_costs(in)(0, 1), 1.0);  // straight line without wave costs
+}
+
 }  // namespace
 }  // namespace fleetmap::exploration

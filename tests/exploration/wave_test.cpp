@@ -6,6 +6,7 @@
 #include <limits>
 #include <queue>
 #include <random>
+#include <span>
 
 namespace fleetmap::exploration {
 namespace {
@@ -157,6 +158,52 @@ TEST(Wave, NoCornerCutting) {
   std::vector<std::uint8_t> p = {1, 0, 0, 1};
   const WaveField f = compute_wave({2, 2, p, {}}, std::vector<Cell>{{0, 0}}, WaveOptions{true, 0.0});
   EXPECT_FALSE(f.reached({1, 1}));
+}
+
+// The costs between goals from one labelled wave: never below the wave from either goal, the same
+// as it from every goal to its nearest one (no third goal's region lies on that path), and
+// symmetric; goals the grid does not connect are kUnreached apart.
+TEST(Wave, PairwiseCostsFromOneLabelledWave) {
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 40; ++trial) {
+    const RandomGrid g = random_grid(rng, 30, 24, 0.25);
+    std::vector<Cell> goals;
+    std::uniform_int_distribution<int> sx(0, g.w - 1), sy(0, g.h - 1);
+    while (goals.size() < std::size_t(2 + trial % 9)) {
+      const Cell c{sx(rng), sy(rng)};
+      if (g.passable[std::size_t(c.y * g.w + c.x)]) goals.push_back(c);
+    }
+    if (trial % 5 == 0) goals.push_back(goals.front());  // two goals on one cell
+    WaveOptions o;
+    o.eight_connected = trial % 2 == 0;
+    const std::size_t m = goals.size();
+    WaveField scratch;
+    const auto pairwise = pairwise_wave_costs({g.w, g.h, g.passable, {}, {}}, goals, o, scratch);
+    ASSERT_EQ(pairwise.size(), m * m);
+    for (std::size_t a = 0; a < m; ++a) {
+      const WaveField from_a = compute_wave({g.w, g.h, g.passable, {}, {}}, std::span<const Cell>(&goals[a], 1), o);
+      float nearest_exact = WaveField::kUnreached, nearest_pairwise = WaveField::kUnreached;
+      for (std::size_t b = 0; b < m; ++b) {
+        const float exact = from_a.cost(goals[b]), c = pairwise[a * m + b];
+        EXPECT_EQ(c, pairwise[b * m + a]) << "trial " << trial;
+        if (exact == WaveField::kUnreached) {
+          EXPECT_EQ(c, WaveField::kUnreached) << "trial " << trial << ": unconnected goals " << a << ", " << b;
+          continue;
+        }
+        EXPECT_GE(c, exact - 1e-4f) << "trial " << trial;
+        if (b == a || goals[b] == goals[a]) {
+          EXPECT_EQ(c, 0.0f);
+          continue;
+        }
+        nearest_exact = std::min(nearest_exact, exact);
+        nearest_pairwise = std::min(nearest_pairwise, c);
+      }
+      if (nearest_exact == WaveField::kUnreached) EXPECT_EQ(nearest_pairwise, WaveField::kUnreached);
+      else EXPECT_NEAR(nearest_pairwise, nearest_exact, 1e-4) << "trial " << trial << " goal " << a;
+    }
+    // The labels: each reached cell belongs to a goal no farther than any other.
+    for (int i = 0; i < g.w * g.h; i += 5) EXPECT_EQ(scratch.source_at(i) >= 0, scratch.cost_at(i) < WaveField::kUnreached);
+  }
 }
 
 }  // namespace

@@ -1,0 +1,105 @@
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <mutex>
+
+#include "exploration/strategies.h"
+#include "exploration/tour_planner.h"
+
+namespace fleetmap::exploration {
+
+namespace {
+
+// Multi-robot frontier tours, after TARE (Cao et al. 2021) and RACER (Zhou et al. 2023): every
+// frontier target is a node, with wave costs from each robot and between the targets; every robot
+// gets an open tour, and the targets are split among the robots so that the longest tour is as
+// short as the search finds (plan_tours). Each robot drives to its tour's first target. Legs
+// between targets are shortened by the sensor range (a target is seen from that far).
+//
+// Tours are repaired, not planned afresh, each round (RACER's incremental update): the previous
+// round's tours are the starting solution, with the targets that vanished dropped and the new ones
+// inserted, so a robot keeps its plan unless a move makes the team's tours shorter, and robots do
+// not swap targets back and forth. A group of robots plans with its own members' earlier tours only:
+// robots that cannot talk never see one another's plans.
+class Tour final : public CoordinationStrategy {
+ public:
+  std::string name() const override { return "tour"; }
+  bool joint() const override { return true; }
+
+  std::vector<int> assign(const AssignmentInput& input) const override {
+    const std::size_t n = input.robots.size(), m = input.targets.size();
+    std::vector<int> out(n, -1);
+    if (n == 0 || m == 0) return out;
+    TourProblem problem;
+    problem.start_cost.resize(Eigen::Index(n), Eigen::Index(m));
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t t = 0; t < m; ++t) problem.start_cost(Eigen::Index(i), Eigen::Index(t)) = input.robots[i].cost_m[t];
+    // Costs between targets only matter when some robot has two or more to visit. A robot sees a
+    // target from up to the sensor range away, so the leg to the next target is only the way to
+    // within that range of it (as in fleetmap's lower bound on exploration time): targets a robot
+    // passes within sensor range of cost nothing more, the tours gather targets that one robot sees
+    // together, and the min-max split sends the other robots elsewhere.
+    problem.between = m > 1 ? target_costs(input) : Eigen::MatrixXd::Zero(Eigen::Index(m), Eigen::Index(m));
+    problem.between = (problem.between.array() - input.sensor_range_m).max(0.0).matrix();
+
+    const std::lock_guard<std::mutex> lock(mutex_);
+    const Tours tours = plan_tours(problem, previous_tours(input, problem));
+    for (std::size_t i = 0; i < n; ++i) {
+      auto& kept = memory_[input.robots[i].team_index];
+      kept.clear();
+      for (int t : tours[i]) kept.push_back(input.targets[std::size_t(t)].goal_m);
+      if (!tours[i].empty()) out[i] = tours[i].front();
+    }
+    return out;
+  }
+
+ private:
+  // The previous round's tours in this round's targets: each remembered goal becomes a target
+  // within kSameTarget (frontiers shrink and their goals move as they are seen), nearest pairs
+  // first, so a target that is still there keeps its place; goals with none (explored meanwhile)
+  // are dropped.
+  Tours previous_tours(const AssignmentInput& input, const TourProblem& problem) const {
+    struct Pair {
+      double distance;
+      std::size_t robot, slot, target;
+    };
+    std::vector<Pair> pairs;
+    std::vector<std::vector<int>> slots(input.robots.size());
+    for (std::size_t i = 0; i < input.robots.size(); ++i) {
+      const auto it = memory_.find(input.robots[i].team_index);
+      if (it == memory_.end()) continue;
+      slots[i].assign(it->second.size(), -1);
+      for (std::size_t k = 0; k < it->second.size(); ++k) {
+        for (std::size_t t = 0; t < input.targets.size(); ++t) {
+          const double d = (input.targets[t].goal_m - it->second[k]).norm();
+          if (d <= kSameTarget && std::isfinite(problem.start_cost(Eigen::Index(i), Eigen::Index(t)))) pairs.push_back({d, i, k, t});
+        }
+      }
+    }
+    std::stable_sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) { return a.distance < b.distance; });
+    std::vector<char> used(input.targets.size(), false);
+    for (const Pair& p : pairs) {
+      if (used[p.target] || slots[p.robot][p.slot] >= 0) continue;
+      used[p.target] = true;
+      slots[p.robot][p.slot] = int(p.target);
+    }
+    Tours tours(input.robots.size());
+    for (std::size_t i = 0; i < slots.size(); ++i)
+      for (int t : slots[i])
+        if (t >= 0) tours[i].push_back(t);
+    return tours;
+  }
+
+  static constexpr double kSameTarget = 1.0;  // metres
+  // Per robot (team index): the goals of its last tour, in the frame of the map it was planned on.
+  // The strategy's only state; assign() is const for its callers, so it is mutable and guarded.
+  mutable std::map<int, std::vector<Eigen::Vector2d>> memory_;
+  mutable std::mutex mutex_;
+};
+
+}  // namespace
+
+std::unique_ptr<CoordinationStrategy> make_tour_strategy(const StrategyOptions&) { return std::make_unique<Tour>(); }
+
+}  // namespace fleetmap::exploration
