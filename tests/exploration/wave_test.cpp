@@ -84,7 +84,7 @@ TEST_P(WaveMatchesReference, OnRandomGridsWithSeveralSources) {
     WaveOptions o;
     o.eight_connected = c.eight;
     o.occupancy_weight = c.weight;
-    const WaveField f = compute_wave({g.w, g.h, g.passable, g.occupancy}, sources, o);
+    const WaveField f = compute_wave({g.w, g.h, g.passable, g.occupancy, {}}, sources, o);
     // Exact, in whole units of 1/70 cell.
     const auto units = reference(g, sources, c.eight, c.weight, 70.0, 99.0, true);
     // Against the true costs: a diagonal of 99/70 is within 5e-5 of sqrt(2); a weighted step is rounded
@@ -114,7 +114,7 @@ TEST(Wave, PathsDescendTheWaveAndHaveItsLength) {
     for (const bool eight : {false, true}) {
       WaveOptions o;
       o.eight_connected = eight;
-      const WaveField f = compute_wave({g.w, g.h, g.passable, {}}, std::vector<Cell>{source}, o);
+      const WaveField f = compute_wave({g.w, g.h, g.passable, {}, {}}, std::vector<Cell>{source}, o);
       for (int i = 0; i < g.w * g.h; i += 7) {
         const Cell target{i % g.w, i / g.w};
         const auto path = f.path_to(target);
@@ -143,7 +143,7 @@ TEST(Wave, PathsDescendTheWaveAndHaveItsLength) {
 TEST(Wave, FourConnectedIsSeedThreeCounting) {
   // The wave-algorithm paper, Fig. 1: the robot's cell is 0, its neighbours 1, theirs 2, ...
   std::vector<std::uint8_t> open(5 * 5, 1);
-  const WaveField f = compute_wave({5, 5, open, {}}, std::vector<Cell>{{2, 2}}, WaveOptions{false, 0.0});
+  const WaveField f = compute_wave({5, 5, open, {}, {}}, std::vector<Cell>{{2, 2}}, WaveOptions{false, 0.0});
   EXPECT_EQ(f.cost({2, 2}), 0.0f);
   EXPECT_EQ(f.cost({3, 2}), 1.0f);
   EXPECT_EQ(f.cost({3, 3}), 2.0f);
@@ -156,7 +156,7 @@ TEST(Wave, NoCornerCutting) {
   //   . #
   //   # .
   std::vector<std::uint8_t> p = {1, 0, 0, 1};
-  const WaveField f = compute_wave({2, 2, p, {}}, std::vector<Cell>{{0, 0}}, WaveOptions{true, 0.0});
+  const WaveField f = compute_wave({2, 2, p, {}, {}}, std::vector<Cell>{{0, 0}}, WaveOptions{true, 0.0});
   EXPECT_FALSE(f.reached({1, 1}));
 }
 
