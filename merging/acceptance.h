@@ -50,6 +50,10 @@ struct AlignmentQuality {
   // RMS distance to the other map's walls of the walls that land within contradiction_distance of
   // them (matched, or near: a cell or two off), in cells.
   double residual_rms = 0.0;
+  // Matched walls (4 x 4 blocks of either map, clutter left out) farther than 2 cells from the two
+  // straight lines that hold the most of them: 0 when all the common walls are one corner (two
+  // walls), which fits any other corner of a bare room as well.
+  int beyond_corner = 0;
   double overlap_radius = 0.0;  // RMS distance of the matched walls from their centroid, in cells
   Eigen::Vector2d overlap_centre = Eigen::Vector2d::Zero();  // that centroid, in a's cells
 };
