@@ -258,7 +258,8 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
     }
   }
   const double support_factor = support(result.evidence * result.distinctiveness);
-  const double corner_factor = clamp01(best_q.beyond_corner / co.full_beyond_corner);
+  const double corner_factor =
+      clamp01((best_q.beyond_corner - co.zero_beyond_corner) / (co.full_beyond_corner - co.zero_beyond_corner));
   result.confidence = agree_factor * acceptance_factor * support_factor * corner_factor;
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {
