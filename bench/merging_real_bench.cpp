@@ -679,7 +679,7 @@ int main(int argc, char** argv) {
       r.fleetmap = run_fleetmap(p, options);
       if (args.peer) r.peer = run_peer(p);
       records.push_back(r);
-      if (diag && p.truth)
+      if (diag.is_open() && p.truth)
         diag << fmt::format("{},{},{:.2f},{},{},{:.3f},{}\n", i, p.set, p.overlap, int(r.fleetmap.merged),
                             int(r.fleetmap.found), r.fleetmap.confidence, diagnose(p, options)) << std::flush;
       if (csv) {
