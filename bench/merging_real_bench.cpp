@@ -84,7 +84,7 @@ struct Args {
 
 [[noreturn]] void usage(const std::string& problem) {
   std::cerr << "fleetmap_bench_merging_real: " << problem << "\n"
-            << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
+            << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
             << "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
             << "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S]\n";
   std::exit(2);
