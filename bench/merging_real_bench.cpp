@@ -66,6 +66,7 @@ struct Args {
   fs::path plans = fs::path(FLEETMAP_SOURCE_DIR) / ".." / "shared" / "datasets" / "houseexpo";
   fs::path cache = fs::path(FLEETMAP_BINARY_DIR) / "merging_real_cache";
   std::string csv;
+  std::string diagnose;      // writes, per pair with a truth, where the right answer drops out of the search
   fs::path dump;             // writes each pair's maps here (a_<k>.png, b_<k>.png) when given
   std::vector<int> only;     // run only these pair numbers (as in the CSV)
   int pairs = 40;            // 300 x 300 pairs per overlap
@@ -83,7 +84,7 @@ struct Args {
 
 [[noreturn]] void usage(const std::string& problem) {
   std::cerr << "fleetmap_bench_merging_real: " << problem << "\n"
-            << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
+            << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
             << "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
             << "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S]\n";
   std::exit(2);
@@ -108,6 +109,7 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--cache") a.cache = value();
     else if (k == "--csv") a.csv = value();
     else if (k == "--dump") a.dump = value();
+    else if (k == "--diagnose") a.diagnose = value();
     else if (k == "--only") {
       const std::string list = value();
       for (std::size_t p = 0; p <= list.size();) {
@@ -431,10 +433,10 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
     o.found = o.error < kSuccessCells;
   }
   const merging::Acceptance acc = merging::acceptance_index(p.a, p.b, r.transform);
-  o.detail = fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};{}",
+  o.detail = fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};{}",
                          r.method, r.quality.agreement, r.acceptance, r.quality.constraint, r.distinctiveness,
                          r.quality.matched, r.quality.contradicted, r.quality.tested, r.quality.overlap_radius,
-                         acc.common(), acc.disagree, r.quality.residual_rms, r.reason);
+                         acc.common(), acc.disagree, r.quality.residual_rms, r.quality.beyond_corner, r.reason);
   return o;
 }
 
@@ -453,6 +455,50 @@ Outcome run_peer(const Pair& p) {
   }
   o.detail = fmt::format("matches={};inliers={}", r.matches, r.inliers);
   return o;
+}
+
+// Where the right answer drops out: the spectral rotations' error, the rank of the first right
+// candidate (within 3 degrees, and 3 cells of the search level at b's known cells) among the
+// overlap search's candidates, among the sweep's, and whether refining any candidate reaches the
+// truth (within 2 cells).
+std::string diagnose(const Pair& p, const merging::MergeOptions& options) {
+  const merging::KnownPart ka(p.a), kb(p.b);
+  const merging::PreparedGrid pa(ka.grid(), options.prepare), pb(kb.grid(), options.prepare);
+  const core::Transform2 truth = p.reference.value_or(*p.truth);
+  const Eigen::Vector2d oa = ka.origin().cast<double>(), ob = kb.origin().cast<double>();
+  const core::Transform2 cut(truth.translation() + truth.rotation_matrix() * ob - oa, truth.rotation());
+  double rot_err = 180.0;
+  for (double r : merging::spectral_rotation_candidates(pa, pb, options.overlap))
+    rot_err = std::min(rot_err, std::abs(core::rad2deg(core::normalize_angle(r - cut.rotation()))));
+  const auto first_right = [&](const std::vector<merging::Hypothesis>& hs, int& refined_rank) {
+    int rank = -1;
+    refined_rank = -1;
+    for (std::size_t i = 0; i < hs.size(); ++i) {
+      const auto& h = hs[i];
+      const int factor = 1 << h.level;
+      const double d = merging::mean_displacement(h.b_to_a, cut, kb.grid());
+      const double dth = std::abs(core::rad2deg(core::normalize_angle(h.b_to_a.rotation() - cut.rotation())));
+      if (rank < 0 && dth < 3.0 && d < 3.0 * factor) rank = int(i);
+      if (refined_rank < 0 && dth < 6.0 && d < 8.0 * factor) {
+        const auto f = merging::refine_alignment(pa, pb, h.b_to_a, h.level, options.refinement);
+        if (merging::mean_displacement(f.b_to_a, cut, kb.grid()) < kSuccessCells) refined_rank = int(i);
+      }
+    }
+    return rank;
+  };
+  int ref_spec = -1, ref_sweep = -1;
+  const auto spec = merging::overlap_hypotheses(pa, pb, options.overlap);
+  const int r_spec = first_right(spec, ref_spec);
+  merging::OverlapSearchOptions sw = options.overlap;
+  sw.sweep_step_deg = options.sweep_step_deg;
+  sw.search_cells = options.sweep_search_cells;
+  const auto sweep = merging::overlap_hypotheses(pa, pb, sw);
+  const int r_sweep = first_right(sweep, ref_sweep);
+  // The right answer's own quality, refined from the truth.
+  const auto f = merging::refine_alignment(pa, pb, cut, 2, options.refinement);
+  const auto q = merging::evaluate_alignment(pa, pb, f.b_to_a, options.quality);
+  return fmt::format("{:.2f},{},{},{},{},{},{},{:.1f},{},{},{:.2f}", rot_err, spec.size(), r_spec, ref_spec, sweep.size(),
+                     r_sweep, ref_sweep, q.score, q.matched, q.contradicted, q.residual_rms);
 }
 
 bool success(const Outcome& o) { return o.merged && o.found; }
@@ -607,6 +653,12 @@ int main(int argc, char** argv) {
     }
 
     std::vector<Record> records;
+    std::ofstream diag;
+    if (!args.diagnose.empty()) {
+      diag.open(args.diagnose);
+      diag << "pair,set,overlap,merged,found,confidence,rot_err_deg,spectral_candidates,first_right,first_refines_right,"
+              "sweep_candidates,sweep_first_right,sweep_first_refines_right,truth_score,truth_matched,truth_contra,truth_rms\n";
+    }
     std::ofstream csv;
     if (!args.csv.empty()) {
       csv.open(args.csv);
@@ -627,6 +679,9 @@ int main(int argc, char** argv) {
       r.fleetmap = run_fleetmap(p, options);
       if (args.peer) r.peer = run_peer(p);
       records.push_back(r);
+      if (diag.is_open() && p.truth)
+        diag << fmt::format("{},{},{:.2f},{},{},{:.3f},{}\n", i, p.set, p.overlap, int(r.fleetmap.merged),
+                            int(r.fleetmap.found), r.fleetmap.confidence, diagnose(p, options)) << std::flush;
       if (csv) {
         for (const auto& [name, o] : {std::pair<std::string, const Outcome*>{"fleetmap", &r.fleetmap}, {"peer", &r.peer}}) {
           if (name == "peer" && !args.peer) continue;

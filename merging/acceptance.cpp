@@ -1,7 +1,9 @@
 #include "merging/acceptance.h"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <unordered_set>
 
 namespace fleetmap::merging {
@@ -39,6 +41,7 @@ struct Tally {
   std::unordered_set<std::int64_t> blocks;   // 4 x 4 blocks of the source map already counted
   std::vector<Eigen::Vector2d> positions;    // matched walls, in a's frame
   std::vector<Eigen::Matrix2d> structures;   // their local structure, in a's frame
+  std::vector<Eigen::Vector2d> structure_positions;  // the matched walls that are not clutter
 };
 
 // Counts `from`'s wall cells moved into `to` by t.
@@ -70,6 +73,7 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
                                (from_b ? std::int64_t(1) << 62 : 0);
       if (!out.blocks.insert(key).second) continue;
       out.positions.push_back(to_a.apply(p.cast<double>()));
+      if (!w.clutter) out.structure_positions.push_back(out.positions.back());
       out.structures.push_back(ra * w.structure.cast<double>() * ra.transpose());
     } else if (!w.clutter && d >= options.contradiction_distance && target.is_free(x, y)) {
       ++out.contradicted;
@@ -81,6 +85,47 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
     if (x < 0 || y < 0 || x >= target.width() || y >= target.height() || !target.is_free(x, y)) continue;
     if (target.distance_at(p.x(), p.y(), 1e4f) >= options.contradiction_distance) ++out.contradicted;
   }
+}
+
+// The points farther than `tolerance` from the `lines` straight lines that hold the most points,
+// taken one after another: a Hough transform (1 degree, 1 cell) picks each line, a total least
+// squares fit to the points within 2 tolerances of it places it.
+int beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double tolerance) {
+  constexpr int kAngles = 180;
+  for (int l = 0; l < lines && points.size() >= 2; ++l) {
+    Eigen::Vector2d lo = points.front(), hi = points.front();
+    for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    const Eigen::Vector2d mid = 0.5 * (lo + hi);
+    const int rho_bins = 2 * int(std::ceil((hi - lo).norm() / 2.0)) + 3, offset = rho_bins / 2;
+    std::vector<int> votes(std::size_t(kAngles * rho_bins), 0);
+    int best = 0, best_votes = -1;
+    for (int k = 0; k < kAngles; ++k) {
+      const double th = std::numbers::pi * k / kAngles;
+      const Eigen::Vector2d n(std::cos(th), std::sin(th));
+      for (const auto& p : points) {
+        const int r = int(std::lround(n.dot(p - mid))) + offset;
+        const std::size_t i = std::size_t(k * rho_bins + std::clamp(r, 0, rho_bins - 1));
+        if (++votes[i] > best_votes) best_votes = votes[i], best = int(i);
+      }
+    }
+    const double th = std::numbers::pi * (best / rho_bins) / kAngles;
+    Eigen::Vector2d n(std::cos(th), std::sin(th));
+    Eigen::Vector2d on = mid + double(best % rho_bins - offset) * n;
+    // Refit to the points near the voted line, then drop the points on it.
+    Eigen::Vector2d c = Eigen::Vector2d::Zero();
+    std::vector<const Eigen::Vector2d*> near;
+    for (const auto& p : points)
+      if (std::abs(n.dot(p - on)) <= 2.0 * tolerance) near.push_back(&p), c += p;
+    if (near.size() >= 2) {
+      c /= double(near.size());
+      Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+      for (const auto* p : near) cov += (*p - c) * (*p - c).transpose();
+      n = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvectors().col(0);
+      on = c;
+    }
+    std::erase_if(points, [&](const Eigen::Vector2d& p) { return std::abs(n.dot(p - on)) <= tolerance; });
+  }
+  return int(points.size());
 }
 
 }  // namespace
@@ -97,6 +142,7 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   q.contradicted = t.contradicted;
   q.score = t.matched - options.contradiction_weight * t.contradicted;
   q.agreement = t.matched + t.contradicted > 0 ? double(t.matched) / double(t.matched + t.contradicted) : 0.0;
+  q.beyond_corner = beyond_lines(t.structure_positions, 2, 2.0);
   if (t.positions.size() < 3) return q;
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   for (const auto& p : t.positions) c += p;

@@ -235,7 +235,8 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   // the answer lays on a's known cells, which is all the evidence there is: rows of identical
   // rooms, or a symmetric room, fit elsewhere nearly as well, and the rest of b, lying on a's
   // unknown, cannot tell them apart.
-  if (options.probe_symmetries && agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence) {
+  if (options.probe_symmetries && best_q.beyond_corner > 0 &&
+      agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence) {
     std::tie(result.distinctiveness, result.alternative) =
         distinctiveness(other_placements(a, b, result.transform, options, others), best_q, result.transform);
     const mapping::OccupancyGrid common = common_part(a.grid(), b.grid(), result.transform, 3);
@@ -257,13 +258,16 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
     }
   }
   const double support_factor = support(result.evidence * result.distinctiveness);
-  result.confidence = agree_factor * acceptance_factor * support_factor;
+  const double corner_factor =
+      clamp01((best_q.beyond_corner - co.zero_beyond_corner) / (co.full_beyond_corner - co.zero_beyond_corner));
+  result.confidence = agree_factor * acceptance_factor * support_factor * corner_factor;
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {
     // The weakest factor says why, in words.
     std::string why;
     if (agree_factor < 0.5) why = "the walls of one map cross the other's free space";
     else if (acceptance_factor < 0.5) why = "the maps disagree on the cells they share (free in one, occupied in the other)";
+    else if (corner_factor < 0.5) why = "the common walls are one corner (two straight walls), which fits any other corner of a bare room as well";
     else if (result.distinctiveness < 0.5) why = "another placement fits nearly as well (repeated or symmetric places)";
     else if (best_q.constraint < co.half_evidence) why = "the common walls leave the placement free to slide or turn (a bare room, a corridor, one wall)";
     else why = "too little of the common walls fits better than chance";

@@ -47,6 +47,11 @@ namespace fleetmap::merging {
 //   A different answer is plausible when its contradictions are what the best answer's own rate
 //   (at least min_contradiction_rate) predicts: with z = (c - rate n) / sqrt(rate n + 1) over its n
 //   tested walls, it counts fully for z <= 2 and not at all for z >= 4.
+// - corner factor: the matched walls off the two straight lines that hold most of them
+//   (AlignmentQuality::beyond_corner), 0 up to zero_beyond_corner, 1 from full_beyond_corner on
+//   (4 x 4 blocks of wall, counted in both maps: a door jamb seen by both is two): two maps whose
+//   common walls are one corner of a bare room fit any other corner as well, and nothing in
+//   either map can tell (seen on a real plan: two corners of a large hall, turned a quarter).
 // half_evidence: the evidence (times distinctiveness) at which the last factor is 0.5, set on the
 // development benchmark of robot-built maps (bench/merging_real_bench.cpp) so that the default
 // min_confidence accepts no wrong answer there; bench/README.md shows the reliability table.
@@ -55,7 +60,9 @@ struct ConfidenceOptions {
   double full_agreement = 0.95;
   double zero_acceptance = 0.93;
   double full_acceptance = 0.98;
-  double half_evidence = 22.0;
+  double half_evidence = 13.0;
+  double zero_beyond_corner = 1.0;
+  double full_beyond_corner = 4.0;
   double distinct_distance = 4.0;
   double distinct_rotation_deg = 2.0;
   double min_contradiction_rate = 0.005;

@@ -12,7 +12,7 @@ struct RefineOptions {
   double converged_cells = 0.01; // stop when a step moves points by less than this (cells of the level)
   double converged_radius = 100; // ... counting a rotation step at this distance from the centre
   double inlier_distance = 2.5;  // cells of the level: walls farther from the other map's walls are left out
-  double contradiction_weight = 3.0;  // LevelFit::score = inliers - weight * outliers
+  double contradiction_weight = 10.0;  // LevelFit::score = inliers - weight * outliers
 };
 
 struct LevelFit {
