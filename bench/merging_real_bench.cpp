@@ -1,6 +1,7 @@
 // Merging maps that robots built: fleetmap's `merge` beside the feature-based peer of the ROS
 // `multirobot_map_merge` package, on the same pairs, as a program that prints markdown for
-// bench/README.md (and, with --csv, one row per pair and method).
+// bench/README.md (and, with --csv, one row per pair and method). Long on purpose: building the
+// robot maps, cutting the pairs, the peer and the diagnosis belong to this one measurement.
 //
 // The maps: one simulated robot explores each of the floor plans of HouseExpo (Li et al. 2019,
 // ../shared/datasets/houseexpo) with visible odometry noise, a noisy laser of 180 to 720 beams

@@ -1,3 +1,7 @@
+// One file, over 500 lines, on purpose: a robot's task cycle (check progress, detour, give way,
+// retry failed approaches, assign in groups) shares the RobotState bookkeeping and the wave set-up,
+// and reads best in one place; the pieces that stand alone (frontiers, targets, waves, strategies,
+// tours) have their own files.
 #include "exploration/team_explorer.h"
 
 #include <algorithm>

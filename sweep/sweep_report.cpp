@@ -1,3 +1,5 @@
+// One file, over 500 lines, on purpose: summary.md, summary.csv, the paired comparison and the
+// plots are read from the same grouped records and must agree cell for cell.
 #include "sweep/sweep_report.h"
 
 #include <algorithm>
