@@ -114,42 +114,60 @@ std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGr
 
 }  // namespace
 
-const std::vector<MergeMethod>& merge_methods() {
-  static const std::vector<MergeMethod> kMethods = {
-      {"overlap",
-       "grid overlap search (wave-algorithm paper, Birk & Carpin 2006): Hough-spectrum rotations (Carpin 2008), FFT "
-       "correlation of walls for translations, coarse to fine; a rotation sweep when the spectra find nothing",
-       {propose_overlap, propose_overlap_sweep}},
-      {"features", "ORB keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
-       {propose_features}},
-  };
-  return kMethods;
-}
-
 namespace {
 
-// auto's order: (method, pass) lists, each ending with a decision.
-const std::vector<std::vector<std::pair<std::string, std::size_t>>>& auto_steps() {
-  static const std::vector<std::vector<std::pair<std::string, std::size_t>>> kSteps = {
-      {{"overlap", 0}},
-      {{"features", 0}, {"overlap", 1}},
-  };
-  return kSteps;
+constexpr const char* kAutoHelp =
+    "overlap's spectral pass; if not confident, the other methods and overlap's sweep too; the best wins";
+
+void add_builtin_methods(core::Registry<MergePasses>& registry) {
+  registry.add("overlap",
+               "grid overlap search (wave-algorithm paper, Birk & Carpin 2006): Hough-spectrum rotations (Carpin "
+               "2008), FFT correlation of walls for translations, coarse to fine; a rotation sweep when the spectra "
+               "find nothing",
+               {propose_overlap, propose_overlap_sweep});
+  registry.add("features", "ORB keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
+               {propose_features});
+}
+
+// The (method, pass) lists `auto` runs, each ending with a decision: the first method's first pass,
+// then every other method's passes, then the first method's remaining passes.
+std::vector<std::vector<const ProposeFn*>> auto_steps(const core::Registry<MergePasses>& registry) {
+  const auto names = registry.names();
+  const MergePasses& first = registry.get(names.front()).make;
+  std::vector<std::vector<const ProposeFn*>> steps(2);
+  steps[0].push_back(&first.front());
+  for (std::size_t i = 1; i < names.size(); ++i) {
+    for (const auto& pass : registry.get(names[i]).make) steps[1].push_back(&pass);
+  }
+  for (std::size_t p = 1; p < first.size(); ++p) steps[1].push_back(&first[p]);
+  if (steps[1].empty()) steps.pop_back();
+  return steps;
 }
 
 }  // namespace
 
+core::Registry<MergePasses>& merge_method_registry() {
+  static core::Registry<MergePasses> registry("merge method");
+  static const bool built_in = (add_builtin_methods(registry), true);
+  (void)built_in;
+  return registry;
+}
+
+void register_merge_method(std::string name, std::string help, MergePasses passes) {
+  if (name == "auto") throw Error("register merge method: 'auto' is the name of all methods in turn");
+  if (passes.empty() || std::any_of(passes.begin(), passes.end(), [](const ProposeFn& f) { return !f; })) {
+    throw Error("register merge method: '" + name + "' needs at least one pass, and no empty one");
+  }
+  merge_method_registry().add(std::move(name), std::move(help), std::move(passes));
+}
+
 std::vector<std::string> merge_method_names() {
   std::vector<std::string> names = {"auto"};
-  for (const auto& m : merge_methods()) names.push_back(m.name);
+  for (auto& n : merge_method_registry().names()) names.push_back(std::move(n));
   return names;
 }
 
-std::string merge_method_help() {
-  std::string s = "  auto: overlap's spectral pass; if not confident, features and overlap's sweep too; the best wins\n";
-  for (const auto& m : merge_methods()) s += "  " + m.name + ": " + m.help + "\n";
-  return s;
-}
+std::string merge_method_help() { return std::string("  auto: ") + kAutoHelp + "\n" + merge_method_registry().help(); }
 
 void check_merge_method(const std::string& name) {
   const auto names = merge_method_names();
@@ -289,29 +307,19 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
     return r;
   }
   core::Random random(options.seed);
-  // Steps: lists of (method, pass). Candidates accumulate; each step ends with a decision.
-  const auto method_named = [](const std::string& name) -> const MergeMethod* {
-    for (const auto& m : merge_methods()) {
-      if (m.name == name) return &m;
-    }
-    return nullptr;
-  };
-  std::vector<std::vector<std::pair<const MergeMethod*, std::size_t>>> steps;
+  // Steps: lists of passes. Candidates accumulate; each step ends with a decision.
+  const auto& registry = merge_method_registry();
+  std::vector<std::vector<const ProposeFn*>> steps;
   if (options.method == "auto") {
-    // overlap's spectral pass is fast and usually enough; then the other passes at once.
-    for (const auto& step : auto_steps()) {
-      steps.emplace_back();
-      for (const auto& [name, pass] : step) steps.back().push_back({method_named(name), pass});
-    }
+    steps = auto_steps(registry);
   } else {
-    const MergeMethod* m = method_named(options.method);
-    for (std::size_t p = 0; p < m->passes.size(); ++p) steps.push_back({{m, p}});
+    for (const auto& pass : registry.get(options.method).make) steps.push_back({&pass});
   }
   std::vector<Hypothesis> candidates;
   MergeResult best;
   for (const auto& step : steps) {
-    for (const auto& [method, pass] : step) {
-      auto more = method->passes[pass](a, b, options, random);
+    for (const ProposeFn* pass : step) {
+      auto more = (*pass)(a, b, options, random);
       candidates.insert(candidates.end(), more.begin(), more.end());
     }
     MergeResult r = decide(a, b, candidates, options);

@@ -4,16 +4,19 @@
 //
 // Methods propose candidate transforms; one common pipeline then refines every candidate
 // (refine.h), scores it by how the two maps' walls fit (acceptance.h) and decides. Methods are
-// chosen by name through the explicit table merge_methods(); "auto" tries them in order.
+// members of an open registry (core/registry.h): the built-in `overlap` and `features`, and any a
+// program adds with register_merge_method; "auto" runs them all in order.
 //
 // Transforms map b's cell coordinates (x = column, y = row from the bottom, cell centres at
 // integers) into a's: a = R(theta) b + t. Both grids are taken to have the same cell size.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "core/random.h"
+#include "core/registry.h"
 #include "core/range.h"
 #include "core/transform2.h"
 #include "mapping/occupancy_grid.h"
@@ -109,18 +112,18 @@ struct MergeResult {
 };
 
 // One pass of a method: proposes candidates for the common pipeline.
-using ProposeFn = std::vector<Hypothesis> (*)(const PreparedGrid& a, const PreparedGrid& b, const MergeOptions& options,
-                                              core::Random& random);
-
+using ProposeFn = std::function<std::vector<Hypothesis>(const PreparedGrid& a, const PreparedGrid& b,
+                                                        const MergeOptions& options, core::Random& random)>;
 // A method runs its passes in order, each adding candidates, until the decision is to merge.
-struct MergeMethod {
-  std::string name;
-  std::string help;
-  std::vector<ProposeFn> passes;
-};
+using MergePasses = std::vector<ProposeFn>;
 
-// The registry: every method by name. `auto` runs overlap's first pass, then everything else.
-const std::vector<MergeMethod>& merge_methods();
+// Every merge method by name, the built-in ones first (overlap, features).
+core::Registry<MergePasses>& merge_method_registry();
+// Adds a method that `merge --method`, scenarios (merging.method) and `auto` then use: auto runs the
+// first method's first pass (overlap's spectral search), and when that is not confident every other
+// method's passes in the order registered, then the first method's remaining passes. Throws Error
+// for an empty or taken name (including "auto") or no passes.
+void register_merge_method(std::string name, std::string help, MergePasses passes);
 // "auto" and the registry's names, for --help and errors.
 std::vector<std::string> merge_method_names();
 // One line per name: "  name: help".

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <optional>
 #include <tuple>
 
 #include "core/angle.h"
@@ -182,16 +184,75 @@ TEST(AlignMaps, SmallExactOverlapIsMergedAccurately) {
   EXPECT_LT(e.translation_cells, kMaxTranslationCells);
 }
 
-TEST(MergeRegistry, NamesAutoFirstThenTheTable) {
+TEST(MergeRegistry, NamesAutoFirstThenTheBuiltInMethods) {
   const auto names = merge_method_names();
   ASSERT_GE(names.size(), 3u);
   EXPECT_EQ(names[0], "auto");
   EXPECT_EQ(names[1], "overlap");
   EXPECT_EQ(names[2], "features");
-  for (const auto& m : merge_methods()) {
-    EXPECT_FALSE(m.passes.empty()) << m.name;
-    EXPECT_NE(merge_method_help().find(m.name + ":"), std::string::npos);
+  for (const auto& name : names) {
+    EXPECT_NE(merge_method_help().find("  " + name + ": "), std::string::npos) << name;
+    if (name != "auto") {
+      EXPECT_FALSE(merge_method_registry().get(name).make.empty()) << name;
+    }
   }
+}
+
+// A program's own method: proposes the true transform, spoiled by a cell and a degree, while a
+// test sets it (and nothing otherwise, so that `auto` in the other tests is unchanged).
+std::optional<core::Transform2> oracle_answer;
+int oracle_calls = 0;
+
+std::vector<Hypothesis> propose_oracle(const PreparedGrid&, const PreparedGrid&, const MergeOptions&, core::Random&) {
+  ++oracle_calls;
+  if (!oracle_answer) return {};
+  const core::Transform2 spoiled(oracle_answer->translation() + Eigen::Vector2d(1.0, -1.0),
+                                 oracle_answer->rotation() + core::deg2rad(1.0));
+  return {Hypothesis{spoiled, 1.0, 0, "oracle"}};
+}
+
+TEST(MergeRegistry, AProgramsOwnMethodIsReachedByNameAndRefinedByTheCommonPipeline) {
+  if (!merge_method_registry().contains("oracle")) {
+    register_merge_method("oracle", "the true transform, a cell and a degree off (a test's own)", {propose_oracle});
+  }
+  const auto names = merge_method_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "oracle"), names.end());
+  EXPECT_NE(merge_method_help().find("  oracle: the true transform"), std::string::npos);
+
+  core::Random world_random(1);
+  SyntheticWorldOptions wo;
+  wo.width = wo.height = 700;
+  const SyntheticWorld world(wo, world_random);
+  CropPairOptions o;
+  o.width = o.height = 200;
+  o.overlap = 0.5;
+  core::Random random(11);
+  const CropPair pair = make_world_pair(world, o, random);
+  const PreparedGrid a(pair.a), b(pair.b);
+  MergeOptions options;
+  options.method = "oracle";
+  oracle_answer = pair.b_to_a;
+  oracle_calls = 0;
+  const MergeResult r = align_prepared(a, b, options);
+  oracle_answer.reset();
+  EXPECT_EQ(oracle_calls, 1);
+  ASSERT_TRUE(r.merged) << r.reason;
+  EXPECT_EQ(r.method, "oracle");
+  const TransformError e = transform_error(r.transform, pair.b_to_a, pair.overlap_centre_b);
+  EXPECT_LT(e.rotation_deg, kMaxRotationDeg);
+  EXPECT_LT(e.translation_cells, kMaxTranslationCells);
+  // Without its answer the method proposes nothing, and the result says so.
+  const MergeResult none = align_prepared(a, b, options);
+  EXPECT_FALSE(none.merged);
+  EXPECT_EQ(none.candidates, 0);
+}
+
+TEST(MergeRegistry, RegisteringAutoATakenNameOrNoPassesIsAnError) {
+  EXPECT_THROW(register_merge_method("auto", "x", {propose_oracle}), Error);
+  EXPECT_THROW(register_merge_method("overlap", "x", {propose_oracle}), Error);
+  EXPECT_THROW(register_merge_method("nothing", "x", {}), Error);
+  EXPECT_THROW(register_merge_method("empty-pass", "x", {ProposeFn{}}), Error);
+  EXPECT_FALSE(merge_method_registry().contains("nothing"));
 }
 
 TEST(MergeRegistry, UnknownMethodIsAnInputErrorNamingTheValidOnes) {
