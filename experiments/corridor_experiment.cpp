@@ -3,7 +3,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <numbers>
 
@@ -15,7 +14,6 @@
 #include "io/yaml_reader.h"
 #include "localization/localizer.h"
 #include "mapping/map_quality.h"
-#include "mapping/range_scan.h"
 #include "merging/fusion.h"
 #include "merging/rendezvous.h"
 #include "sim/simulation.h"

@@ -4,8 +4,9 @@
 // The world: a rectangular corridor loop whose outer free extent is length x height (21.3 m x 17 m)
 // and whose corridors are long and featureless. One robot drives the loop's centre line laps times,
 // counter-clockwise; its odometry has a scale error, a turn bias and noise; a front laser
-// (SICK LMS200-like: 181 beams over 180 degrees, 8 m) reads the true walls. The same drive (odometry
-// and scans) is replayed through each localizer, and the map each one builds is measured: the
+// (SICK LMS200-like: 181 beams over 180 degrees, 8 m) reads the true walls. Each localizer drives
+// the same drive on sim::Simulation (a sim::WaypointDriver steering on the true pose; the same seed
+// gives the same odometry and scans), and the map each one builds is measured: the
 // length and height of the smallest rectangle around its walls (cv::minAreaRect), against the real
 // ones. The map is the robot's own grid at the estimated poses (odometry, scan-matching) or the
 // localizer's own map (rbpf: the best particle's).

@@ -1,4 +1,4 @@
-// sim/corridor_experiment.cpp and sim/corridor_output.cpp: León et al.'s corridor comparison and
+// experiments/corridor_experiment.cpp and experiments/corridor_output.cpp: León et al.'s corridor comparison and
 // merging by detection, on a small loop so that the test takes seconds.
 #include "experiments/corridor_experiment.h"
 
