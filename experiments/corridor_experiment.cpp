@@ -56,6 +56,7 @@ CorridorOptions parse_corridor_options(const std::string& text, const std::strin
     throw InputError(top.where("experiment") + ": expected 'leon_corridor', got '" + experiment + "'");
   }
   o.seed = std::uint64_t(top.integer("seed", 1, 0));
+  o.seeds = int(top.integer("seeds", o.seeds, 1, 1000));
   {
     auto w = top.map("world");
     o.length_m = w.number("length", o.length_m, 2.0, 1000.0);
@@ -281,9 +282,10 @@ Drive drive(const CorridorOptions& o, const mapping::OccupancyGrid& truth, const
 
 CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorProgress& progress) {
   for (const auto& m : o.methods) {
-    const std::vector<std::string> valid = {"ideal", "odometry", "scan-matching", "rbpf"};
+    const std::vector<std::string> valid = {"ideal", "odometry", "scan-matching", "fastslam-grid", "rbpf"};
     if (std::find(valid.begin(), valid.end(), m) == valid.end()) {
-      throw InputError("methods.list: '" + m + "' is not compared here (valid: ideal, odometry, scan-matching, rbpf)");
+      throw InputError("methods.list: '" + m +
+                       "' is not compared here (valid: ideal, odometry, scan-matching, fastslam-grid, rbpf)");
     }
   }
   if (o.laps.empty()) throw InputError("drive.laps: expected at least one lap count");
@@ -292,7 +294,8 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
   result.truth = corridor_world(o);
   result.real = {true, o.length_m, o.height_m};
   const auto& g = result.truth.geometry();
-  const int total_work = int(o.methods.size()) + (o.merge_study ? 2 + int(o.detection_errors_deg.size()) : 0);
+  if (o.seeds < 1) throw InputError("seeds: expected at least 1, got " + std::to_string(o.seeds));
+  const int total_work = o.seeds * int(o.methods.size()) + (o.merge_study ? 2 + int(o.detection_errors_deg.size()) : 0);
   int done = 0;
 
   // Every method drives the same drive: the same seed gives the same odometry and the same scans
@@ -310,25 +313,29 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
     w.reached_m = 0.3;
     return w;
   };
-  for (const auto& method : o.methods) {
-    const Drive r = drive(o, result.truth, {start, way(line, true, o.laps.back()), method, o.seed + 7, std::nullopt},
-                          std::make_shared<core::Random>(core::Random(o.seed).fork(1)), o.laps);
-    for (std::size_t i = 0; i < o.laps.size(); ++i) {
-      CorridorRun run;
-      run.method = method;
-      run.laps = o.laps[i];
-      run.map = r.maps[i];
-      run.dimensions = measure_loop(run.map);
-      run.length_error = std::abs(run.dimensions.length_m - o.length_m) / o.length_m;
-      run.height_error = std::abs(run.dimensions.height_m - o.height_m) / o.height_m;
-      const int end = r.lap_end[std::size_t(std::min<int>(o.laps[i], int(r.lap_end.size())) - 1)];
-      run.truth.assign(r.truth.begin(), r.truth.begin() + end + 1);
-      run.estimate.assign(r.estimate.begin(), r.estimate.begin() + end + 1);
-      run.final_position_error_m = (run.truth.back().position() - run.estimate.back().position()).norm();
-      run.seconds = r.seconds[i];
-      result.runs.push_back(std::move(run));
+  for (int k = 0; k < o.seeds; ++k) {
+    for (const auto& method : o.methods) {
+      const std::uint64_t seed = o.seed + std::uint64_t(k);
+      const Drive r = drive(o, result.truth, {start, way(line, true, o.laps.back()), method, seed + 7, std::nullopt},
+                            std::make_shared<core::Random>(core::Random(seed).fork(1)), o.laps);
+      for (std::size_t i = 0; i < o.laps.size(); ++i) {
+        CorridorRun run;
+        run.method = method;
+        run.seed = seed;
+        run.laps = o.laps[i];
+        run.map = r.maps[i];
+        run.dimensions = measure_loop(run.map);
+        run.length_error = std::abs(run.dimensions.length_m - o.length_m) / o.length_m;
+        run.height_error = std::abs(run.dimensions.height_m - o.height_m) / o.height_m;
+        const int end = r.lap_end[std::size_t(std::min<int>(o.laps[i], int(r.lap_end.size())) - 1)];
+        run.truth.assign(r.truth.begin(), r.truth.begin() + end + 1);
+        run.estimate.assign(r.estimate.begin(), r.estimate.begin() + end + 1);
+        run.final_position_error_m = (run.truth.back().position() - run.estimate.back().position()).norm();
+        run.seconds = r.seconds[i];
+        result.runs.push_back(std::move(run));
+      }
+      if (progress) progress(++done, total_work);
     }
-    if (progress) progress(++done, total_work);
   }
   if (!o.merge_study) return result;
 

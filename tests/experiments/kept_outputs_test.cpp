@@ -136,6 +136,7 @@ TEST(KeptOutputs, CorridorOfLeonEtAl) {
   o.rbpf_particles = 4;
   o.detection_errors_deg = {0.0, 5.0};
   o.seed = 3;
+  o.methods = {"ideal", "odometry", "scan-matching", "rbpf"};
   expect_kept("leon_corridor", corridor_text(run_corridor_experiment(o)));
 }
 
