@@ -3,7 +3,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <numbers>
 
@@ -15,10 +14,9 @@
 #include "io/yaml_reader.h"
 #include "localization/localizer.h"
 #include "mapping/map_quality.h"
-#include "mapping/range_scan.h"
 #include "merging/fusion.h"
 #include "merging/rendezvous.h"
-#include "sim/world.h"
+#include "sim/simulation.h"
 
 namespace fleetmap::experiments {
 
@@ -58,6 +56,7 @@ CorridorOptions parse_corridor_options(const std::string& text, const std::strin
     throw InputError(top.where("experiment") + ": expected 'leon_corridor', got '" + experiment + "'");
   }
   o.seed = std::uint64_t(top.integer("seed", 1, 0));
+  o.seeds = int(top.integer("seeds", o.seeds, 1, 1000));
   {
     auto w = top.map("world");
     o.length_m = w.number("length", o.length_m, 2.0, 1000.0);
@@ -188,57 +187,6 @@ std::vector<Eigen::Vector2d> centre_line(const CorridorOptions& o) {
   return {{c, c}, {o.length_m - c, c}, {o.length_m - c, o.height_m - c}, {c, o.height_m - c}};
 }
 
-// Steers the true pose toward waypoint `target`: turn in place when more than 30 degrees off.
-localization::Odometry steer(const core::Pose2& truth, const Eigen::Vector2d& target, const CorridorOptions& o) {
-  const Eigen::Vector2d d = target - truth.position();
-  const double err = core::normalize_angle(std::atan2(d.y(), d.x()) - truth.theta);
-  const double max_turn = core::deg2rad(45.0);  // deg/s
-  const double omega = std::clamp(err / o.period_s, -max_turn, max_turn);
-  const double v = std::abs(err) > core::deg2rad(30.0) ? 0.0 : std::min(o.speed_mps, d.norm() / o.period_s);
-  return {v, omega, o.period_s};
-}
-
-// One robot's recorded drive: true poses, what its odometry reported, what its laser read.
-struct Drive {
-  std::vector<core::Pose2> truth;                 // truth[0] = start, truth[k] after step k
-  std::vector<localization::Odometry> odometry;  // odometry[k-1]: step k
-  std::vector<localization::RangeScan> scans;     // scans[k] at truth[k]
-  std::vector<int> lap_end;                       // step at which lap i+1 ends
-};
-
-Drive record_drive(const sim::World& world, const CorridorOptions& o, const core::Pose2& start,
-                   const std::vector<Eigen::Vector2d>& waypoints, bool closed, int laps, core::Random& rng) {
-  Drive d;
-  d.truth.push_back(start);
-  d.scans.push_back(sim::read_ranges(world, start, o.laser, rng));
-  // A closed loop starts on its first waypoint and counts a lap each time it is back there.
-  std::size_t next = closed ? 1 : 0;
-  int lap = 0;
-  const int limit = 100000;
-  for (int k = 1; k <= limit; ++k) {
-    const core::Pose2& p = d.truth.back();
-    if ((waypoints[next] - p.position()).norm() < 0.3) {
-      if (!closed && next + 1 == waypoints.size()) break;
-      if (closed && next == 0) {
-        d.lap_end.push_back(k - 1);
-        if (++lap == laps) break;
-      }
-      next = (next + 1) % waypoints.size();
-    }
-    const localization::Odometry u = steer(p, waypoints[next], o);
-    d.truth.push_back(localization::integrate_motion(p, u));
-    d.truth.back().theta = core::normalize_angle(d.truth.back().theta);
-    localization::Odometry r = u;
-    r.v = u.v * (1.0 + o.odometry.scale_error) + rng.normal(0.0, o.odometry.speed_noise);
-    r.omega = u.omega + core::deg2rad(o.odometry.turn_bias_deg_per_m) * std::abs(u.v) +
-              rng.normal(0.0, core::deg2rad(o.odometry.turn_noise_deg));
-    d.odometry.push_back(r);
-    d.scans.push_back(sim::read_ranges(world, d.truth.back(), o.laser, rng));
-  }
-  if (d.lap_end.size() < std::size_t(closed ? laps : 1)) d.lap_end.push_back(int(d.odometry.size()));
-  return d;
-}
-
 localization::LocalizerContext context_for(const CorridorOptions& o, const core::Pose2& start, std::uint64_t seed) {
   localization::LocalizerContext c;
   c.initial_pose = start;
@@ -254,42 +202,90 @@ localization::LocalizerContext context_for(const CorridorOptions& o, const core:
   return c;
 }
 
-struct Replay {
-  std::vector<core::Pose2> estimate;
-  std::vector<mapping::OccupancyGrid> maps;  // at each requested step
-  double seconds = 0.0;
+// One robot's drive on the simulator, and what the experiment keeps of it.
+struct Drive {
+  std::vector<core::Pose2> truth;     // truth[0] = start, truth[k] after step k (world frame)
+  std::vector<core::Pose2> estimate;  // the localizer's, in its map frame
+  std::vector<int> lap_end;           // step at which lap i+1 ended
+  std::vector<mapping::OccupancyGrid> maps;  // the map at the end of each lap count asked for
+  std::vector<double> seconds;               // the localizer's time until then
 };
 
-// Replays a drive through a localizer, mapping at its estimate (or taking its own map), and keeps
-// the map at each step of `snapshots`.
-Replay replay(const Drive& d, const std::string& method, const localization::LocalizerContext& c,
-              const core::GridGeometry& geometry, const std::vector<int>& snapshots) {
-  Replay r;
-  auto loc = localization::make_localizer(method, c);
-  mapping::OccupancyGrid own(geometry);
-  const auto t0 = std::chrono::steady_clock::now();
-  for (std::size_t k = 0; k < d.scans.size(); ++k) {
-    if (k > 0) loc->predict(d.odometry[k - 1]);
-    loc->observe_truth(d.truth[k]);
-    loc->update_scan(d.scans[k], own);
-    mapping::insert_scan(own, loc->pose(), d.scans[k]);
-    r.estimate.push_back(loc->pose());
-    if (std::find(snapshots.begin(), snapshots.end(), int(k)) != snapshots.end()) {
-      auto mine = loc->map_estimate();
-      r.maps.push_back(mine ? std::move(*mine) : own);
+struct DriveSpec {
+  core::Pose2 start;
+  sim::WaypointDrive way;
+  std::string method;      // a registered localizer
+  std::uint64_t seed = 0;  // the localizer's
+  // Maps in its own frame (its start at the origin) on this grid; none: the world's frame and grid.
+  std::optional<core::GridGeometry> own_frame;
+};
+
+// Drives one robot along its waypoints on the simulator: a line follower on the true pose, its
+// odometry misreported (scale error, turn bias and noise), its odometry and laser noise drawn from
+// `rng` (one stream for the whole drive, which drives may share one after the other), localized by
+// `spec.method` and mapping at its estimate (or taking the localizer's own map). The map is kept at
+// the end of each lap count of `laps` (sorted); a drive that ends early keeps its last map for the rest.
+Drive drive(const CorridorOptions& o, const mapping::OccupancyGrid& truth, const DriveSpec& spec,
+            const std::shared_ptr<core::Random>& rng, const std::vector<int>& laps) {
+  sim::Scenario scenario;
+  scenario.seed = o.seed;
+  scenario.steps = 100000;
+  scenario.period_s = o.period_s;
+  scenario.robot_count = 1;
+  scenario.placement = sim::Placement::List;
+  scenario.starts = {spec.start};
+  scenario.robot.radius_m = 0.05;  // a point on the centre line, well clear of the walls
+  scenario.robot.max_speed_mps = spec.way.speed_mps;
+  scenario.robot.max_turn_rate_rps = spec.way.max_turn_rate_rps;
+  scenario.range = o.laser;
+  scenario.localization = spec.method;
+  scenario.merging = spec.own_frame ? "rendezvous" : "known";
+  sim::SimulationSetup how;
+  how.measure_coverage = false;
+  sim::RobotSetup& robot = how.robots.emplace_back();
+  auto driver = std::make_shared<sim::WaypointDriver>(spec.way, o.period_s);
+  robot.driver = driver;
+  robot.motion_rng = robot.sensor_rng = rng;
+  robot.odometry_error = sim::OdometryError{o.odometry.scale_error, core::deg2rad(o.odometry.turn_bias_deg_per_m),
+                                            o.odometry.speed_noise, core::deg2rad(o.odometry.turn_noise_deg)};
+  robot.localizer = [&](const localization::LocalizerContext& c) {
+    return localization::make_localizer(spec.method, context_for(o, c.initial_pose, spec.seed));
+  };
+  robot.map_geometry = spec.own_frame;
+
+  Drive d;
+  const auto keep = [&](const sim::Simulation& s) {
+    auto mine = s.localizer(0).map_estimate();
+    d.maps.push_back(mine ? std::move(*mine) : s.robot_map(0));
+    d.seconds.push_back(s.track(0).localization_s);
+  };
+  std::size_t laps_done = 0;
+  sim::Simulation simulation(scenario, truth, std::move(how));
+  simulation.run_to_end({}, [&](const sim::Simulation& s) {
+    d.truth.push_back(s.true_poses()[0]);
+    d.estimate.push_back(s.localizer(0).pose());
+    const auto& ends = driver->lap_ends();
+    if (ends.size() > laps_done && ends.back() == s.step_count()) {
+      laps_done = ends.size();
+      for (int l : laps) {
+        if (l == int(laps_done)) keep(s);
+      }
     }
-  }
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return r;
+  });
+  d.lap_end = driver->lap_ends();
+  if (d.lap_end.size() < std::size_t(spec.way.closed ? spec.way.laps : 1)) d.lap_end.push_back(simulation.step_count());
+  while (d.maps.size() < laps.size()) keep(simulation);
+  return d;
 }
 
 }  // namespace
 
 CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorProgress& progress) {
   for (const auto& m : o.methods) {
-    const std::vector<std::string> valid = {"ideal", "odometry", "scan-matching", "rbpf"};
+    const std::vector<std::string> valid = {"ideal", "odometry", "scan-matching", "fastslam-grid", "rbpf"};
     if (std::find(valid.begin(), valid.end(), m) == valid.end()) {
-      throw InputError("methods.list: '" + m + "' is not compared here (valid: ideal, odometry, scan-matching, rbpf)");
+      throw InputError("methods.list: '" + m +
+                       "' is not compared here (valid: ideal, odometry, scan-matching, fastslam-grid, rbpf)");
     }
   }
   if (o.laps.empty()) throw InputError("drive.laps: expected at least one lap count");
@@ -297,73 +293,86 @@ CorridorResult run_corridor_experiment(const CorridorOptions& o, const CorridorP
   result.options = o;
   result.truth = corridor_world(o);
   result.real = {true, o.length_m, o.height_m};
-  const sim::World world(result.truth, {});
   const auto& g = result.truth.geometry();
-  const int total_work = int(o.methods.size()) + (o.merge_study ? 2 + int(o.detection_errors_deg.size()) : 0);
+  if (o.seeds < 1) throw InputError("seeds: expected at least 1, got " + std::to_string(o.seeds));
+  const int total_work = o.seeds * int(o.methods.size()) + (o.merge_study ? 2 + int(o.detection_errors_deg.size()) : 0);
   int done = 0;
 
-  // One drive, replayed by every method: the same odometry and the same scans.
-  core::Random rng = core::Random(o.seed).fork(1);
+  // Every method drives the same drive: the same seed gives the same odometry and the same scans
+  // (the robot steers on its true pose, whatever the method believes).
   const auto line = centre_line(o);
   const core::Pose2 start(line[0].x(), line[0].y(), 0.0);
-  const Drive drive = record_drive(world, o, start, line, true, o.laps.back(), rng);
-  std::vector<int> snapshots;
-  for (int laps : o.laps) snapshots.push_back(drive.lap_end[std::size_t(std::min<int>(laps, int(drive.lap_end.size())) - 1)]);
-  for (const auto& method : o.methods) {
-    const Replay r = replay(drive, method, context_for(o, start, o.seed + 7), g, snapshots);
-    for (std::size_t i = 0; i < o.laps.size(); ++i) {
-      CorridorRun run;
-      run.method = method;
-      run.laps = o.laps[i];
-      run.map = r.maps[i];
-      run.dimensions = measure_loop(run.map);
-      run.length_error = std::abs(run.dimensions.length_m - o.length_m) / o.length_m;
-      run.height_error = std::abs(run.dimensions.height_m - o.height_m) / o.height_m;
-      const int end = snapshots[i];
-      run.truth.assign(drive.truth.begin(), drive.truth.begin() + end + 1);
-      run.estimate.assign(r.estimate.begin(), r.estimate.begin() + end + 1);
-      run.final_position_error_m = (run.truth.back().position() - run.estimate.back().position()).norm();
-      run.seconds = r.seconds * double(end + 1) / double(drive.scans.size());
-      result.runs.push_back(std::move(run));
+  const auto way = [&](std::vector<Eigen::Vector2d> waypoints, bool closed, int laps) {
+    sim::WaypointDrive w;
+    w.waypoints = std::move(waypoints);
+    w.closed = closed;
+    w.laps = laps;
+    w.speed_mps = o.speed_mps;
+    w.max_turn_rate_rps = core::deg2rad(45.0);
+    w.turn_in_place_rad = core::deg2rad(30.0);
+    w.reached_m = 0.3;
+    return w;
+  };
+  for (int k = 0; k < o.seeds; ++k) {
+    for (const auto& method : o.methods) {
+      const std::uint64_t seed = o.seed + std::uint64_t(k);
+      const Drive r = drive(o, result.truth, {start, way(line, true, o.laps.back()), method, seed + 7, std::nullopt},
+                            std::make_shared<core::Random>(core::Random(seed).fork(1)), o.laps);
+      for (std::size_t i = 0; i < o.laps.size(); ++i) {
+        CorridorRun run;
+        run.method = method;
+        run.seed = seed;
+        run.laps = o.laps[i];
+        run.map = r.maps[i];
+        run.dimensions = measure_loop(run.map);
+        run.length_error = std::abs(run.dimensions.length_m - o.length_m) / o.length_m;
+        run.height_error = std::abs(run.dimensions.height_m - o.height_m) / o.height_m;
+        const int end = r.lap_end[std::size_t(std::min<int>(o.laps[i], int(r.lap_end.size())) - 1)];
+        run.truth.assign(r.truth.begin(), r.truth.begin() + end + 1);
+        run.estimate.assign(r.estimate.begin(), r.estimate.begin() + end + 1);
+        run.final_position_error_m = (run.truth.back().position() - run.estimate.back().position()).norm();
+        run.seconds = r.seconds[i];
+        result.runs.push_back(std::move(run));
+      }
+      if (progress) progress(++done, total_work);
     }
-    if (progress) progress(++done, total_work);
   }
   if (!o.merge_study) return result;
 
   // Merging by detection. From the lower-left corner the master drives the bottom and right
-  // corridors, the other the left and top ones; they meet at the upper-right corner.
+  // corridors, the other the left and top ones; they meet at the upper-right corner. Each maps
+  // with scan matching in its own frame: the master's is the world's, the other's has its start at
+  // the origin. One stream serves the master's drive, then the other's, then the detection.
   const double c = 0.5 * o.corridor_width_m;
   const core::Pose2 master_start(c + 1.0, c, 0.0);
   const core::Pose2 other_start(c, c + 1.0, std::numbers::pi / 2.0);
   const std::vector<Eigen::Vector2d> master_way = {{o.length_m - c, c}, {o.length_m - c, o.height_m - c - 1.5}};
   const std::vector<Eigen::Vector2d> other_way = {{c, o.height_m - c}, {o.length_m - c - 1.5, o.height_m - c}};
-  core::Random merge_rng = core::Random(o.seed).fork(2);
-  const Drive master = record_drive(world, o, master_start, master_way, false, 1, merge_rng);
-  const Drive other = record_drive(world, o, other_start, other_way, false, 1, merge_rng);
-  if (progress) progress(++done, total_work);
-  // Each maps with scan matching in its own frame: the master's is the world's, the other's has its
-  // start at the origin.
-  const Replay master_run = replay(master, "scan-matching", context_for(o, master_start, o.seed + 11), g,
-                                   {int(master.scans.size()) - 1});
+  const auto merge_rng = std::make_shared<core::Random>(core::Random(o.seed).fork(2));
   const double half = std::hypot(g.width_m(), g.height_m()) + 2.0;
   const core::GridGeometry other_geometry(o.resolution_m, int(std::ceil(2.0 * half / o.resolution_m)),
                                           int(std::ceil(2.0 * half / o.resolution_m)), core::Pose2(-half, -half, 0.0));
-  const Replay other_run = replay(other, "scan-matching", context_for(o, core::Pose2(), o.seed + 13), other_geometry,
-                                  {int(other.scans.size()) - 1});
+  const Drive master_run = drive(o, result.truth, {master_start, way(master_way, false, 1), "scan-matching", o.seed + 11,
+                                                   std::nullopt},
+                                 merge_rng, {1});
   if (progress) progress(++done, total_work);
-  result.master_path = master.truth;
-  result.other_path = other.truth;
-  result.meeting_master = master.truth.back();
-  result.meeting_other = other.truth.back();
+  const Drive other_run = drive(o, result.truth, {other_start, way(other_way, false, 1), "scan-matching", o.seed + 13,
+                                                  other_geometry},
+                                merge_rng, {1});
+  if (progress) progress(++done, total_work);
+  result.master_path = master_run.truth;
+  result.other_path = other_run.truth;
+  result.meeting_master = master_run.truth.back();
+  result.meeting_other = other_run.truth.back();
 
   // The detection, both ways, from the true poses with the detector's noise.
   const sim::RobotDetectorOptions detector;
   const Eigen::Vector2d d = result.meeting_other.position() - result.meeting_master.position();
-  const double range = d.norm() + merge_rng.normal(0.0, detector.range_noise_m);
+  const double range = d.norm() + merge_rng->normal(0.0, detector.range_noise_m);
   const double bearing_mo = core::normalize_angle(std::atan2(d.y(), d.x()) - result.meeting_master.theta +
-                                                  merge_rng.normal(0.0, detector.bearing_noise_rad));
+                                                  merge_rng->normal(0.0, detector.bearing_noise_rad));
   const double bearing_om = core::normalize_angle(std::atan2(-d.y(), -d.x()) - result.meeting_other.theta +
-                                                  merge_rng.normal(0.0, detector.bearing_noise_rad));
+                                                  merge_rng->normal(0.0, detector.bearing_noise_rad));
   // The truth: the other's frame in the world is its start pose.
   const core::Transform2 true_other_to_master = other_start.as_transform();
   result.master_map = master_run.maps.front();

@@ -4,11 +4,13 @@
 // The world: a rectangular corridor loop whose outer free extent is length x height (21.3 m x 17 m)
 // and whose corridors are long and featureless. One robot drives the loop's centre line laps times,
 // counter-clockwise; its odometry has a scale error, a turn bias and noise; a front laser
-// (SICK LMS200-like: 181 beams over 180 degrees, 8 m) reads the true walls. The same drive (odometry
-// and scans) is replayed through each localizer, and the map each one builds is measured: the
+// (SICK LMS200-like: 181 beams over 180 degrees, 8 m) reads the true walls. Each localizer drives
+// the same drive on sim::Simulation (a sim::WaypointDriver steering on the true pose; the same seed
+// gives the same odometry and scans), and the map each one builds is measured: the
 // length and height of the smallest rectangle around its walls (cv::minAreaRect), against the real
 // ones. The map is the robot's own grid at the estimated poses (odometry, scan-matching) or the
-// localizer's own map (rbpf: the best particle's).
+// localizer's own map (fastslam-grid, rbpf: the best particle's). Over several seeds, Table I
+// gives the mean and the standard deviation of each cell.
 //
 // Merging by detection: two robots map halves of the loop with scan matching, each in its own
 // frame; where they meet, the master measures range and bearing to the other and the other its
@@ -40,14 +42,18 @@ struct CorridorOptions {
   double corridor_width_m = 2.0;
   double resolution_m = 0.1;
   std::vector<int> laps = {1, 3};    // maps are measured after each of these laps
-  // `ideal` (the true pose) shows what the measurement itself gives on a perfect map.
-  std::vector<std::string> methods = {"ideal", "odometry", "scan-matching", "rbpf"};
+  // `ideal` (the true pose) shows what the measurement itself gives on a perfect map; León et al.'s
+  // three methods are scan-matching, fastslam-grid and rbpf.
+  std::vector<std::string> methods = {"ideal", "odometry", "scan-matching", "fastslam-grid", "rbpf"};
   double speed_mps = 0.5;
   double period_s = 0.5;
   sim::RangeSensorOptions laser;          // set by default_laser()
   OdometryErrorOptions odometry;
-  int rbpf_particles = 30;
+  int rbpf_particles = 30;                // particles of rbpf and fastslam-grid
   std::uint64_t seed = 1;
+  // Table I over the seeds seed .. seed + seeds - 1 (mean and standard deviation); the pictures and
+  // the merge study use `seed`.
+  int seeds = 1;
   // Merging by detection: orientation errors (degrees) added to the detected bearing.
   std::vector<double> detection_errors_deg = {0.0, 1.0, 2.0, 5.0, 10.0};
   bool merge_study = true;
@@ -80,6 +86,7 @@ MapDimensions measure_loop(const mapping::OccupancyGrid& map);
 
 struct CorridorRun {
   std::string method;
+  std::uint64_t seed = 0;
   int laps = 0;
   MapDimensions dimensions;
   double length_error = 0.0;  // |measured - real| / real

@@ -1,5 +1,6 @@
 #include "experiments/corridor_output.h"
 
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -16,11 +17,26 @@ std::string num(double v, int decimals) {
   return core::fixed(v, decimals);
 }
 
+// The runs of the first seed with this lap count, one per method in the options' order.
 std::vector<const CorridorRun*> runs_with_laps(const CorridorResult& r, int laps) {
   std::vector<const CorridorRun*> out;
   for (const auto& run : r.runs)
-    if (run.laps == laps) out.push_back(&run);
+    if (run.laps == laps && run.seed == r.options.seed) out.push_back(&run);
   return out;
+}
+
+// One cell of Table I: the value of one seed, or the mean and sample standard deviation over the
+// seeds of this method and lap count.
+std::string cell(const CorridorResult& r, const CorridorRun& first, double (*value)(const CorridorRun&), double scale,
+                 int decimals, const std::string& unit) {
+  std::vector<double> v;
+  for (const auto& run : r.runs)
+    if (run.method == first.method && run.laps == first.laps) v.push_back(scale * value(run));
+  if (v.size() < 2) return num(scale * value(first), decimals) + unit;
+  double mean = 0.0, spread = 0.0;
+  for (double x : v) mean += x / double(v.size());
+  for (double x : v) spread += (x - mean) * (x - mean) / double(v.size() - 1);
+  return num(mean, decimals) + unit + " ± " + num(std::sqrt(spread), decimals) + unit;
 }
 
 // The true walls' faces: wall cells with a free 4-neighbour inside the loop, in `geometry`'s cells.
@@ -64,20 +80,30 @@ std::string corridor_table_markdown(const CorridorResult& r) {
   std::ostringstream md;
   for (int laps : r.options.laps) {
     const auto runs = runs_with_laps(r, laps);
-    md << "**" << laps_text(laps) << "** (seed " << r.options.seed << ")\n\n| | Real |";
+    md << "**" << laps_text(laps) << "** ";
+    if (r.options.seeds > 1) {
+      md << "(seeds " << r.options.seed << "-" << r.options.seed + std::uint64_t(r.options.seeds - 1)
+         << ": mean ± standard deviation)";
+    } else {
+      md << "(seed " << r.options.seed << ")";
+    }
+    md << "\n\n| | Real |";
     for (const auto* run : runs) md << " " << run->method << " |";
     md << "\n|---|---|";
     for (std::size_t i = 0; i < runs.size(); ++i) md << "---|";
+    const auto row = [&](double (*value)(const CorridorRun&), double scale, int decimals, const std::string& unit) {
+      for (const auto* run : runs) md << " " << cell(r, *run, value, scale, decimals, unit) << " |";
+    };
     md << "\n| Length (m) | " << num(r.real.length_m, 1) << " |";
-    for (const auto* run : runs) md << " " << num(run->dimensions.length_m, 2) << " |";
+    row([](const CorridorRun& c) { return c.dimensions.length_m; }, 1.0, 2, "");
     md << "\n| Error length | |";
-    for (const auto* run : runs) md << " " << num(100.0 * run->length_error, 1) << "% |";
+    row([](const CorridorRun& c) { return c.length_error; }, 100.0, 1, "%");
     md << "\n| Height (m) | " << num(r.real.height_m, 1) << " |";
-    for (const auto* run : runs) md << " " << num(run->dimensions.height_m, 2) << " |";
+    row([](const CorridorRun& c) { return c.dimensions.height_m; }, 1.0, 2, "");
     md << "\n| Error height | |";
-    for (const auto* run : runs) md << " " << num(100.0 * run->height_error, 1) << "% |";
+    row([](const CorridorRun& c) { return c.height_error; }, 100.0, 1, "%");
     md << "\n| Final position error (m) | |";
-    for (const auto* run : runs) md << " " << num(run->final_position_error_m, 2) << " |";
+    row([](const CorridorRun& c) { return c.final_position_error_m; }, 1.0, 2, "");
     md << "\n\n";
   }
   return md.str();
@@ -85,10 +111,10 @@ std::string corridor_table_markdown(const CorridorResult& r) {
 
 std::string corridor_table_csv(const CorridorResult& r) {
   std::ostringstream csv;
-  csv << "method,laps,real_length_m,real_height_m,length_m,height_m,length_error_pct,height_error_pct,"
+  csv << "method,seed,laps,real_length_m,real_height_m,length_m,height_m,length_error_pct,height_error_pct,"
          "final_position_error_m,seconds\n";
   for (const auto& run : r.runs) {
-    csv << run.method << "," << run.laps << "," << num(r.real.length_m, 3) << "," << num(r.real.height_m, 3) << ","
+    csv << run.method << "," << run.seed << "," << run.laps << "," << num(r.real.length_m, 3) << "," << num(r.real.height_m, 3) << ","
         << num(run.dimensions.length_m, 3) << "," << num(run.dimensions.height_m, 3) << ","
         << num(100.0 * run.length_error, 2) << "," << num(100.0 * run.height_error, 2) << ","
         << num(run.final_position_error_m, 3) << "," << num(run.seconds, 3) << "\n";
@@ -126,6 +152,7 @@ nlohmann::json corridor_json(const CorridorResult& r) {
   j["runs"] = nlohmann::json::array();
   for (const auto& run : r.runs) {
     j["runs"].push_back({{"method", run.method},
+                         {"seed", run.seed},
                          {"laps", run.laps},
                          {"found", run.dimensions.found},
                          {"length_m", run.dimensions.length_m},
@@ -171,6 +198,7 @@ std::vector<std::filesystem::path> write_corridor_outputs(const CorridorResult& 
   text("corridor.json", corridor_json(r).dump(2) + "\n");
   const viz::Color red{220, 40, 40}, green{40, 160, 60}, blue{40, 90, 220};
   for (const auto& run : r.runs) {
+    if (run.seed != r.options.seed) continue;  // pictures of the first seed
     viz::Overlays o;
     o.cells.push_back({wall_faces(r.truth, run.map.geometry()), red, "true walls", 0.55});
     o.paths.push_back({positions(run.truth), green, "true path", 1, false});

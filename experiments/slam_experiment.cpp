@@ -15,8 +15,7 @@
 #include "core/random.h"
 #include "localization/polynomial_slam.h"
 #include "merging/polynomial_exchange.h"
-#include "sim/motion.h"
-#include "sim/sensors.h"
+#include "sim/simulation.h"
 
 namespace fleetmap::experiments {
 
@@ -122,7 +121,135 @@ SlamSetup prepare_slam(const SlamScenario& scenario) {
 
 namespace {
 
-// D'Alfonso et al.'s polynomial SLAM, one filter per robot.
+// D'Alfonso et al.'s filter as the simulator's localizer for this experiment: the scenario's
+// `polynomial:` options, P0 and Q, every distance sensor's reading, and the filter within reach of
+// the rendezvous exchange (§3.2).
+class TeamPolynomialSlam final : public localization::Localizer {
+ public:
+  TeamPolynomialSlam(const core::Pose2& start, const Eigen::Matrix3d& p0, const Eigen::Matrix3d& q,
+                     const localization::PolynomialSlamOptions& options)
+      : slam_(start, p0, q, options) {}
+
+  std::string name() const override { return "polynomial"; }
+  void predict(const localization::Odometry& u) override { slam_.predict(u); }
+  void update_scan(const localization::RangeScan& scan, const mapping::OccupancyGrid& /*own_map*/) override {
+    slam_.update(scan.angles, scan.ranges);
+  }
+  void change_frame(const core::Transform2& new_from_old) override { slam_.change_frame(new_from_old); }
+  core::Pose2 pose() const override { return slam_.pose(); }
+  Eigen::Matrix3d covariance() const override { return slam_.pose_covariance(); }
+
+  localization::PolynomialSlam& slam() { return slam_; }
+  const localization::PolynomialSlam& slam() const { return slam_; }
+
+ private:
+  localization::PolynomialSlam slam_;
+};
+
+const localization::PolynomialSlam& filter_of(const sim::Simulation& s, int robot) {
+  return dynamic_cast<const TeamPolynomialSlam&>(s.localizer(robot)).slam();
+}
+
+localization::PolynomialSlam& filter_of(sim::Simulation& s, int robot) {
+  return dynamic_cast<TeamPolynomialSlam&>(s.localizer(robot)).slam();
+}
+
+// The smallest grid at the room's resolution that holds the whole room in the frame of a robot
+// starting at `start` (its own map is not this experiment's output; the polynomials are).
+core::GridGeometry room_in_frame(const core::GridGeometry& room, const core::Pose2& start) {
+  const core::Transform2 to_frame = start.as_transform().inverse();
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const auto& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(room.width(), 0), Eigen::Vector2d(0, room.height()),
+                             Eigen::Vector2d(room.width(), room.height())}) {
+    const Eigen::Vector2d p = to_frame.apply(room.grid_to_world(corner));
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const double res = room.resolution();
+  return core::GridGeometry(res, int(std::ceil((hi.x() - lo.x()) / res)), int(std::ceil((hi.y() - lo.y()) / res)),
+                            core::Pose2(lo.x(), lo.y(), 0.0));
+}
+
+// The rendezvous of D'Alfonso et al. §3.2 between robots a and b of the simulation: each sends the
+// other the polynomials extracted since their last rendezvous, with its pose and the camera's
+// reading of the other; both messages are built before either is merged, so neither echoes the other.
+class PolynomialExchange {
+ public:
+  PolynomialExchange(const SlamScenario& scenario, const std::vector<int>& team, bool enabled, SlamRunResult& result)
+      : sc_(scenario), team_(team), enabled_(enabled), result_(result),
+        sent_upto_(team.size(), std::vector<long>(team.size(), 0)), seconds_(team.size(), 0.0) {}
+
+  // A rendezvous is the step two robots start seeing each other (a choice: the paper does not say
+  // how often robots that keep seeing each other exchange).
+  void operator()(sim::Simulation& s, int a, int b) {
+    const sim::Detection* ab = seen(s, a, b);
+    const sim::Detection* ba = seen(s, b, a);
+    if (!enabled_ || ab == nullptr || ba == nullptr) return;
+    struct Outgoing {
+      int from, to;
+      merging::PolynomialMessage message;
+    };
+    std::vector<Outgoing> outgoing;
+    for (const auto& [l, j, seen_lj] : {std::tuple{a, b, ab}, std::tuple{b, a, ba}}) {
+      const auto& sender = filter_of(s, l);
+      merging::PolynomialMessage m;
+      m.sender_pose = sender.pose();
+      m.sender_covariance = sender.pose_covariance();
+      m.distance = seen_lj->range;
+      m.bearing_sender_to_receiver = seen_lj->bearing;
+      long& sent = sent_upto_[std::size_t(l)][std::size_t(j)];
+      long upto = sent;
+      for (std::size_t i = 0; i < sender.map().landmarks.size(); ++i) {
+        const auto& landmark = sender.map().landmarks[i];
+        upto = std::max(upto, landmark.id + 1);
+        // Remark 1: only what was extracted since the last rendezvous with this robot.
+        if (landmark.id < sent) continue;
+        if (landmark.received_from == team_[std::size_t(j)]) continue;
+        m.polynomials.push_back(landmark.polynomial);
+        m.position_variances.push_back(sender.position_variance(int(i)));
+      }
+      sent = upto;
+      outgoing.push_back({l, j, std::move(m)});
+    }
+    for (const auto& o : outgoing) {
+      const sim::Detection* seen_jl = seen(s, o.to, o.from);
+      merging::ExchangeOptions options;
+      options.segment_tolerance = sc_.segment_tolerance_m;
+      options.range_noise = sc_.camera.range_noise_m;
+      options.bearing_noise = sc_.camera.bearing_noise_rad;
+      auto& receiver = filter_of(s, o.to);
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto curves = merging::receive_polynomials(o.message, receiver.pose(), seen_jl->range, seen_jl->bearing,
+                                                       team_[std::size_t(o.from)], options);
+      receiver.integrate_received(curves);
+      seconds_[std::size_t(o.to)] += seconds_since(t0);
+      result_.rendezvous.push_back({s.step_count(), team_[std::size_t(o.from)], team_[std::size_t(o.to)],
+                                    int(o.message.polynomials.size()), merging::message_bytes(o.message),
+                                    merging::grid_patch_bytes(o.message.polynomials, sc_.grid_patch_resolution_m)});
+    }
+  }
+
+  // Time robot a spent merging what it received.
+  double seconds(int a) const { return seconds_[std::size_t(a)]; }
+
+ private:
+  static const sim::Detection* seen(const sim::Simulation& s, int a, int b) {
+    for (const auto& d : s.detections(a)) {
+      if (d.other == b) return &d;
+    }
+    return nullptr;
+  }
+
+  const SlamScenario& sc_;
+  const std::vector<int>& team_;
+  bool enabled_;
+  SlamRunResult& result_;
+  std::vector<std::vector<long>> sent_upto_;
+  std::vector<double> seconds_;
+};
+
+// D'Alfonso et al.'s polynomial SLAM, one filter per robot, on the simulator: each robot in its own
+// frame R_j,0, driven by its precomputed commands, its camera on a stream of its own.
 SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange, int only) {
   const SlamScenario& sc = setup.scenario;
   std::vector<int> team;  // scenario robot index of each robot in this run
@@ -131,7 +258,6 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
   }
   const int n = int(team.size());
   const core::Random run_rng = core::Random(sc.seed).fork(std::uint64_t(run));
-  std::vector<core::Random> motion_rng, sensor_rng, camera_rng;
   const Eigen::Matrix3d p0 =
       Eigen::Vector3d(sc.initial_sigma_xy * sc.initial_sigma_xy, sc.initial_sigma_xy * sc.initial_sigma_xy,
                       sc.initial_sigma_heading * sc.initial_sigma_heading)
@@ -140,144 +266,78 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
                                             sc.noise.position_m * sc.noise.position_m,
                                             sc.noise.heading_rad * sc.noise.heading_rad)
                                 .asDiagonal();
-  std::vector<localization::PolynomialSlam> slam;
-  std::vector<core::Pose2> truths;
-  std::vector<localization::LocalizationMetrics> metrics(static_cast<std::size_t>(n));
-  std::vector<double> busy(std::size_t(n), 0.0);
   SlamRunResult result;
   result.run = run;
   result.exchange = exchange;
+
+  sim::Scenario scenario;
+  scenario.seed = run_rng.seed();
+  scenario.steps = sc.steps;
+  scenario.period_s = sc.period_s;
+  scenario.placement = sim::Placement::List;
+  scenario.robot = sc.robot;
+  scenario.noise = sc.noise;
+  scenario.range = sc.range;
+  scenario.detector = sc.camera;
+  scenario.localization = "polynomial";
+  scenario.merging = "rendezvous";       // each robot maps in its own frame R_j,0 (§3.2)
+  scenario.communication.range_m = 0.0;  // robots talk when they see each other
+  sim::SimulationSetup how;
+  how.measure_coverage = false;
   for (int a = 0; a < n; ++a) {
     const int r = team[std::size_t(a)];
-    motion_rng.push_back(run_rng.fork(100 + std::uint64_t(r)));
-    sensor_rng.push_back(run_rng.fork(200 + std::uint64_t(r)));
-    camera_rng.push_back(run_rng.fork(300 + std::uint64_t(r)));
-    // Each robot starts from x_j,0 = [0 0 0] in its own frame R_j,0 (§3.2).
-    slam.emplace_back(core::Pose2(), p0, q, sc.polynomial);
-    truths.push_back(sc.robots[std::size_t(r)].start);
+    const SlamRobot& robot = sc.robots[std::size_t(r)];
+    scenario.starts.push_back(robot.start);
+    sim::RobotSetup rs;
+    std::vector<sim::Command> commands;
+    for (const auto& u : setup.commands[std::size_t(r)]) commands.push_back({u.v, u.omega});
+    rs.driver = std::make_shared<sim::CommandScript>(std::move(commands));
+    // Each robot starts from x_j,0 = [0 0 0] in its own frame R_j,0: the simulator's initial pose.
+    rs.localizer = [&](const localization::LocalizerContext& c) {
+      return std::make_unique<TeamPolynomialSlam>(c.initial_pose, p0, q, sc.polynomial);
+    };
+    // Streams by the robot's index in the scenario, so that a robot alone has its noise in the team.
+    rs.motion_rng = std::make_shared<core::Random>(run_rng.fork(100 + std::uint64_t(r)));
+    rs.sensor_rng = std::make_shared<core::Random>(run_rng.fork(200 + std::uint64_t(r)));
+    rs.detector_rng = std::make_shared<core::Random>(run_rng.fork(300 + std::uint64_t(r)));
+    rs.map_geometry = room_in_frame(setup.world.geometry(), robot.start);
+    how.robots.push_back(std::move(rs));
     SlamRobotResult rr;
-    rr.name = sc.robots[std::size_t(r)].name;
+    rr.name = robot.name;
     result.robots.push_back(std::move(rr));
   }
-  std::vector<std::vector<char>> was_mutual(std::size_t(n), std::vector<char>(std::size_t(n), 0));
-  std::vector<std::vector<long>> sent_upto(std::size_t(n), std::vector<long>(std::size_t(n), 0));
+  scenario.robot_count = n;
+  auto exchanges = std::make_shared<PolynomialExchange>(sc, team, exchange, result);
+  how.on_meeting = [exchanges](sim::Simulation& s, int a, int b) { (*exchanges)(s, a, b); };
 
-  const auto record = [&]() {
+  std::vector<localization::LocalizationMetrics> metrics(static_cast<std::size_t>(n));
+  const auto record = [&](const sim::Simulation& s) {
+    const std::vector<core::Pose2> truths = s.true_poses();
     for (int a = 0; a < n; ++a) {
       const core::Pose2& start = sc.robots[std::size_t(team[std::size_t(a)])].start;
+      const auto& filter = filter_of(s, a);
       // mu's x~: the estimate compensated by the bias of x_j,0 = [0 0 0] (§4); P turned with it.
-      const core::Pose2 estimate = start.compose(slam[std::size_t(a)].pose());
+      const core::Pose2 estimate = start.compose(filter.pose());
       Eigen::Matrix3d j = Eigen::Matrix3d::Identity();
       j.topLeftCorner<2, 2>() = start.as_transform().rotation_matrix();
-      const Eigen::Matrix3d p = j * slam[std::size_t(a)].pose_covariance() * j.transpose();
+      const Eigen::Matrix3d p = j * filter.pose_covariance() * j.transpose();
       metrics[std::size_t(a)].add(truths[std::size_t(a)], estimate, p);
       result.robots[std::size_t(a)].truth.push_back(truths[std::size_t(a)]);
       result.robots[std::size_t(a)].estimate.push_back(estimate);
     }
   };
-
-  const auto sense_and_update = [&]() {
-    for (int a = 0; a < n; ++a) {
-      const localization::RangeScan scan = sim::read_ranges(setup.world, truths[std::size_t(a)], sc.range, sensor_rng[std::size_t(a)]);
-      const auto t0 = std::chrono::steady_clock::now();
-      slam[std::size_t(a)].update(scan.angles, scan.ranges);
-      busy[std::size_t(a)] += seconds_since(t0);
-    }
-  };
-
-  const auto rendezvous = [&](int step) {
-    std::vector<std::vector<sim::Detection>> seen(static_cast<std::size_t>(n));
-    for (int a = 0; a < n; ++a) seen[std::size_t(a)] = sim::detect_robots(setup.world, a, truths, sc.camera, camera_rng[std::size_t(a)]);
-    const auto find = [&](int a, int b) -> const sim::Detection* {
-      for (const auto& d : seen[std::size_t(a)]) {
-        if (d.other == b) return &d;
-      }
-      return nullptr;
-    };
-    for (int a = 0; a < n; ++a) {
-      for (int b = a + 1; b < n; ++b) {
-        const sim::Detection* ab = find(a, b);
-        const sim::Detection* ba = find(b, a);
-        const bool mutual = ab != nullptr && ba != nullptr;
-        // A rendezvous is the step two robots start seeing each other (a choice: the paper does
-        // not say how often robots that keep seeing each other exchange).
-        const bool meets = mutual && !was_mutual[std::size_t(a)][std::size_t(b)];
-        was_mutual[std::size_t(a)][std::size_t(b)] = mutual;
-        if (!meets || !exchange) continue;
-        // Both messages are built before either is merged, so neither echoes the other.
-        struct Outgoing {
-          int from, to;
-          merging::PolynomialMessage message;
-        };
-        std::vector<Outgoing> outgoing;
-        for (const auto& [l, j, seen_lj] : {std::tuple{a, b, ab}, std::tuple{b, a, ba}}) {
-          const auto& sender = slam[std::size_t(l)];
-          merging::PolynomialMessage m;
-          m.sender_pose = sender.pose();
-          m.sender_covariance = sender.pose_covariance();
-          m.distance = seen_lj->range;
-          m.bearing_sender_to_receiver = seen_lj->bearing;
-          long upto = sent_upto[std::size_t(l)][std::size_t(j)];
-          for (std::size_t i = 0; i < sender.map().landmarks.size(); ++i) {
-            const auto& landmark = sender.map().landmarks[i];
-            upto = std::max(upto, landmark.id + 1);
-            // Remark 1: only what was extracted since the last rendezvous with this robot.
-            if (landmark.id < sent_upto[std::size_t(l)][std::size_t(j)]) continue;
-            if (landmark.received_from == team[std::size_t(j)]) continue;
-            m.polynomials.push_back(landmark.polynomial);
-            m.position_variances.push_back(sender.position_variance(int(i)));
-          }
-          sent_upto[std::size_t(l)][std::size_t(j)] = upto;
-          outgoing.push_back({l, j, std::move(m)});
-        }
-        for (const auto& o : outgoing) {
-          const sim::Detection* seen_jl = find(o.to, o.from);
-          merging::ExchangeOptions options;
-          options.segment_tolerance = sc.segment_tolerance_m;
-          options.range_noise = sc.camera.range_noise_m;
-          options.bearing_noise = sc.camera.bearing_noise_rad;
-          auto& receiver = slam[std::size_t(o.to)];
-          const auto t0 = std::chrono::steady_clock::now();
-          const auto curves = merging::receive_polynomials(o.message, receiver.pose(), seen_jl->range, seen_jl->bearing,
-                                                           team[std::size_t(o.from)], options);
-          receiver.integrate_received(curves);
-          busy[std::size_t(o.to)] += seconds_since(t0);
-          result.rendezvous.push_back({step, team[std::size_t(o.from)], team[std::size_t(o.to)],
-                                       int(o.message.polynomials.size()), merging::message_bytes(o.message),
-                                       merging::grid_patch_bytes(o.message.polynomials, sc.grid_patch_resolution_m)});
-        }
-      }
-    }
-  };
-
-  // Step 0: the first readings, before moving.
-  sense_and_update();
-  rendezvous(0);
-  record();
-  for (int k = 1; k <= sc.steps; ++k) {
-    for (int a = 0; a < n; ++a) {
-      const auto& u = setup.commands[std::size_t(team[std::size_t(a)])][std::size_t(k - 1)];
-      const sim::MoveResult mv = sim::move_robot(setup.world, a, truths, sc.robot, {u.v, u.omega}, sc.period_s, sc.noise,
-                                       motion_rng[std::size_t(a)]);
-      truths[std::size_t(a)] = mv.pose;
-      const auto t0 = std::chrono::steady_clock::now();
-      slam[std::size_t(a)].predict(mv.odometry);
-      busy[std::size_t(a)] += seconds_since(t0);
-    }
-    sense_and_update();
-    rendezvous(k);
-    record();
-  }
+  sim::Simulation simulation(scenario, setup.world.truth(), std::move(how));
+  simulation.run_to_end({}, record);
 
   for (int a = 0; a < n; ++a) {
     SlamRobotResult& rr = result.robots[std::size_t(a)];
-    const auto& s = slam[std::size_t(a)];
+    const auto& s = filter_of(simulation, a);
     const core::Transform2 frame = sc.robots[std::size_t(team[std::size_t(a)])].start.as_transform();
     const std::vector<mapping::Polynomial> polys = s.map().polynomials();
     rr.localization = metrics[std::size_t(a)].summary();
     rr.mapping = mapping::mapping_error(polys, frame, setup.walls, 0.01);
     rr.boundary_coverage = mapping::boundary_coverage(polys, frame, setup.walls, 0.1, 0.02);
-    rr.tau_s = busy[std::size_t(a)] / double(sc.steps + 1);
+    rr.tau_s = (simulation.track(a).localization_s + exchanges->seconds(a)) / double(sc.steps + 1);
     rr.polynomials = int(polys.size());
     for (const auto& p : polys) {
       std::vector<Eigen::Vector2d> curve;

@@ -3,6 +3,8 @@
 // noise-free, from the waypoints), each running its SLAM method from its own origin
 // (x_j,0 = [0 0 0] in R_j,0), exchanging maps when two robots see each other, and measured
 // against the truth: mu (the paper's form and the standard NEES), nu, tau, bytes per rendezvous.
+// A run is a sim::Simulation set up for it: each robot driven by its commands (sim::CommandScript),
+// in its own frame, with the filter as its localizer; a meeting handler exchanges the polynomials.
 // `method` picks the SLAM method through a table in slam_experiment.cpp.
 #include <Eigen/Core>
 

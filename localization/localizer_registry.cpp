@@ -31,6 +31,10 @@ core::Registry<LocalizerFactory>& localizer_registry() {
           "Rao-Blackwellized particle filter, a grid per particle, scan-matching proposal (León et al., sec. II.C; "
           "Grisetti et al. 2005)",
           make_rbpf_localizer);
+    r.add("fastslam-grid",
+          "grid-based FastSLAM: particles drawn from the raw motion model, each weighted by its scan on its own grid, "
+          "no scan-matching proposal (León et al., sec. II.B)",
+          make_grid_fastslam_localizer);
     return true;
   }();
   (void)built_in;

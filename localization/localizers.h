@@ -18,5 +18,6 @@ std::unique_ptr<Localizer> make_polynomial_localizer(const LocalizerContext& con
 std::unique_ptr<Localizer> make_scan_matching_localizer(const LocalizerContext& context);  // scan_matching_localizer.cpp
 std::unique_ptr<Localizer> make_mcl_localizer(const LocalizerContext& context);            // mcl_localizer.cpp
 std::unique_ptr<Localizer> make_rbpf_localizer(const LocalizerContext& context);           // rbpf_localizer.cpp
+std::unique_ptr<Localizer> make_grid_fastslam_localizer(const LocalizerContext& context);  // rbpf_localizer.cpp
 
 }  // namespace fleetmap::localization

@@ -14,7 +14,8 @@
 
 namespace fleetmap::localization {
 
-RbpfLocalizer::RbpfLocalizer(const LocalizerContext& c) : options_(c.options), rng_(c.seed) {
+RbpfLocalizer::RbpfLocalizer(const LocalizerContext& c, Proposal proposal)
+    : options_(c.options), proposal_(proposal), rng_(c.seed) {
   if (c.options.rbpf_particles < 1) {
     throw InputError("localization.rbpf_particles: expected at least 1, got " + std::to_string(c.options.rbpf_particles));
   }
@@ -29,7 +30,7 @@ void RbpfLocalizer::predict(const Odometry& u) {
   for (auto& p : particles_) {
     p.odometry_pose = integrate_motion(p.pose, u);
     p.pose = p.odometry_pose;
-    if (!options_.rbpf_sample_motion) continue;
+    if (!options_.rbpf_sample_motion && proposal_ == Proposal::ScanMatching) continue;
     p.pose = {p.pose.x + rng_.normal(0.0, options_.process_noise_xy), p.pose.y + rng_.normal(0.0, options_.process_noise_xy),
               core::normalize_angle(p.pose.theta + rng_.normal(0.0, options_.process_noise_theta))};
   }
@@ -41,12 +42,18 @@ void RbpfLocalizer::update_scan(const RangeScan& scan, const mapping::OccupancyG
     for (auto& p : particles_) p.map = start;  // one set of tiles, shared by all
     maps_ready_ = true;
   }
-  const ScanMatcherOptions m = scan_matcher_options(options_, scan.max_range, own_map.resolution());
+  ScanMatcherOptions m = scan_matcher_options(options_, scan.max_range, own_map.resolution());
+  if (proposal_ == Proposal::Motion) {
+    // The likelihood at the drawn pose alone: no search, no refinement, no prior.
+    m.search_xy_m = m.search_theta_rad = 0.0;
+    m.prior_xy_m = m.prior_theta_rad = 0.0;
+    m.refine_iterations = 0;
+  }
   for (auto& p : particles_) {
     // The motion model p(x | x', u) is centred on the odometry step; the drawn pose seeds the search.
     const ScanMatch match = match_scan_to_grid(p.map, scan, p.pose, m, p.odometry_pose);
     if (match.matched) {
-      p.pose = match.pose;
+      if (proposal_ == Proposal::ScanMatching) p.pose = match.pose;
       p.log_weight += match.log_normalizer;
       ++matched_;
     }
@@ -145,5 +152,9 @@ RbpfLocalizer::MemoryStats RbpfLocalizer::memory() const {
 }
 
 std::unique_ptr<Localizer> make_rbpf_localizer(const LocalizerContext& c) { return std::make_unique<RbpfLocalizer>(c); }
+
+std::unique_ptr<Localizer> make_grid_fastslam_localizer(const LocalizerContext& c) {
+  return std::make_unique<RbpfLocalizer>(c, RbpfLocalizer::Proposal::Motion);
+}
 
 }  // namespace fleetmap::localization

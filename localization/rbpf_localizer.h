@@ -14,6 +14,11 @@
 //  5. selective resampling: low-variance resampling when N_eff = 1 / sum(w^2) < N / 2.
 // Maps are CowGrids: resampled copies share every tile until one of them writes to it.
 // The reported pose and map are the particle with the largest weight.
+//
+// `fastslam-grid` is the same filter without the improved proposal (León et al., §II.B: grid-based
+// FastSLAM, Montemerlo et al.'s particles with a grid each): a particle keeps its draw from the raw
+// motion model (step 1, always sampled), and its weight is the likelihood of the scan at that pose
+// on its own map (the likelihood field of step 2 at the one pose, scaled the same way).
 #include <memory>
 #include <vector>
 
@@ -26,6 +31,10 @@ namespace fleetmap::localization {
 
 class RbpfLocalizer final : public Localizer {
  public:
+  enum class Proposal {
+    ScanMatching,  // `rbpf`: Grisetti et al.'s improved proposal
+    Motion,        // `fastslam-grid`: the raw motion model
+  };
   struct Particle {
     core::Pose2 pose;
     core::Pose2 odometry_pose;  // the last odometry step from the previous pose, undrawn
@@ -40,9 +49,9 @@ class RbpfLocalizer final : public Localizer {
 
   // The particles' maps are created at the first scan with the geometry of the robot's own map,
   // and restart from that map (shared by all) when its geometry changes, e.g. after change_frame.
-  explicit RbpfLocalizer(const LocalizerContext& context);
+  explicit RbpfLocalizer(const LocalizerContext& context, Proposal proposal = Proposal::ScanMatching);
 
-  std::string name() const override { return "rbpf"; }
+  std::string name() const override { return proposal_ == Proposal::Motion ? "fastslam-grid" : "rbpf"; }
   void predict(const Odometry& u) override;
   void update_scan(const RangeScan& scan, const mapping::OccupancyGrid& own_map) override;
   core::Pose2 pose() const override { return particles_[std::size_t(best_)].pose; }
@@ -60,6 +69,7 @@ class RbpfLocalizer final : public Localizer {
   void resample();
 
   LocalizerOptions options_;
+  Proposal proposal_;
   core::Random rng_;
   std::vector<Particle> particles_;
   int best_ = 0;

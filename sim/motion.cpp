@@ -79,6 +79,14 @@ Command escape_command(const core::Pose2& estimate, const mapping::OccupancyGrid
   return c;
 }
 
+localization::Odometry misreport_odometry(const localization::Odometry& driven, const OdometryError& e,
+                                          core::Random& rng) {
+  localization::Odometry r = driven;
+  r.v = driven.v * (1.0 + e.scale_error) + rng.normal(0.0, e.speed_noise_mps);
+  r.omega = driven.omega + e.turn_bias_rad_per_m * std::abs(driven.v) + rng.normal(0.0, e.turn_noise_rps);
+  return r;
+}
+
 bool clear_of_robots(int self, const Eigen::Vector2d& p, const std::vector<core::Pose2>& truths, double radius_m) {
   for (std::size_t j = 0; j < truths.size(); ++j) {
     if (int(j) != self && (truths[j].position() - p).norm() < 2.0 * radius_m) return false;

@@ -24,6 +24,19 @@ struct MotionNoise {
   double heading_rad = 0.00017453292519943296;
 };
 
+// León et al.'s odometry (§II.D): the robot drives its command without process noise, and its
+// wheel encoders misreport what it drove: a scale error, a turn bias per metre and noise.
+struct OdometryError {
+  double scale_error = 0.0;          // reported distance = (1 + scale_error) x driven
+  double turn_bias_rad_per_m = 0.0;  // a heading drift per metre driven, reported but not driven
+  double speed_noise_mps = 0.0;      // standard deviation, per step
+  double turn_noise_rps = 0.0;       // standard deviation, per step
+};
+
+// What the encoders report for the motion `driven`: speed noise is drawn before turn noise.
+localization::Odometry misreport_odometry(const localization::Odometry& driven, const OdometryError& error,
+                                          core::Random& rng);
+
 struct Command {
   double v = 0.0;
   double omega = 0.0;

@@ -1,15 +1,14 @@
 #include "sim/simulation.h"
 
 #include <algorithm>
-#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
 #include <fmt/format.h>
-#include <opencv2/imgproc.hpp>
 
+#include "core/angle.h"
 #include "core/error.h"
 #include "core/format.h"
 #include "localization/localizers.h"
@@ -62,8 +61,9 @@ World make_world(const Scenario& s, mapping::OccupancyGrid truth) {
 
 }  // namespace
 
-Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
+Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, SimulationSetup setup)
     : scenario_(scenario),
+      setup_(std::move(setup)),
       world_(make_world(scenario, std::move(truth))),
       rng_(scenario.seed),
       merged_(world_.geometry()),
@@ -85,7 +85,18 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
   const int n = scenario_.robot_count;
   if (n > 64) throw InputError("robots: at most 64 robots");
   robots_.resize(std::size_t(n));
-  for (int i = 0; i < n; ++i) robots_[std::size_t(i)].truth = scenario_.starts[std::size_t(i)];
+  setup_.robots.resize(std::size_t(n));
+  for (int i = 0; i < n; ++i) {
+    Robot& robot = robots_[std::size_t(i)];
+    const RobotSetup& how = setup_.robots[std::size_t(i)];
+    robot.truth = scenario_.starts[std::size_t(i)];
+    robot.driver = how.driver;
+    robot.odometry_error = how.odometry_error;
+    robot.motion_rng = how.motion_rng ? how.motion_rng : std::make_shared<core::Random>(rng_.fork(100 + std::uint64_t(i)));
+    robot.sensor_rng = how.sensor_rng ? how.sensor_rng : std::make_shared<core::Random>(rng_.fork(200 + std::uint64_t(i)));
+    robot.detector_rng = how.detector_rng ? how.detector_rng : robot.sensor_rng;
+  }
+  explored_ = std::any_of(robots_.begin(), robots_.end(), [](const Robot& r) { return !r.driver; });
 
   // Map frames: one shared world frame, or one per robot, its origin at the robot's start.
   aligner_ = merging::make_map_aligner(scenario_.merging);
@@ -98,6 +109,10 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
       const core::Pose2& start = robots_[std::size_t(i)].truth;
       robots_[std::size_t(i)].frame = i;
       frame_origin_.push_back(start.as_transform());
+      if (const auto& own = setup_.robots[std::size_t(i)].map_geometry) {
+        frame_geometry_.push_back(*own);
+        continue;
+      }
       // Large enough to hold the whole world around the start, however the frame is turned.
       double reach = 0.0;
       for (const auto& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(g.width(), 0), Eigen::Vector2d(0, g.height()),
@@ -130,8 +145,6 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
     Robot& robot = robots_[std::size_t(i)];
     context.global_localization = std::find(scenario_.lost_robots.begin(), scenario_.lost_robots.end(), i + 1) !=
                                   scenario_.lost_robots.end();
-    robot.motion_rng = rng_.fork(100 + std::uint64_t(i));
-    robot.sensor_rng = rng_.fork(200 + std::uint64_t(i));
     // Each robot knows its start and the landmark map in its own map frame.
     const core::Transform2 to_frame = frame_origin(i).inverse();
     context.initial_pose = core::Pose2::from_transform(to_frame * robot.truth.as_transform());
@@ -140,7 +153,8 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
       context.known_landmarks.push_back({int(k), to_frame.apply(world_.landmarks()[k]), Eigen::Matrix2d::Zero()});
     }
     context.seed = rng_.fork(300 + std::uint64_t(i)).seed();
-    robot.localizer = localization::make_localizer(scenario_.localization, context);
+    const auto& make = setup_.robots[std::size_t(i)].localizer;
+    robot.localizer = make ? make(context) : localization::make_localizer(scenario_.localization, context);
     robot.map = mapping::OccupancyGrid(frame_geometry_[std::size_t(robot.frame)]);
   }
   if (scenario_.path_planner != "wave") {
@@ -158,9 +172,11 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth)
       return r.success() ? r.path : std::vector<Eigen::Vector2d>{};
     });
   }
-  std::vector<Eigen::Vector2d> start_points;
-  for (const auto& p : scenario_.starts) start_points.push_back(p.position());
-  observable_ = world_.observable_space(start_points, scenario_.robot.radius_m, scenario_.range.max_range_m);
+  if (setup_.measure_coverage) {
+    std::vector<Eigen::Vector2d> start_points;
+    for (const auto& p : scenario_.starts) start_points.push_back(p.position());
+    observable_ = world_.observable_space(start_points, scenario_.robot.radius_m, scenario_.range.max_range_m);
+  }
   sensed_by_.assign(std::size_t(world_.geometry().cell_count()), 0);
   previous_links_.assign(std::size_t(n), std::vector<char>(std::size_t(n), 0));
 
@@ -186,7 +202,20 @@ std::vector<core::Pose2> Simulation::estimated_poses() const {
   return out;
 }
 
-bool Simulation::done() const { return step_ >= scenario_.steps || explorer_.all_finished(); }
+bool Simulation::finished(int i) const {
+  const Robot& r = robots_[std::size_t(i)];
+  return r.driver ? !r.command.has_value() : explorer_.finished(i);
+}
+
+bool Simulation::all_finished() const {
+  if (std::none_of(robots_.begin(), robots_.end(), [](const Robot& r) { return bool(r.driver); }))
+    return explorer_.all_finished();
+  for (int i = 0; i < scenario_.robot_count; ++i)
+    if (!finished(i)) return false;
+  return true;
+}
+
+bool Simulation::done() const { return step_ >= scenario_.steps || all_finished(); }
 
 void Simulation::sense_and_map() {
   const int n = scenario_.robot_count;
@@ -196,18 +225,19 @@ void Simulation::sense_and_map() {
   const std::vector<core::Pose2> truths = true_poses();
   for (int i = 0; i < n; ++i) {
     Robot& robot = robots_[std::size_t(i)];
-    auto& rng = robot.sensor_rng;
+    auto& rng = *robot.sensor_rng;
     scans[std::size_t(i)] = read_ranges(world_, robot.truth, scenario_.range, rng);
     if (!world_.landmarks().empty()) {
       landmark_obs[std::size_t(i)] = read_landmarks(world_, robot.truth, scenario_.landmark_sensor, rng);
     }
-    robot.detections = detect_robots(world_, i, truths, scenario_.detector, rng);
+    robot.detections = detect_robots(world_, i, truths, scenario_.detector, *robot.detector_rng);
   }
   timing_.sensing += seconds_since(t0);
 
   t0 = Clock::now();
   for (int i = 0; i < n; ++i) {
     Robot& robot = robots_[std::size_t(i)];
+    const auto t_robot = Clock::now();
     auto& loc = *robot.localizer;
     loc.observe_truth(core::Pose2::from_transform(frame_origin(i).inverse() * robot.truth.as_transform()));
     if (!landmark_obs[std::size_t(i)].empty()) loc.update_landmarks(landmark_obs[std::size_t(i)]);
@@ -219,6 +249,7 @@ void Simulation::sense_and_map() {
         loc.update_robot({d.other, d.range, d.bearing, other.pose(), other.covariance()});
       }
     }
+    robot.track.localization_s += seconds_since(t_robot);
   }
   // Collaborative localization (León et al., eq. (15)): the detected robot learns from its detector.
   if (scenario_.localization_options.use_robot_detections) {
@@ -264,6 +295,13 @@ void Simulation::communicate() {
       if (!links_[std::size_t(i)][std::size_t(j)]) continue;
       const bool new_link = !previous_links_[std::size_t(i)][std::size_t(j)];
       if (new_link) ++meetings_;
+      if (setup_.on_meeting) {
+        if (new_link) {
+          events_.push_back({step_, "meeting", i, j, "the experiment's exchange"});
+          setup_.on_meeting(*this, i, j);
+        }
+        continue;
+      }
       Robot &a = robots_[std::size_t(i)], &b = robots_[std::size_t(j)];
       if (a.frame != b.frame) try_merge(i, j);
       if (a.frame != b.frame) {
@@ -281,6 +319,17 @@ void Simulation::communicate() {
 
 void Simulation::decide() {
   const auto t0 = Clock::now();
+  for (int i = 0; i < scenario_.robot_count; ++i) {
+    Robot& r = robots_[std::size_t(i)];
+    if (!r.driver) continue;
+    r.command = r.driver->next({step_, r.truth, r.localizer->pose()});
+    if (!r.command && !r.was_finished) events_.push_back({step_, "finished", i, -1, "the end of its drive"});
+    r.was_finished = !r.command;
+  }
+  if (!explored_) {
+    timing_.exploration += seconds_since(t0);
+    return;
+  }
   std::vector<exploration::ExplorerRobot> views;
   for (const Robot& r : robots_) views.push_back({&r.map, r.localizer->pose()});
   // Robots coordinate only when they can talk and share a map frame.
@@ -289,6 +338,7 @@ void Simulation::decide() {
     for (std::size_t j = 0; j < links.size(); ++j) links[i][j] = links[i][j] && robots_[i].frame == robots_[j].frame;
   explorer_.update(views, links);
   for (int i = 0; i < scenario_.robot_count; ++i) {
+    if (robots_[std::size_t(i)].driver) continue;
     const bool f = explorer_.finished(i);
     bool& was = robots_[std::size_t(i)].was_finished;
     if (f && !was) events_.push_back({step_, "finished", i, -1, "no reachable frontier left"});
@@ -301,8 +351,10 @@ void Simulation::measure() {
   const auto t0 = Clock::now();
   std::int64_t known = 0;
   const auto& cells = observable_.observable;
-  for (int idx : cells) known += merged_.log_odds_at(idx) != 0.0f;
-  coverage_.push_back(cells.empty() ? 1.0 : double(known) / double(cells.size()));
+  if (setup_.measure_coverage) {
+    for (int idx : cells) known += merged_.log_odds_at(idx) != 0.0f;
+    coverage_.push_back(cells.empty() ? 1.0 : double(known) / double(cells.size()));
+  }
   for (int i = 0; i < scenario_.robot_count; ++i) {
     const Robot& robot = robots_[std::size_t(i)];
     RobotTrack& t = robots_[std::size_t(i)].track;
@@ -325,15 +377,23 @@ void Simulation::step() {
   std::vector<core::Pose2> truths = true_poses();
   for (int i = 0; i < scenario_.robot_count; ++i) {
     Robot& robot = robots_[std::size_t(i)];
-    const auto path = explorer_.path(i);
     auto& loc = *robot.localizer;
     // Two blocked moves in a row: back away from the obstacle before following the path again.
     int& streak = robot.blocked_streak;
-    const Command cmd = streak >= 2 ? escape_command(loc.pose(), robot.map, scenario_.period_s)
-                                    : follow_path(loc.pose(), path, robot.map, scenario_.robot, scenario_.period_s,
-                                                  scenario_.lookahead_m);
-    const MoveResult mv =
-        move_robot(world_, i, truths, scenario_.robot, cmd, scenario_.period_s, scenario_.noise, robot.motion_rng);
+    Command cmd;
+    if (robot.driver) {
+      cmd = robot.command.value_or(Command{});
+    } else {
+      cmd = streak >= 2 ? escape_command(loc.pose(), robot.map, scenario_.period_s)
+                        : follow_path(loc.pose(), explorer_.path(i), robot.map, scenario_.robot, scenario_.period_s,
+                                      scenario_.lookahead_m);
+    }
+    MoveResult mv = move_robot(world_, i, truths, scenario_.robot, cmd, scenario_.period_s,
+                               robot.odometry_error ? MotionNoise{0.0, 0.0} : scenario_.noise, *robot.motion_rng);
+    if (robot.odometry_error) {
+      mv.pose.theta = core::normalize_angle(mv.pose.theta);
+      mv.odometry = misreport_odometry(mv.odometry, *robot.odometry_error, *robot.motion_rng);
+    }
     robot.truth = truths[std::size_t(i)] = mv.pose;
     auto& t = robot.track;
     t.distance_m += mv.distance_m;
@@ -343,7 +403,9 @@ void Simulation::step() {
       ++t.blocked_moves;
       events_.push_back({step_, "blocked", i, -1, "move stopped by a wall or a robot"});
     }
+    const auto t_predict = Clock::now();
     loc.predict(mv.odometry);
+    t.localization_s += seconds_since(t_predict);
   }
   timing_.motion += seconds_since(t0);
   sense_and_map();
@@ -353,105 +415,18 @@ void Simulation::step() {
   timing_.total += seconds_since(t_step);
 }
 
-RunResult Simulation::run(const ProgressCallback& progress, const std::function<void(const Simulation&)>& on_step) {
+void Simulation::run_to_end(const ProgressCallback& progress, const std::function<void(const Simulation&)>& on_step) {
   if (on_step) on_step(*this);
   while (!done()) {
     step();
     if (progress) progress(step_, scenario_.steps, coverage());
     if (on_step) on_step(*this);
   }
+}
+
+RunResult Simulation::run(const ProgressCallback& progress, const std::function<void(const Simulation&)>& on_step) {
+  run_to_end(progress, on_step);
   return result();
-}
-
-std::vector<UnexploredRegion> Simulation::unexplored_regions() const {
-  const auto& g = world_.geometry();
-  cv::Mat left(g.height(), g.width(), CV_8UC1, cv::Scalar(0));
-  for (int idx : observable_.observable)
-    if (merged_.log_odds_at(idx) == 0.0f) left.at<std::uint8_t>(idx / g.width(), idx % g.width()) = 1;
-  cv::Mat labels;
-  const int n = cv::connectedComponents(left, labels, 8, CV_32S);
-  std::vector<UnexploredRegion> out(std::size_t(std::max(0, n - 1)));
-  std::vector<std::vector<Eigen::Vector2d>> cells(out.size());
-  for (int idx : observable_.observable) {
-    const int label = labels.at<int>(idx / g.width(), idx % g.width());
-    if (label > 0) cells[std::size_t(label - 1)].push_back(g.cell_center(g.cell_of_index(idx)));
-  }
-  // What the robots' explorers left when they ran out of targets, in the world frame.
-  std::vector<exploration::TeamExplorer::LeftFrontier> frontiers;
-  for (int i = 0; i < scenario_.robot_count; ++i)
-    for (auto f : explorer_.left_frontiers(i)) {
-      f.position_m = frame_origin(i) * f.position_m;
-      frontiers.push_back(std::move(f));
-    }
-  const bool finished = explorer_.all_finished();
-  for (std::size_t k = 0; k < out.size(); ++k) {
-    auto& r = out[k];
-    r.area_m2 = double(cells[k].size()) * observable_.cell_area_m2;
-    for (const auto& c : cells[k]) r.centre_m += c;
-    r.centre_m /= double(std::max<std::size_t>(1, cells[k].size()));
-    if (!finished) {
-      r.reason = "step limit: the run ended with targets left";
-      continue;
-    }
-    // The nearest frontier piece the explorers left, if the region is within its reach: a piece is
-    // represented by one cell and reaches piece_radius_m from it (on cells of the explorer's size).
-    const double cell = std::max(g.resolution(), scenario_.exploration.planning_resolution_m);
-    double best = scenario_.exploration.targets.piece_radius_m + 2.0 * cell;
-    r.reason = "no frontier on the robots' maps: too small to be one, or closed off by cells mapped as walls";
-    for (const auto& f : frontiers)
-      for (const auto& c : cells[k])
-        if ((c - f.position_m).norm() < best) {
-          best = (c - f.position_m).norm();
-          r.reason = f.reason;
-        }
-  }
-  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.area_m2 > b.area_m2; });
-  return out;
-}
-
-RunResult Simulation::result() const {
-  RunResult r;
-  r.scenario = scenario_;
-  r.steps = step_;
-  r.finished = explorer_.all_finished();
-  r.coverage = coverage_;
-  for (std::size_t k = 0; k < coverage_.size(); ++k) {
-    if (!r.steps_to_95 && coverage_[k] >= 0.95) r.steps_to_95 = int(k);
-    if (!r.steps_to_99 && coverage_[k] >= 0.99) r.steps_to_99 = int(k);
-  }
-  std::int64_t sensed = 0, shared = 0;
-  for (int idx : observable_.observable) {
-    const int robots = std::popcount(sensed_by_[std::size_t(idx)]);
-    sensed += robots > 0;
-    shared += robots > 1;
-  }
-  r.redundancy = sensed ? double(shared) / double(sensed) : 0.0;
-  r.bytes_sent = bytes_sent_;
-  r.meetings = meetings_;
-  r.space.observable_cells = std::int64_t(observable_.observable.size());
-  r.space.unreachable_cells = std::int64_t(observable_.unreachable.size());
-  r.space.pose_cells = observable_.poses;
-  r.space.free_cells = observable_.free_cells;
-  r.space.cell_area_m2 = observable_.cell_area_m2;
-  for (int idx : observable_.unreachable)
-    if (merged_.log_odds_at(idx) != 0.0f) r.space.seen_unreachable.push_back(idx);
-  r.unexplored = unexplored_regions();
-  for (const Robot& robot : robots_) r.robots.push_back(robot.track);
-  for (int i = 0; i < scenario_.robot_count; ++i) r.robot_frames.push_back(frame_origin(i));
-  r.merges = merges_;
-  for (std::size_t i = 0; i < r.robots.size(); ++i) r.robots[i].localizer_counters = robots_[i].localizer->counters();
-  r.events = events_;
-  r.landmarks = world_.landmarks();
-  r.merged = merged_;
-  for (const Robot& robot : robots_) r.robot_maps.push_back(robot.map);
-  r.map_quality = mapping::map_quality(merged_, world_.truth());
-  for (int i = 0; i < scenario_.robot_count; ++i) {
-    r.robot_map_quality.push_back(
-        mapping::map_quality(robots_[std::size_t(i)].map, world_.truth(), r.robot_frames[std::size_t(i)]));
-  }
-  r.exploration = explorer_.stats();
-  r.timing = timing_;
-  return r;
 }
 
 }  // namespace fleetmap::sim

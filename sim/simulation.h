@@ -15,6 +15,7 @@
 #include "mapping/occupancy_grid.h"
 #include "merging/map_aligner.h"
 #include "sim/communication.h"
+#include "sim/driver.h"
 #include "sim/placement.h"
 #include "sim/scenario.h"
 #include "sim/world.h"
@@ -35,6 +36,8 @@ struct RobotTrack {
   std::vector<Eigen::Matrix3d> covariance;
   double distance_m = 0.0;
   int blocked_moves = 0;
+  double localization_s = 0.0;  // the localizer's time: predict and every update
+
   std::vector<std::pair<std::string, double>> localizer_counters;
 };
 
@@ -79,7 +82,7 @@ struct UnexploredRegion {
 struct RunResult {
   Scenario scenario;                 // as run: starts resolved, landmarks placed
   int steps = 0;                     // steps taken
-  bool finished = false;             // every robot ran out of reachable frontiers before the limit
+  bool finished = false;             // every robot ran out of reachable frontiers (or came to the end of its drive)
   // coverage[k] after step k (k = 0: the first scan, before moving): the share of the observable
   // cells of the ground truth (World::observable_space) that the merged map has observed.
   std::vector<double> coverage;
@@ -107,16 +110,52 @@ struct RunResult {
 // Called after every step with (step, step limit, coverage).
 using ProgressCallback = std::function<void(int, int, double)>;
 
+class Simulation;
+
+// How an experiment sets up a robot beyond what a scenario says. Every member may stay empty.
+struct RobotSetup {
+  // Drives the robot instead of the exploration.
+  std::shared_ptr<Driver> driver;
+  // Makes its localizer from the context the simulator built (start, seed, noise from the
+  // scenario), e.g. a registered localizer with the experiment's own noise model. Empty: the
+  // scenario's `localization` from the registry.
+  localization::LocalizerFactory localizer;
+  // Its random streams (motion noise, range and landmark sensors, robot detector). Empty: its own,
+  // forked from the scenario's seed, the detector reading from the sensors' stream. One stream may
+  // serve several (motion and sensors; two runs one after the other).
+  std::shared_ptr<core::Random> motion_rng, sensor_rng, detector_rng;
+  // León et al.'s odometry: no process noise on the motion, errors in what the encoders report.
+  std::optional<OdometryError> odometry_error;
+  // The grid of its own map, in its map frame (a robot in its own frame; default: large enough to
+  // hold the whole world around its start, however the frame is turned).
+  std::optional<core::GridGeometry> map_geometry;
+};
+
+// Two robots (a < b) whose link has just come up: an experiment's own exchange of what they know
+// (D'Alfonso et al.'s polynomials), which then replaces the frame alignment and the grid exchange.
+using MeetingHandler = std::function<void(Simulation&, int a, int b)>;
+
+struct SimulationSetup {
+  std::vector<RobotSetup> robots;  // by robot index; robots beyond the list get the defaults
+  // Coverage of the observable space, measured every step. Experiments that measure their own
+  // outputs switch it off (it needs the observable space of the whole map).
+  bool measure_coverage = true;
+  MeetingHandler on_meeting;
+};
+
 class Simulation {
  public:
   // Places the robots and takes the first readings. Throws InputError for starts in a wall,
   // outside the map, on another robot, or when the robots cannot all be placed.
-  Simulation(const Scenario& scenario, mapping::OccupancyGrid truth);
+  Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, SimulationSetup setup = {});
   ~Simulation();
 
+  // At the step limit, or every robot finished (out of reachable frontiers, or at the end of its drive).
   bool done() const;
   void step();
-  // Runs to the end; `progress` and `on_step` (for pictures) may be empty.
+  // Steps to the end; `progress` and `on_step` (for pictures, an experiment's outputs) may be empty.
+  void run_to_end(const ProgressCallback& progress = {}, const std::function<void(const Simulation&)>& on_step = {});
+  // Runs to the end and returns the result.
   RunResult run(const ProgressCallback& progress = {}, const std::function<void(const Simulation&)>& on_step = {});
 
   int step_count() const { return step_; }
@@ -127,6 +166,10 @@ class Simulation {
   std::vector<core::Pose2> true_poses() const;
   std::vector<core::Pose2> estimated_poses() const;
   const RobotTrack& track(int i) const { return robots_[std::size_t(i)].track; }
+  const localization::Localizer& localizer(int i) const { return *robots_[std::size_t(i)].localizer; }
+  localization::Localizer& localizer(int i) { return *robots_[std::size_t(i)].localizer; }
+  // The robots robot i detected this step.
+  const std::vector<Detection>& detections(int i) const { return robots_[std::size_t(i)].detections; }
   std::vector<Eigen::Vector2d> path(int i) const { return explorer_.path(i); }
   double coverage() const { return coverage_.empty() ? 0.0 : coverage_.back(); }
   // Where robot i's map frame lies in the world (identity with merging: known).
@@ -145,6 +188,8 @@ class Simulation {
   core::Pose2 in_world(int i, const core::Pose2& frame_pose) const;
   void decide();
   void measure();
+  bool finished(int i) const;
+  bool all_finished() const;
 
   // One robot of the run: where it truly is, what it knows (estimate, map in its map frame), its
   // random streams, and what the run records about it.
@@ -156,7 +201,10 @@ class Simulation {
     // world (known to the simulator only, for evaluation). With merging: known every robot is in
     // frame 0, the world's.
     int frame = 0;
-    core::Random motion_rng{0}, sensor_rng{0};
+    std::shared_ptr<core::Random> motion_rng, sensor_rng, detector_rng;
+    std::shared_ptr<Driver> driver;        // null: the explorer drives
+    std::optional<Command> command;        // the driver's for the next step; none: its drive is over
+    std::optional<OdometryError> odometry_error;
     std::vector<Detection> detections;  // this step's
     RobotTrack track;
     bool was_finished = false;
@@ -164,6 +212,8 @@ class Simulation {
   };
 
   Scenario scenario_;
+  SimulationSetup setup_;
+  bool explored_ = true;  // some robot is driven by the explorer
   World world_;
   core::Random rng_;
   std::vector<Robot> robots_;

@@ -1,4 +1,4 @@
-// sim/corridor_experiment.cpp and sim/corridor_output.cpp: León et al.'s corridor comparison and
+// experiments/corridor_experiment.cpp and experiments/corridor_output.cpp: León et al.'s corridor comparison and
 // merging by detection, on a small loop so that the test takes seconds.
 #include "experiments/corridor_experiment.h"
 
@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "core/format.h"
 #include "experiments/corridor_output.h"
 #include "tests/test_support.h"
 
@@ -48,7 +49,7 @@ TEST(CorridorWorld, HasTheLoopsDimensions) {
 
 TEST(CorridorExperiment, MeasuresEveryMethodAndShowsWhatADetectionErrorDoes) {
   const CorridorResult r = run_corridor_experiment(small_loop());
-  ASSERT_EQ(r.runs.size(), 8u);  // 4 methods x 2 lap counts
+  ASSERT_EQ(r.runs.size(), 10u);  // 5 methods x 2 lap counts
   for (const auto& run : r.runs) {
     ASSERT_TRUE(run.dimensions.found) << run.method;
     if (run.method == "ideal") {
@@ -98,18 +99,49 @@ TEST(CorridorExperiment, WritesTablesFiguresAndJson) {
   EXPECT_EQ(written.size(), 8u);
   const std::string csv = corridor_table_csv(r);
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
-            "method,laps,real_length_m,real_height_m,length_m,height_m,length_error_pct,height_error_pct,"
+            "method,seed,laps,real_length_m,real_height_m,length_m,height_m,length_error_pct,height_error_pct,"
             "final_position_error_m,seconds");
   EXPECT_NE(corridor_table_markdown(r).find("| Length (m) | 9.0 |"), std::string::npos);
 }
 
+TEST(CorridorExperiment, OverSeveralSeedsTableIGivesTheMeanAndTheSpread) {
+  auto o = small_loop();
+  o.laps = {1};
+  o.methods = {"odometry"};
+  o.merge_study = false;
+  o.seed = 2;
+  o.seeds = 3;
+  const CorridorResult r = run_corridor_experiment(o);
+  ASSERT_EQ(r.runs.size(), 3u);
+  std::vector<double> errors;
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(r.runs[k].seed, 2u + k);
+    errors.push_back(r.runs[k].final_position_error_m);
+  }
+  // Each seed its own drive: its own odometry noise, its own drift.
+  EXPECT_NE(errors[0], errors[1]);
+  EXPECT_NE(errors[1], errors[2]);
+  const double mean = (errors[0] + errors[1] + errors[2]) / 3.0;
+  double var = 0.0;
+  for (double e : errors) var += (e - mean) * (e - mean) / 2.0;
+  const std::string md = corridor_table_markdown(r);
+  EXPECT_NE(md.find("(seeds 2-4: mean ± standard deviation)"), std::string::npos) << md;
+  EXPECT_NE(md.find("| Final position error (m) | | " + core::fixed(mean, 2) + " ± " + core::fixed(std::sqrt(var), 2) + " |"),
+            std::string::npos)
+      << md;
+  // The first seed's run is the run of that seed alone.
+  o.seeds = 1;
+  EXPECT_EQ(run_corridor_experiment(o).runs[0].final_position_error_m, errors[0]);
+}
+
 TEST(CorridorOptionsParsing, ReadsTheScenarioAndRejectsBadKeys) {
   const std::string good =
-      "experiment: leon_corridor\nseed: 4\nworld:\n  length: 12\ndrive:\n  laps: [3, 1]\nmethods:\n  list: [odometry]\n";
+      "experiment: leon_corridor\nseed: 4\nseeds: 10\nworld:\n  length: 12\ndrive:\n  laps: [3, 1]\nmethods:\n  list: [odometry]\n";
   EXPECT_TRUE(is_corridor_scenario(good, "c.yaml"));
   EXPECT_FALSE(is_corridor_scenario("map: office\n", "s.yaml"));
   const CorridorOptions o = parse_corridor_options(good, "c.yaml");
   EXPECT_EQ(o.seed, 4u);
+  EXPECT_EQ(o.seeds, 10);
   EXPECT_EQ(o.length_m, 12.0);
   EXPECT_EQ(o.laps, (std::vector<int>{1, 3}));
   EXPECT_EQ(o.methods, std::vector<std::string>{"odometry"});
@@ -119,6 +151,7 @@ TEST(CorridorOptionsParsing, ReadsTheScenarioAndRejectsBadKeys) {
   expect_input_error([] { parse_corridor_options("experiment: leon_corridor\nworld:\n  length: -1\n", "c.yaml"); },
                      {"length"});
   expect_input_error([] { parse_corridor_options("experiment: other\n", "c.yaml"); }, {"experiment", "other"});
+  expect_input_error([] { parse_corridor_options("experiment: leon_corridor\nseeds: 0\n", "c.yaml"); }, {"seeds", "0"});
   auto bad = small_loop();
   bad.methods = {"mcl"};
   expect_input_error([&] { run_corridor_experiment(bad); }, {"methods.list", "'mcl'"});

@@ -1,4 +1,5 @@
-// `rbpf` (localization/rbpf_localizer.cpp) and its copy-on-write maps (localization/cow_grid.cpp).
+// `rbpf` and `fastslam-grid` (localization/rbpf_localizer.cpp) and their copy-on-write maps
+// (localization/cow_grid.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -174,6 +175,71 @@ TEST(RbpfLocalizer, CorrectsBiasedOdometry) {
   }
   EXPECT_GT((odometry.position() - truth.position()).norm(), 0.12);
   EXPECT_LT((pf->pose().position() - truth.position()).norm(), 0.04);
+}
+
+// Grid FastSLAM has no scan-matching proposal: one particle with no process noise is dead
+// reckoning, whatever the scans say (the same set-up as above makes the scan matcher move).
+TEST(GridFastSlam, WithOneParticleAndNoNoiseIsDeadReckoning) {
+  const auto room = asymmetric_room();
+  core::Random rng(11);
+  LocalizerContext c;
+  c.initial_pose = {1.5, 1.5, 0.2};
+  c.options.process_noise_xy = 0.0;
+  c.options.process_noise_theta = 0.0;
+  c.options.range_noise = 0.01;
+  c.options.rbpf_particles = 1;
+  auto fs = make_localizer("fastslam-grid", c);
+  auto odo = make_localizer("odometry", c);
+  EXPECT_EQ(fs->name(), "fastslam-grid");
+  mapping::OccupancyGrid own(room.geometry());
+  core::Pose2 truth = c.initial_pose;
+  for (int k = 0; k < 25; ++k) {
+    if (k > 0) {
+      const Odometry driven{0.15, k % 10 < 5 ? 0.0 : 0.1, 1.0};
+      truth = integrate_motion(truth, driven);
+      const Odometry reported{0.14, driven.omega + 0.004, 1.0};
+      fs->predict(reported);
+      odo->predict(reported);
+    }
+    const auto scan = scan_at(room, truth, 0.01, rng);
+    fs->update_scan(scan, own);
+    ASSERT_NEAR(fs->pose().x, odo->pose().x, 1e-9) << "step " << k;
+    ASSERT_NEAR(fs->pose().y, odo->pose().y, 1e-9) << "step " << k;
+    ASSERT_NEAR(core::normalize_angle(fs->pose().theta - odo->pose().theta), 0.0, 1e-9) << "step " << k;
+  }
+  EXPECT_GT((fs->pose().position() - truth.position()).norm(), 0.1);  // the bias was there to correct
+}
+
+// Its particles are drawn from the motion model and weighed by their scans on their own maps: with
+// enough of them the best one ends nearer the truth than dead reckoning.
+TEST(GridFastSlam, WeighsParticlesByTheirScansAndBeatsDeadReckoning) {
+  const auto room = asymmetric_room();
+  core::Random rng(4);
+  LocalizerContext c;
+  c.initial_pose = {1.5, 1.5, 0.0};
+  c.options.process_noise_xy = 0.01;
+  c.options.process_noise_theta = 0.005;
+  c.options.range_noise = 0.01;
+  c.options.rbpf_particles = 40;
+  c.seed = 3;
+  auto fs = make_localizer("fastslam-grid", c);
+  mapping::OccupancyGrid own(room.geometry());
+  core::Pose2 truth = c.initial_pose, odometry = c.initial_pose;
+  for (int k = 0; k < 30; ++k) {
+    if (k > 0) {
+      const Odometry driven{0.1, k < 15 ? 0.0 : 0.05, 1.0};
+      truth = integrate_motion(truth, driven);
+      const Odometry reported{0.095, driven.omega + 0.003, 1.0};
+      odometry = integrate_motion(odometry, reported);
+      fs->predict(reported);
+    }
+    fs->update_scan(scan_at(room, truth, 0.01, rng), own);
+  }
+  double resamplings = 0;
+  for (const auto& [name, value] : fs->counters())
+    if (name == "resamplings") resamplings = value;
+  EXPECT_GT(resamplings, 0);  // the weights told the particles apart
+  EXPECT_LT((fs->pose().position() - truth.position()).norm(), 0.5 * (odometry.position() - truth.position()).norm());
 }
 
 }  // namespace
