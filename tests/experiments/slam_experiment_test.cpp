@@ -123,19 +123,26 @@ TEST(SlamExperiment, ShapeInTheStateIsNotOverconfidentOnThePapersExperiment) {
 }
 
 TEST(SlamExperiment, WithRealisticOdometryNoiseSlamBeatsDeadReckoning) {
-  // 5 mm and 0.3 deg of odometry noise per step: dead reckoning drifts 0.1-0.3 m over 200 steps; in
-  // most runs every robot's SLAM estimate is closer to the truth than dead reckoning from the same
-  // start estimate (README: in 95, 80 and 90 of 100 runs for r1, r2, r3).
+  // 5 mm and 0.3 deg of odometry noise per step: dead reckoning drifts 0.1-0.4 m over 200 steps. Over
+  // 12 runs every robot's SLAM estimate is on average closer to the truth than dead reckoning from
+  // the same start estimate, and closer in more than half of the runs (README: r2, the weakest,
+  // in 80 of 100).
   const SlamScenario s = load_slam_scenario(std::string(FLEETMAP_SOURCE_DIR) + "/scenarios/dalfonso_odometry.yaml");
-  const PerRun m = per_run(s, 8);
+  ASSERT_TRUE(s.sampled_start);
+  const int runs = 12;
+  const PerRun m = per_run(s, runs);
   for (std::size_t i = 0; i < s.robots.size(); ++i) {
     int better = 0;
-    std::string runs;
-    for (std::size_t k = 0; k < m.rmse[i].size(); ++k) {
-      better += m.rmse[i][k] < m.dead_reckoning[i][k];
-      runs += fmt::format(" {:.3f}/{:.3f}", m.rmse[i][k], m.dead_reckoning[i][k]);
+    double slam = 0.0, dead_reckoning = 0.0;
+    std::string each;
+    for (int k = 0; k < runs; ++k) {
+      better += m.rmse[i][std::size_t(k)] < m.dead_reckoning[i][std::size_t(k)];
+      slam += m.rmse[i][std::size_t(k)] / runs;
+      dead_reckoning += m.dead_reckoning[i][std::size_t(k)] / runs;
+      each += fmt::format(" {:.3f}/{:.3f}", m.rmse[i][std::size_t(k)], m.dead_reckoning[i][std::size_t(k)]);
     }
-    EXPECT_GE(better, 5) << s.robots[i].name << ": SLAM/dead reckoning RMSE" << runs;
+    EXPECT_LT(slam, dead_reckoning) << s.robots[i].name << ": SLAM/dead reckoning RMSE" << each;
+    EXPECT_GT(better, runs / 2) << s.robots[i].name << ": SLAM/dead reckoning RMSE" << each;
   }
 }
 
