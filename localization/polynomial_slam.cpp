@@ -1,3 +1,7 @@
+// Over 500 lines on purpose: D'Alfonso et al.'s §3.1 (extraction, the three association cases,
+// Q_bad refits, clusters) and §3.3 (merging) act on one filter state and its landmark bookkeeping;
+// split across files, each part would need the others' private helpers. The reading model and the
+// fit's Jacobians (eq. (2), (5)) are free functions at the top and tested on their own.
 #include "localization/polynomial_slam.h"
 
 #include <Eigen/Dense>
