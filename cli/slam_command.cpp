@@ -35,6 +35,8 @@ struct SlamFlags {
   int jobs = 1;
   std::string out;
   bool quiet = false;
+  bool sampled_start = false;
+  bool exact_start = false;
 };
 
 std::string method_names() {
@@ -50,6 +52,8 @@ int run_slam(const SlamFlags& f) {
   experiments::SlamScenario s = experiments::load_slam_scenario(f.scenario);
   if (f.runs) s.runs = *f.runs;
   if (f.seed) s.seed = *f.seed;
+  if (f.sampled_start) s.sampled_start = true;
+  if (f.exact_start) s.sampled_start = false;
   io::OutputFolder folder(out, "slam", experiments::slam_output_files(s), {f.scenario}, "--out " + out.string());
   const experiments::SlamSetup setup = experiments::prepare_slam(s);
   folder.claim();
@@ -118,6 +122,13 @@ Command add_slam_command(CLI::App& root) {
   app->add_option("--out", f->out,
                   "Output folder: new, empty, or of an earlier slam run (its files are replaced) "
                   "[default: out/slam_<scenario name>]");
+  auto* sampled = app->add_flag("--sampled-start", f->sampled_start,
+                                "Start each robot's estimate off its true start by a draw from P0, so that the NEES "
+                                "measures consistency [default: the scenario's initial_sigma.sampled]");
+  app->add_flag("--exact-start", f->exact_start,
+                "Start each robot's estimate exactly at its true start, as D'Alfonso et al. do "
+                "[default: the scenario's initial_sigma.sampled]")
+      ->excludes(sampled);
   app->add_flag("--quiet,-q", f->quiet, "Print only the path of table1.md; no progress bar");
   return {app, [f]() { return run_slam(*f); }};
 }

@@ -266,6 +266,7 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
                                             sc.noise.position_m * sc.noise.position_m,
                                             sc.noise.heading_rad * sc.noise.heading_rad)
                                 .asDiagonal();
+  std::vector<core::Pose2> start_estimates;  // per robot, in its own frame
   SlamRunResult result;
   result.run = run;
   result.exchange = exchange;
@@ -288,13 +289,22 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
     const int r = team[std::size_t(a)];
     const SlamRobot& robot = sc.robots[std::size_t(r)];
     scenario.starts.push_back(robot.start);
+    // Each robot starts from x_j,0 = [0 0 0] in its own frame R_j,0 (§3.2), or from a draw of P0
+    // around it (sampled_start: then the truth is off the estimate as P0 says).
+    core::Pose2 start_estimate;
+    if (sc.sampled_start) {
+      core::Random start_rng = run_rng.fork(400 + std::uint64_t(r));
+      start_estimate = core::Pose2(start_rng.normal(0.0, sc.initial_sigma_xy), start_rng.normal(0.0, sc.initial_sigma_xy),
+                                   start_rng.normal(0.0, sc.initial_sigma_heading));
+    }
+    start_estimates.push_back(start_estimate);
     sim::RobotSetup rs;
     std::vector<sim::Command> commands;
     for (const auto& u : setup.commands[std::size_t(r)]) commands.push_back({u.v, u.omega});
     rs.driver = std::make_shared<sim::CommandScript>(std::move(commands));
-    // Each robot starts from x_j,0 = [0 0 0] in its own frame R_j,0: the simulator's initial pose.
-    rs.localizer = [&](const localization::LocalizerContext& c) {
-      return std::make_unique<TeamPolynomialSlam>(c.initial_pose, p0, q, sc.polynomial);
+    // The simulator's initial pose is x_j,0 in the robot's own frame; the filter starts there or at the draw.
+    rs.localizer = [&, start_estimate](const localization::LocalizerContext& c) {
+      return std::make_unique<TeamPolynomialSlam>(c.initial_pose.compose(start_estimate), p0, q, sc.polynomial);
     };
     // Streams by the robot's index in the scenario, so that a robot alone has its noise in the team.
     rs.motion_rng = std::make_shared<core::Random>(run_rng.fork(100 + std::uint64_t(r)));
@@ -335,6 +345,15 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
     const core::Transform2 frame = sc.robots[std::size_t(team[std::size_t(a)])].start.as_transform();
     const std::vector<mapping::Polynomial> polys = s.map().polynomials();
     rr.localization = metrics[std::size_t(a)].summary();
+    double dr_sq = 0.0;
+    const auto& planned = setup.planned[std::size_t(team[std::size_t(a)])];
+    const core::Pose2& start = sc.robots[std::size_t(team[std::size_t(a)])].start;
+    // From the same start estimate as the filter's: start * x_0 * start^-1 * planned_k.
+    const core::Pose2 from = start.compose(start_estimates[std::size_t(a)]).compose(start.inverse());
+    for (std::size_t k = 0; k < rr.truth.size(); ++k) {
+      dr_sq += (rr.truth[k].position() - from.compose(planned[k]).position()).squaredNorm();
+    }
+    rr.dead_reckoning_rmse = std::sqrt(dr_sq / double(rr.truth.size()));
     rr.mapping = mapping::mapping_error(polys, frame, setup.walls, 0.01);
     rr.boundary_coverage = mapping::boundary_coverage(polys, frame, setup.walls, 0.1, 0.02);
     rr.tau_s = (simulation.track(a).localization_s + exchanges->seconds(a)) / double(sc.steps + 1);

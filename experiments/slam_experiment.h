@@ -61,6 +61,10 @@ struct SlamRobotResult {
   std::vector<core::Pose2> truth;     // k = 0..steps, room frame
   std::vector<core::Pose2> estimate;  // the estimate brought into the room frame by the true start
   localization::LocalizationSummary localization;  // mu (dalfonso_mu), the standard NEES, RMSE
+  // Dead reckoning on the same run: the odometry integrated from the filter's start estimate. The odometry is the
+  // precomputed commands (the noise is the model's w_k, on the true motion), so this is the
+  // noise-free path, unless a move was cut short by a wall.
+  double dead_reckoning_rmse = 0.0;  // m
   mapping::MappingError mapping;      // nu
   double boundary_coverage = 0.0;     // share of the true walls within 0.1 m of the map
   double tau_s = 0.0;                 // mean SLAM time per step (predict, update, received maps)

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 #include "io/file_io.h"
+#include "localization/metrics.h"
 #include "io/map_io.h"
 #include "viz/render.h"
 
@@ -36,6 +37,8 @@ const std::vector<Metric>& metrics() {
       {"mean_distance_m", "mean distance of the map to the true walls, m", "{:.3g}",
        [](const SlamRobotResult& r) { return r.mapping.mean_distance; }},
       {"position_rmse_m", "position RMSE, m", "{:.3g}", [](const SlamRobotResult& r) { return r.localization.position_rmse; }},
+      {"dead_reckoning_rmse_m", "position RMSE of dead reckoning on the same runs, m", "{:.3g}",
+       [](const SlamRobotResult& r) { return r.dead_reckoning_rmse; }},
       {"walls_mapped_pct", "true walls within 0.1 m of the map, %", "{:.3g}",
        [](const SlamRobotResult& r) { return 100.0 * r.boundary_coverage; }},
       {"polynomials", "polynomials in the map", "{:.3g}", [](const SlamRobotResult& r) { return double(r.polynomials); }},
@@ -159,6 +162,27 @@ std::string slam_table_markdown(const SlamSetup& setup, const SlamCampaign& c, b
       }
       md << "\n";
     }
+  }
+  // Consistency: the mean of N runs' NEES against its 95% chi-square band.
+  md << "\n## Consistency\n\n"
+     << "A consistent filter's NEES is chi2(3) at every step. Each run's NEES above is its mean over "
+     << setup.scenario.steps + 1 << " steps; these are strongly correlated in time, so a run's mean is taken as one "
+     << "chi2(3) value (the widest band) and the mean of N runs must lie in chi2(3N)/N's 95% band "
+     << "(Bar-Shalom et al. 2001); with independent steps the band would be chi2(3N(k_f+1))/(N(k_f+1))'s, narrower.\n\n";
+  for (const auto& col : cols) {
+    std::vector<double> v;
+    for (const auto& run : *col.runs) {
+      for (const auto& r : run.robots) {
+        if (r.name == col.name && r.localization.average_nees) v.push_back(*r.localization.average_nees);
+      }
+    }
+    if (v.empty()) continue;
+    const double mean = mean_std(v).mean;
+    const auto band = localization::average_chi_square_band(3, long(v.size()));
+    const auto narrow = localization::average_chi_square_band(3, long(v.size()) * (setup.scenario.steps + 1));
+    md << fmt::format("- {}: mean NEES {:.3g} over {} runs, {} the band [{:.3g}, {:.3g}] (independent steps: [{:.3g}, {:.3g}])\n",
+                      col.title, mean, v.size(), band.contains(mean) ? "inside" : (mean > band.upper ? "above" : "below"),
+                      band.lower, band.upper, narrow.lower, narrow.upper);
   }
   // Bytes per rendezvous message, polynomials against the equivalent grid patch.
   std::vector<double> per_run, polys, bytes, grid;

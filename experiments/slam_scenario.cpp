@@ -150,6 +150,7 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
     auto p0 = top.map("initial_sigma");
     s.initial_sigma_xy = p0.number("xy", s.initial_sigma_xy, 0.0, 1e3);
     s.initial_sigma_heading = p0.number("heading", s.initial_sigma_heading, 0.0, 10.0);
+    s.sampled_start = p0.boolean("sampled", s.sampled_start);
     p0.finish();
   }
   {
@@ -180,6 +181,8 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
     o.cluster_tolerance = p.number("cluster_tolerance", o.cluster_tolerance, 1e-6, 10.0);
     o.shape_noise = p.boolean("shape_noise", o.shape_noise);
     o.lowest_order = p.boolean("lowest_order", o.lowest_order);
+    o.shape_in_state = p.boolean("shape_in_state", o.shape_in_state);
+    o.feature_noise = p.number("feature_noise", o.feature_noise, 0.0, 1.0);
     p.finish();
   }
   top.finish();

@@ -24,12 +24,14 @@ namespace {
 Eigen::VectorXd covariance_times_h(const Eigen::MatrixXd& p, const ScalarReading& r) {
   Eigen::VectorXd ph = p.leftCols<3>() * r.h_pose.transpose();
   if (r.slot >= 0) ph += r.h_slot * p.col(3 + r.slot);
+  for (const auto& [slot, h] : r.h_more) ph += h * p.col(3 + slot);
   return ph;
 }
 
 double h_times(const Eigen::VectorXd& v, const ScalarReading& r) {
   double s = r.h_pose.dot(v.head<3>());
   if (r.slot >= 0) s += r.h_slot * v(3 + r.slot);
+  for (const auto& [slot, h] : r.h_more) s += h * v(3 + slot);
   return s;
 }
 
@@ -64,19 +66,34 @@ void PolynomialEkf::update(double z, const ScalarReading& r) {
 }
 
 int PolynomialEkf::augment(const LandmarkGeneration& g) {
+  BlockGeneration b;
+  b.value = Eigen::VectorXd::Constant(1, g.value);
+  b.g_pose = g.g_pose;
+  for (const auto& [slot, d] : g.g_slots) b.g_slots.emplace_back(slot, Eigen::VectorXd::Constant(1, d));
+  b.noise = Eigen::MatrixXd::Constant(1, 1, g.noise_variance);
+  return augment(b);
+}
+
+int PolynomialEkf::augment(const BlockGeneration& g) {
   const Eigen::Index n = mean_.size();
-  // g_x P: the new row of G_x P G_x^T, from the pose rows and the rows of the source slots.
-  Eigen::RowVectorXd gp = g.g_pose * covariance_.topRows<3>();
-  for (const auto& [slot, d] : g.g_slots) gp += d * covariance_.row(3 + slot);
-  double diag = gp.head<3>().dot(g.g_pose);
-  for (const auto& [slot, d] : g.g_slots) diag += d * gp(3 + slot);
-  diag += g.noise_variance;
-  covariance_.conservativeResize(n + 1, n + 1);
-  covariance_.block(n, 0, 1, n) = gp;
-  covariance_.block(0, n, n, 1) = gp.transpose();
-  covariance_(n, n) = diag;
-  mean_.conservativeResize(n + 1);
-  mean_(n) = g.value;
+  const Eigen::Index k = g.value.size();
+  if (g.g_pose.rows() != k || g.g_pose.cols() != 3 || g.noise.rows() != k || g.noise.cols() != k) {
+    throw Error("PolynomialEkf::augment: a block of k entries needs a k x 3 g_pose and a k x k noise");
+  }
+  // J P: the new rows of G_x P G_x^T, from the pose rows and the rows of the source slots.
+  Eigen::MatrixXd jp = g.g_pose * covariance_.topRows<3>();
+  for (const auto& [slot, d] : g.g_slots) {
+    if (d.size() != k) throw Error("PolynomialEkf::augment: a slot's derivative needs one entry per new entry");
+    jp += d * covariance_.row(3 + slot);
+  }
+  Eigen::MatrixXd block = jp.leftCols<3>() * g.g_pose.transpose() + g.noise;
+  for (const auto& [slot, d] : g.g_slots) block += jp.col(3 + slot) * d.transpose();
+  covariance_.conservativeResize(n + k, n + k);
+  covariance_.block(n, 0, k, n) = jp;
+  covariance_.block(0, n, n, k) = jp.transpose();
+  covariance_.block(n, n, k, k) = 0.5 * (block + block.transpose());
+  mean_.conservativeResize(n + k);
+  mean_.tail(k) = g.value;
   return int(n) - 3;
 }
 
@@ -94,22 +111,31 @@ void PolynomialEkf::remove(const std::vector<int>& slots) {
 
 void PolynomialEkf::change_frame(const core::Transform2& t, const std::vector<double>& positions,
                                  const std::vector<double>& scales) {
-  const Eigen::Index n = mean_.size();
-  if (Eigen::Index(positions.size()) != n - 3 || Eigen::Index(scales.size()) != n - 3) {
+  const Eigen::Index n = mean_.size() - 3;
+  if (Eigen::Index(positions.size()) != n || Eigen::Index(scales.size()) != n) {
     throw Error("PolynomialEkf::change_frame: one position and one scale per landmark expected");
   }
-  const core::Pose2 moved = core::Pose2::from_transform(t * pose().as_transform());
-  mean_.head<3>() << moved.x, moved.y, core::normalize_angle(moved.theta);
-  Eigen::VectorXd scale = Eigen::VectorXd::Ones(n);
-  for (Eigen::Index s = 0; s < n - 3; ++s) {
-    mean_(3 + s) = positions[std::size_t(s)];
-    scale(3 + s) = scales[std::size_t(s)];
-  }
   // A = diag(R, 1, scales): rows and columns of the landmarks scale, the position block turns.
-  covariance_ = scale.asDiagonal() * covariance_ * scale.asDiagonal();
-  const Eigen::Matrix2d r = t.rotation_matrix();
-  covariance_.topRows<2>() = r * covariance_.topRows<2>();
-  covariance_.leftCols<2>() = covariance_.leftCols<2>() * r.transpose();
+  change_frame(t, Eigen::Map<const Eigen::VectorXd>(positions.data(), n),
+               Eigen::Map<const Eigen::VectorXd>(scales.data(), n).asDiagonal().toDenseMatrix());
+}
+
+void PolynomialEkf::change_frame(const core::Transform2& t, const Eigen::VectorXd& values,
+                                 const Eigen::MatrixXd& jacobian) {
+  const Eigen::Index n = mean_.size() - 3;
+  const Eigen::Index m = values.size();
+  if (jacobian.rows() != m || jacobian.cols() != n) {
+    throw Error("PolynomialEkf::change_frame: one value per new slot and a new x old jacobian expected");
+  }
+  const core::Pose2 moved = core::Pose2::from_transform(t * pose().as_transform());
+  Eigen::VectorXd mean(m + 3);
+  mean << moved.x, moved.y, core::normalize_angle(moved.theta), values;
+  mean_ = std::move(mean);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m + 3, n + 3);
+  a.topLeftCorner<2, 2>() = t.rotation_matrix();
+  a(2, 2) = 1.0;
+  a.bottomRightCorner(m, n) = jacobian;
+  covariance_ = a * covariance_ * a.transpose();
   symmetrise(covariance_);
 }
 

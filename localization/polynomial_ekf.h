@@ -1,9 +1,10 @@
 #pragma once
 // The extended Kalman filter of D'Alfonso et al.'s polynomial SLAM (§3.1): the augmented state
 // X = [x, y, theta, c0_1, ..., c0_n], the pose followed by one position coefficient c_0 per
-// polynomial landmark ("slots" 0, 1, ... in state order). Readings are scalar (a distance along a
-// sensor axis, eq. (2)); landmarks enter by the covariance augmentation of eq. (4)-(5) and leave
-// by removing their rows and columns.
+// polynomial landmark ("slots" 0, 1, ... in state order), or, with the shape in the state, a block
+// [c0, a_1..a_m] per landmark (PolynomialSlam decides what the slots mean). Readings are scalar (a
+// distance along a sensor axis, eq. (2)); landmarks enter by the covariance augmentation of
+// eq. (4)-(5) and leave by removing their rows and columns.
 // Contract: the covariance stays symmetric (Joseph-form updates, symmetrised) and the heading in (-pi, pi].
 #include <Eigen/Core>
 
@@ -22,6 +23,7 @@ struct ScalarReading {
   Eigen::RowVector3d h_pose = Eigen::RowVector3d::Zero();   // dh / d(x, y, theta)
   int slot = -1;                                            // the landmark read, -1 for none
   double h_slot = 0.0;                                      // dh / d c0_slot
+  std::vector<std::pair<int, double>> h_more;               // (slot, dh / d X_slot): further entries (shape)
   double noise = 0.0;                                       // Var(v)
 };
 
@@ -35,12 +37,24 @@ struct LandmarkGeneration {
   double noise_variance = 0.0;
 };
 
+// A block of k new entries X_new = g(X, y) (eq. (4)-(5) for a landmark with its shape in the
+// state): G_x = [I_n; J] with J = [g_pose, 0, ..., g_slots columns], and G_y V G_y^T = `noise`.
+struct BlockGeneration {
+  Eigen::VectorXd value;                                    // k
+  Eigen::MatrixXd g_pose;                                   // k x 3
+  std::vector<std::pair<int, Eigen::VectorXd>> g_slots;     // (slot, d X_new / d X_slot, k)
+  Eigen::MatrixXd noise;                                    // k x k
+};
+
 class PolynomialEkf {
  public:
   PolynomialEkf(const core::Pose2& initial_pose, const Eigen::Matrix3d& initial_covariance);
 
   // x <- f(x, u) (the exact differential-drive arc); P_rr <- F P_rr F^T + Q, P_rl <- F P_rl.
   void predict(const Odometry& u, const Eigen::Matrix3d& process_noise);
+
+  // P_ss += variance: process noise on a landmark entry.
+  void add_noise(int slot, double variance) { covariance_(3 + slot, 3 + slot) += variance; }
 
   // S = H P H^T + R.
   double innovation_variance(const ScalarReading& r) const;
@@ -50,6 +64,8 @@ class PolynomialEkf {
 
   // D'Alfonso et al. eq. (4): appends c0_new and P~ = G_x P G_x^T + G_y V G_y^T; returns the new slot.
   int augment(const LandmarkGeneration& g);
+  // The same for a block of entries; returns the first new slot.
+  int augment(const BlockGeneration& g);
   // Removes the slots' rows and columns (D'Alfonso et al., §3.1); later slots move down to fill the gaps.
   void remove(const std::vector<int>& slots);
   // Re-expresses the state in another frame, x_new = new_from_old * x_old, where each landmark's
@@ -57,12 +73,17 @@ class PolynomialEkf {
   // X <- (pose moved, positions), P <- A P A^T with A = diag(R, 1, scales).
   void change_frame(const core::Transform2& new_from_old, const std::vector<double>& positions,
                     const std::vector<double>& scales);
+  // The general form: the slots' new values and d X_new / d X_old over all slots (n_new x n_old):
+  // P <- A P A^T with A = diag(R, 1, jacobian).
+  void change_frame(const core::Transform2& new_from_old, const Eigen::VectorXd& values,
+                    const Eigen::MatrixXd& jacobian);
 
   core::Pose2 pose() const { return {mean_(0), mean_(1), mean_(2)}; }
   Eigen::Matrix3d pose_covariance() const { return covariance_.topLeftCorner<3, 3>(); }
   int slots() const { return static_cast<int>(mean_.size()) - 3; }
   double position(int slot) const { return mean_(3 + slot); }
   double position_variance(int slot) const { return covariance_(3 + slot, 3 + slot); }
+  double value(int slot) const { return mean_(3 + slot); }
   const Eigen::VectorXd& mean() const { return mean_; }
   const Eigen::MatrixXd& covariance() const { return covariance_; }
 

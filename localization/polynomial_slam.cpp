@@ -1,3 +1,7 @@
+// Over 500 lines on purpose: D'Alfonso et al.'s §3.1 (extraction, the three association cases,
+// Q_bad refits, clusters) and §3.3 (merging) act on one filter state and its landmark bookkeeping;
+// split across files, each part would need the others' private helpers. The reading model and the
+// fit's Jacobians (eq. (2), (5)) are free functions at the top and tested on their own.
 #include "localization/polynomial_slam.h"
 
 #include <Eigen/Dense>
@@ -24,8 +28,10 @@ struct PolynomialSlam::SourcePoint {
   double weight = 1.0;
   Eigen::Vector2d observer = Eigen::Vector2d::Zero();
   Eigen::Vector2d beam = Eigen::Vector2d::UnitX();
-  int slot = -1;
+  long step = 0;                      // Measured: the step it was read at
+  int slot = -1;                      // OnLandmark: the landmark's index
   Eigen::Vector2d shift = Eigen::Vector2d::Zero();
+  Eigen::VectorXd basis;              // OnLandmark: d position / d the landmark's entries, along `shift`
   int group = -1;
   double variance = 0.0;
   double angle_variance = 0.0;
@@ -37,6 +43,7 @@ struct PolynomialSlam::SourcePoint {
     s.weight = q.weight;
     s.observer = q.observer;
     s.beam = q.beam;
+    s.step = q.step;
     return s;
   }
 };
@@ -62,6 +69,81 @@ void validate(const PolynomialSlamOptions& o) {
   if (!(o.min_incidence_cos >= 0.0 && o.min_incidence_cos < 1.0)) fail("min_incidence_cos", "a number in [0, 1)", o.min_incidence_cos);
   if (!std::isfinite(o.domain_margin)) fail("domain_margin", "a finite number", o.domain_margin);
   if (!(o.cluster_tolerance > 0.0)) fail("cluster_tolerance", "a positive number", o.cluster_tolerance);
+  if (!(o.feature_noise >= 0.0) || !std::isfinite(o.feature_noise)) fail("feature_noise", "a finite number >= 0", o.feature_noise);
+}
+
+Eigen::VectorXd ShapeBasis::at(double xi) const {
+  Eigen::VectorXd b(size);
+  const double t = (xi - centre) / scale;
+  double power = 1.0;
+  for (int j = 0; j < size; ++j, power *= t) b(j) = power;
+  return b;
+}
+
+mapping::Polynomial polynomial_from_entries(const mapping::Polynomial& reference, const ShapeBasis& basis,
+                                            const Eigen::VectorXd& entries) {
+  mapping::Polynomial p = reference;
+  p.position = entries(0);
+  const int m = p.order();
+  // sum_j a_j ((xi - c) / s)^j = sum_l xi^l sum_{j >= l} a_j C(j, l) (-c)^(j - l) / s^j.
+  for (int j = 1; j < basis.size && j < entries.size(); ++j) {
+    const double aj = entries(j) / std::pow(basis.scale, j);
+    double binom = 1.0;  // C(j, l) for l = j, j - 1, ...
+    double shift = 1.0;  // (-c)^(j - l)
+    for (int l = j; l >= 0; --l) {
+      const double d = aj * binom * shift;
+      if (l == 0) {
+        p.position += d;
+      } else if (l <= m) {
+        p.shape[std::size_t(m - l)] += d;
+      }
+      binom = binom * double(l) / double(j - l + 1);
+      shift *= -basis.centre;
+    }
+  }
+  return p;
+}
+
+std::optional<ScalarReading> range_reading(const mapping::Polynomial& reference, const ShapeBasis& basis,
+                                           const Eigen::VectorXd& entries, int first_slot, const core::Pose2& pose,
+                                           double sensor_angle, double max_distance, double domain_margin,
+                                           double* cos_incidence) {
+  const mapping::Polynomial p = polynomial_from_entries(reference, basis, entries);
+  const auto hit = mapping::intersect_ray(p, pose.position(), pose.theta + sensor_angle, max_distance, domain_margin);
+  if (!hit) return std::nullopt;
+  ScalarReading r;
+  r.predicted = hit->distance;
+  r.h_pose << hit->d_origin.x(), hit->d_origin.y(), hit->d_angle;
+  r.slot = first_slot;
+  r.h_slot = hit->d_position;
+  // dF / d a_j = t^j where F = p(xi) - eta: dh / d a_j = t^j dh / d c_0.
+  const Eigen::VectorXd b = basis.at(hit->xi);
+  for (int j = 1; j < basis.size; ++j) r.h_more.emplace_back(first_slot + j, hit->d_position * b(j));
+  if (cos_incidence) *cos_incidence = hit->cos_incidence;
+  return r;
+}
+
+std::vector<Eigen::MatrixXd> fit_gradient(const mapping::Polynomial& polynomial, const ShapeBasis& basis,
+                                          const std::vector<mapping::WeightedPoint>& points) {
+  // beta = (A^T W A)^-1 A^T W eta with A_k = basis.at(xi_k)^T: d beta / d eta_k = N^-1 A_k^T w_k,
+  // and a shift d xi_k moves the residual eta_k - p(xi_k) as an eta shift of -p'(xi_k) d xi_k.
+  Eigen::MatrixXd n = Eigen::MatrixXd::Zero(basis.size, basis.size);
+  std::vector<Eigen::VectorXd> rows;
+  rows.reserve(points.size());
+  for (const auto& q : points) {
+    rows.push_back(basis.at(polynomial.local(q.position).x()));
+    n += q.weight * rows.back() * rows.back().transpose();
+  }
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(n);
+  std::vector<Eigen::MatrixXd> out;
+  out.reserve(points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const double xi = polynomial.local(points[k].position).x();
+    const Eigen::VectorXd m = ldlt.solve(points[k].weight * rows[k]);
+    const Eigen::Vector2d direction = polynomial.world(Eigen::Vector2d(-polynomial.slope(xi), 1.0));
+    out.push_back(m * direction.transpose());
+  }
+  return out;
 }
 
 namespace {
@@ -103,16 +185,29 @@ PolynomialSlam::PolynomialSlam(const core::Pose2& initial_pose, const Eigen::Mat
 void PolynomialSlam::predict(const Odometry& u) {
   ++step_;
   filter_.predict(u, process_noise_);
+  if (options_.feature_noise > 0.0) {
+    for (int s = 0; s < filter_.slots(); ++s) filter_.add_noise(s, options_.feature_noise);
+  }
+}
+
+int PolynomialSlam::first_slot(int landmark) const {
+  int slot = 0;
+  for (int i = 0; i < landmark; ++i) slot += bases_[std::size_t(i)].basis.size;
+  return slot;
+}
+
+Eigen::VectorXd PolynomialSlam::entries(int index) const {
+  const int first = first_slot(index);
+  return filter_.mean().segment(3 + first, bases_[std::size_t(index)].basis.size);
 }
 
 mapping::Polynomial PolynomialSlam::current(int index) const {
-  mapping::Polynomial p = map_.landmarks[std::size_t(index)].polynomial;
-  p.position = filter_.position(index);
-  return p;
+  const LandmarkState& l = bases_[std::size_t(index)];
+  return polynomial_from_entries(l.reference, l.basis, entries(index));
 }
 
 void PolynomialSlam::sync_positions() {
-  for (std::size_t i = 0; i < map_.landmarks.size(); ++i) map_.landmarks[i].polynomial.position = filter_.position(int(i));
+  for (std::size_t i = 0; i < map_.landmarks.size(); ++i) map_.landmarks[i].polynomial = current(int(i));
 }
 
 void PolynomialSlam::update(const std::vector<double>& angles, const std::vector<std::optional<double>>& ranges) {
@@ -157,30 +252,29 @@ void PolynomialSlam::update(const std::vector<double>& angles, const std::vector
     if (index < 0) continue;  // replaced by a refit or a merge in this step
     const core::Pose2 now = filter_.pose();
     const double y = *ranges[i];
-    const auto hit = mapping::intersect_ray(current(index), now.position(), now.theta + angles[i],
-                                            y + options_.sigma_max + 1.0, options_.domain_margin);
-    if (!hit || hit->cos_incidence < options_.min_incidence_cos) {
+    const LandmarkState& state = bases_[std::size_t(index)];
+    double cos_incidence = 0.0;
+    auto model = range_reading(state.reference, state.basis, entries(index), first_slot(index), now, angles[i],
+                               y + options_.sigma_max + 1.0, options_.domain_margin, &cos_incidence);
+    if (!model || cos_incidence < options_.min_incidence_cos) {
       ++counters_.rejected_readings;
       continue;
     }
-    ScalarReading reading;
-    reading.predicted = hit->distance;
-    reading.h_pose << hit->d_origin.x(), hit->d_origin.y(), hit->d_angle;
-    reading.slot = index;
-    reading.h_slot = hit->d_position;
+    ScalarReading& reading = *model;
     reading.noise = r;
-    if (options_.shape_noise) {
+    if (options_.shape_noise && !options_.shape_in_state) {
       // The shape's own uncertainty at the point read: a shift along the independent axis moves
       // the curve by -p' delta, a turn phi about the domain's middle by ((xi - xc) + p' (p - p_c)) phi.
       const mapping::Polynomial p = current(index);
       const auto& landmark = map_.landmarks[std::size_t(index)];
-      const double d = p.slope(hit->xi), xc = 0.5 * (p.lo + p.hi);
-      const double lever = (hit->xi - xc) + d * (p.value(hit->xi) - p.value(xc));
-      reading.noise += hit->d_position * hit->d_position *
+      const Eigen::Vector2d at = p.local(now.position() + reading.predicted * Eigen::Vector2d(std::cos(now.theta + angles[i]), std::sin(now.theta + angles[i])));
+      const double d = p.slope(at.x()), xc = 0.5 * (p.lo + p.hi);
+      const double lever = (at.x() - xc) + d * (p.value(at.x()) - p.value(xc));
+      reading.noise += reading.h_slot * reading.h_slot *
                        (d * d * landmark.along_variance + lever * lever * landmark.angle_variance);
     }
     const double s = filter_.innovation_variance(reading);
-    const double nu = y - hit->distance;
+    const double nu = y - reading.predicted;
     if (!(s > 0.0) || nu * nu / s > options_.innovation_gate) {
       ++counters_.rejected_readings;
       continue;
@@ -199,6 +293,7 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
   const mapping::PolynomialAxis axis = mapping::principal_axis(weighted);
   auto fit = mapping::fit_polynomial(weighted, options_.order, axis);
   if (!fit || !(fit->max_residual <= max_residual)) return std::nullopt;
+  int fit_order = options_.order;
   if (options_.lowest_order) {
     // The lowest order whose fit explains the points as well as order m does, within the noise:
     // its weighted RMS residual at most that of order m plus half a reading's standard deviation.
@@ -209,6 +304,7 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
         // Kept as an order-m polynomial whose leading coefficients are zero.
         lower->polynomial.shape.insert(lower->polynomial.shape.begin(), std::size_t(options_.order - order), 0.0);
         fit = std::move(lower);
+        fit_order = order;
         break;
       }
     }
@@ -217,62 +313,116 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
   // refit of Q_bad points beyond p's end with R on p, say); such a polynomial maps nothing seen.
   if (mapping::stray_between_points(fit->polynomial, weighted) > options_.sigma_max) return std::nullopt;
 
-  // D'Alfonso et al. eq. (5): the gradient of c0_new = g(X, y) with respect to the pose, the source
-  // landmarks' c0 and the readings, at x_k|k-1 and y_k.
-  const std::vector<Eigen::Vector2d> grad = mapping::position_gradient(fit->polynomial, weighted);
-  const Eigen::Vector2d dependent = fit->polynomial.dependent_direction();
-  LandmarkGeneration g;
-  g.value = fit->polynomial.position;
+  // D'Alfonso et al. eq. (5): the gradient of the new entries g(X, y) (c0, and the shape when it is in
+  // the state) with respect to the pose, the source landmarks' entries and the readings, at x_k|k-1
+  // and y_k. Every point is a function of the current pose: one read k steps ago moved with the
+  // pose since (lever arm from the current position), plus the process noise of those k steps.
+  const mapping::Polynomial& shape = fit->polynomial;
+  ShapeBasis basis;
+  basis.centre = 0.5 * (shape.lo + shape.hi);
+  basis.scale = std::max(0.5 * (shape.hi - shape.lo), 1e-3);
+  basis.size = options_.shape_in_state ? fit_order + 1 : 1;
+  const int k = basis.size;
+  const std::vector<Eigen::MatrixXd> grad = fit_gradient(shape, basis, weighted);
+  const core::Pose2 x_now = filter_.pose();
+  const Eigen::Vector2d dependent = shape.dependent_direction();
+  BlockGeneration g;
+  g.value = Eigen::VectorXd::Zero(k);
+  g.value(0) = shape.position;
+  g.g_pose = Eigen::MatrixXd::Zero(k, 3);
+  g.noise = Eigen::MatrixXd::Zero(k, k);
   const double r = std::pow(std::max(options_.range_noise, kMinRangeStd), 2);
-  std::vector<std::pair<int, double>> group_shift;  // per received group: sum of g . dependent
-  for (std::size_t k = 0; k < points.size(); ++k) {
-    const SourcePoint& p = points[k];
-    const Eigen::Vector2d& gk = grad[k];
+  std::vector<std::pair<int, Eigen::MatrixXd>> by_age;     // (steps since read, sum of d g / d pose of those points)
+  std::vector<std::pair<int, Eigen::VectorXd>> slot_grad;  // (slot, d g / d X_slot)
+  struct Group {
+    int id;
+    Eigen::VectorXd shift, turn;
+    Eigen::Vector2d centroid;
+    int count;
+    double variance, angle_variance;
+  };
+  std::vector<Group> groups;
+  for (const auto& p : points) {
+    if (p.kind != SourcePoint::Kind::Received) continue;
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const Group& gr) { return gr.id == p.group; });
+    if (it == groups.end()) {
+      groups.push_back({p.group, Eigen::VectorXd::Zero(k), Eigen::VectorXd::Zero(k), Eigen::Vector2d::Zero(), 0,
+                        p.variance, p.angle_variance});
+      it = groups.end() - 1;
+    }
+    it->centroid += p.position;
+    ++it->count;
+  }
+  for (auto& gr : groups) gr.centroid /= double(gr.count);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const SourcePoint& p = points[i];
+    const Eigen::MatrixXd& gk = grad[i];  // k x 2
     switch (p.kind) {
-      case SourcePoint::Kind::Measured:
-        // pi = observer + y u: d pi / d(x, y, theta) = [I | perp(pi - observer)], d pi / d y = u.
-        g.g_pose += Eigen::RowVector3d(gk.x(), gk.y(), gk.dot(perp(p.position - p.observer)));
-        g.noise_variance += std::pow(gk.dot(p.beam), 2) * r;
+      case SourcePoint::Kind::Measured: {
+        // pi = observer + y u, moved with the pose: d pi / d(x, y, theta) = [I | perp(pi - x_now)], d pi / d y = u.
+        Eigen::MatrixXd dp(k, 3);
+        dp << gk, gk * perp(p.position - x_now.position());
+        g.g_pose += dp;
+        const Eigen::VectorXd gu = gk * p.beam;
+        g.noise += r * gu * gu.transpose();
+        const int age = int(std::max(0L, step_ - p.step));
+        if (age > 0) {
+          auto it = std::find_if(by_age.begin(), by_age.end(), [&](const auto& a) { return a.first == age; });
+          if (it == by_age.end()) {
+            by_age.emplace_back(age, dp);
+          } else {
+            it->second += dp;
+          }
+        }
         break;
+      }
       case SourcePoint::Kind::OnLandmark: {
-        const double d = gk.dot(p.shift);
-        auto it = std::find_if(g.g_slots.begin(), g.g_slots.end(), [&](const auto& s) { return s.first == p.slot; });
-        if (it == g.g_slots.end()) {
-          g.g_slots.emplace_back(p.slot, d);
-        } else {
-          it->second += d;
+        const int first = first_slot(p.slot);
+        const Eigen::VectorXd along = gk * p.shift;
+        for (int j = 0; j < int(p.basis.size()); ++j) {
+          const int slot = first + j;
+          auto it = std::find_if(slot_grad.begin(), slot_grad.end(), [&](const auto& s) { return s.first == slot; });
+          if (it == slot_grad.end()) {
+            slot_grad.emplace_back(slot, along * p.basis(j));
+          } else {
+            it->second += along * p.basis(j);
+          }
         }
         break;
       }
       case SourcePoint::Kind::Received: {
-        g.g_pose += Eigen::RowVector3d(gk.x(), gk.y(), gk.dot(perp(p.position - p.observer)));
-        auto it = std::find_if(group_shift.begin(), group_shift.end(), [&](const auto& s) { return s.first == p.group; });
-        if (it == group_shift.end()) {
-          group_shift.emplace_back(p.group, gk.dot(dependent));
-        } else {
-          it->second += gk.dot(dependent);
-        }
+        Eigen::MatrixXd dp(k, 3);
+        dp << gk, gk * perp(p.position - x_now.position());
+        g.g_pose += dp;
+        auto it = std::find_if(groups.begin(), groups.end(), [&](const Group& gr) { return gr.id == p.group; });
+        it->shift += gk * dependent;
+        it->turn += gk * perp(p.position - it->centroid);
         break;
       }
     }
   }
-  for (const auto& [group, shift] : group_shift) {
-    for (const auto& p : points) {
-      if (p.kind == SourcePoint::Kind::Received && p.group == group) {
-        g.noise_variance += shift * shift * p.variance;
-        break;
-      }
-    }
+  // The process noise of the steps between a point's reading and now: the noise of step now - j
+  // moves every point read j or more steps ago (each step's noise independent).
+  std::sort(by_age.begin(), by_age.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  Eigen::MatrixXd older = Eigen::MatrixXd::Zero(k, 3);
+  for (std::size_t i = 0; i < by_age.size(); ++i) {
+    older += by_age[i].second;
+    const int steps = by_age[i].first - (i + 1 < by_age.size() ? by_age[i + 1].first : 0);
+    g.noise += double(steps) * older * process_noise_ * older.transpose();
   }
+  for (const auto& gr : groups) {
+    g.noise += gr.variance * gr.shift * gr.shift.transpose() + gr.angle_variance * gr.turn * gr.turn.transpose();
+  }
+  g.g_slots = std::move(slot_grad);
   filter_.augment(g);
   mapping::PolynomialLandmark landmark;
   landmark.id = next_id_++;
   landmark.polynomial = fit->polynomial;
   landmark.received_from = received_from;
+  bases_.push_back({fit->polynomial, basis});
   // The shape's uncertainty (options.shape_noise): the least of its sources'. Points computed from
   // the pose carry the pose's variance along the curve and in heading, plus the fit's slope variance.
   {
-    const mapping::Polynomial& shape = fit->polynomial;
     const Eigen::Vector2d along = shape.world(Eigen::Vector2d(1.0, 0.0));
     const Eigen::Matrix3d pose = filter_.pose_covariance();
     const double pose_along = along.dot(pose.topLeftCorner<2, 2>() * along);
@@ -305,13 +455,22 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
 void PolynomialSlam::remove_landmarks(std::vector<int> indices) {
   std::sort(indices.begin(), indices.end());
   indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
-  filter_.remove(indices);
-  for (auto it = indices.rbegin(); it != indices.rend(); ++it) map_.landmarks.erase(map_.landmarks.begin() + *it);
+  std::vector<int> slots;
+  for (int i : indices) {
+    const int first = first_slot(i);
+    for (int j = 0; j < bases_[std::size_t(i)].basis.size; ++j) slots.push_back(first + j);
+  }
+  filter_.remove(slots);
+  for (auto it = indices.rbegin(); it != indices.rend(); ++it) {
+    map_.landmarks.erase(map_.landmarks.begin() + *it);
+    bases_.erase(bases_.begin() + *it);
+  }
 }
 
 std::vector<PolynomialSlam::SourcePoint> PolynomialSlam::samples_of(int index, int count) const {
   const mapping::Polynomial p = current(index);
-  const double weight = 1.0 / std::max(filter_.position_variance(index), 1e-12);  // §3.3
+  const double weight = 1.0 / std::max(position_variance(index), 1e-12);  // §3.3
+  const ShapeBasis& basis = bases_[std::size_t(index)].basis;
   std::vector<SourcePoint> out;
   for (const auto& q : mapping::sample_equally(p, count)) {
     SourcePoint s;
@@ -320,6 +479,7 @@ std::vector<PolynomialSlam::SourcePoint> PolynomialSlam::samples_of(int index, i
     s.weight = weight;
     s.slot = index;
     s.shift = p.dependent_direction();
+    s.basis = basis.at(p.local(q).x());
     out.push_back(s);
   }
   return out;
@@ -450,33 +610,50 @@ int PolynomialSlam::integrate_received(const std::vector<ReceivedCurve>& curves)
 
 void PolynomialSlam::change_frame(const core::Transform2& t) {
   const Eigen::Matrix2d rot = t.rotation_matrix();
-  std::vector<double> positions, scales;
+  const int old_slots = filter_.slots();
+  std::vector<Eigen::VectorXd> values;
+  std::vector<Eigen::MatrixXd> blocks;  // d new entries / d old entries, per landmark
   for (int i = 0; i < int(map_.landmarks.size()); ++i) {
     const mapping::Polynomial old = current(i);
+    const ShapeBasis& old_basis = bases_[std::size_t(i)].basis;
     // Points every 2 cm (at least 4 (m + 1)) on the old curve, moved; the refit follows them to
-    // far below the sensor noise for the smooth, short curves a map holds.
+    // far below the sensor noise for the smooth, short curves a map holds. With the shape in the
+    // state the refit keeps the landmark's order (a turned line is a line).
     const int count = std::max(4 * (options_.order + 1), int(std::ceil(old.length() / 0.02)) + 1);
     std::vector<mapping::WeightedPoint> moved;
-    for (const auto& q : mapping::sample_equally(old, count)) moved.push_back({t * q, 1.0});
-    std::optional<mapping::PolynomialFit> fit;
-    for (int order = options_.order; order >= 1 && !fit; --order) {
-      fit = mapping::fit_polynomial(moved, order, mapping::principal_axis(moved));
+    std::vector<double> old_xi;
+    for (const auto& q : mapping::sample_equally(old, count)) {
+      moved.push_back({t * q, 1.0});
+      old_xi.push_back(old.local(q).x());
     }
+    std::optional<mapping::PolynomialFit> fit;
+    int order = options_.shape_in_state && old_basis.size > 1 ? old_basis.size - 1 : options_.order;
+    for (; order >= 1 && !fit; --order) fit = mapping::fit_polynomial(moved, order, mapping::principal_axis(moved));
     if (!fit) throw Error("PolynomialSlam::change_frame: a polynomial could not be refitted in the new frame");
-    // Shifting the old curve by delta along its dependent axis shifts the moved points by
-    // delta R e_old, and the refit's c_0 by delta sum_k g_k . R e_old.
+    ++order;
+    fit->polynomial.shape.insert(fit->polynomial.shape.begin(), std::size_t(options_.order - order), 0.0);
+    ShapeBasis basis;
+    basis.centre = 0.5 * (fit->polynomial.lo + fit->polynomial.hi);
+    basis.scale = std::max(0.5 * (fit->polynomial.hi - fit->polynomial.lo), 1e-3);
+    basis.size = options_.shape_in_state && old_basis.size > 1 ? order + 1 : 1;
+    // An old entry e_j moves the old curve by basis_j(xi) along its dependent axis, each moved
+    // point by basis_j(xi_k) R e_old, and the refit's entries by sum_k G_k R e_old basis_j(xi_k).
     const Eigen::Vector2d shift = rot * old.dependent_direction();
-    double scale = 0.0;
-    for (const auto& g : mapping::position_gradient(fit->polynomial, moved)) scale += g.dot(shift);
+    const std::vector<Eigen::MatrixXd> grad = fit_gradient(fit->polynomial, basis, moved);
+    Eigen::MatrixXd block = Eigen::MatrixXd::Zero(basis.size, old_basis.size);
+    for (std::size_t k = 0; k < moved.size(); ++k) block += (grad[k] * shift) * old_basis.at(old_xi[k]).transpose();
+    Eigen::VectorXd value = Eigen::VectorXd::Zero(basis.size);
+    value(0) = fit->polynomial.position;
     auto& landmark = map_.landmarks[std::size_t(i)];
     landmark.polynomial = fit->polynomial;
+    bases_[std::size_t(i)] = {fit->polynomial, basis};
     for (auto& b : landmark.bad_points) {
       b.position = t * b.position;
       b.observer = t * b.observer;
       b.beam = rot * b.beam;
     }
-    positions.push_back(fit->polynomial.position);
-    scales.push_back(scale);
+    values.push_back(std::move(value));
+    blocks.push_back(std::move(block));
   }
   for (auto& cluster : map_.clusters) {
     for (auto& q : cluster.points) {
@@ -485,7 +662,17 @@ void PolynomialSlam::change_frame(const core::Transform2& t) {
       q.beam = rot * q.beam;
     }
   }
-  filter_.change_frame(t, positions, scales);
+  int new_slots = 0;
+  for (const auto& v : values) new_slots += int(v.size());
+  Eigen::VectorXd all_values(new_slots);
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(new_slots, old_slots);
+  for (std::size_t i = 0, row = 0, col = 0; i < values.size(); ++i) {
+    all_values.segment(Eigen::Index(row), values[i].size()) = values[i];
+    jacobian.block(Eigen::Index(row), Eigen::Index(col), blocks[i].rows(), blocks[i].cols()) = blocks[i];
+    row += std::size_t(blocks[i].rows());
+    col += std::size_t(blocks[i].cols());
+  }
+  filter_.change_frame(t, all_values, jacobian);
   sync_positions();
 }
 

@@ -60,7 +60,46 @@ struct PolynomialSlamOptions {
   // wall has a wrong slope and curvature that the filter, holding the shape fixed, cannot correct.
   // False: always order m, as the paper.
   bool lowest_order = true;
+  // D'Alfonso et al. keep the shape b_m..b_1 out of the state (a "shape landmark" of the extraction
+  // step only). True: each landmark's shape is in the state with its c_0, as corrections
+  // a_1..a_q to the polynomial in the centred, scaled variable t = (xi - centre) / scale of its
+  // domain when it was made (q its order: a line has c_0 and a_1), so that readings correct a
+  // wrong shape and its error is shared by all readings of it; `shape_noise` is then not used.
+  bool shape_in_state = false;
+  // Process noise on each landmark's entries per step (m^2): the walls do not move, so 0; more
+  // lets the filter follow a boundary an m-th order polynomial cannot follow exactly.
+  double feature_noise = 0.0;
 };
+
+// A landmark's state block (options.shape_in_state): `size` entries, c_0 and a_1..a_{size-1} in
+// t = (xi - centre) / scale; without the shape in the state, size 1 (c_0 alone).
+struct ShapeBasis {
+  double centre = 0.0;
+  double scale = 1.0;
+  int size = 1;
+  // [1, t, t^2, ..., t^(size-1)] at xi: d p(xi) / d entries.
+  Eigen::VectorXd at(double xi) const;
+};
+
+// The polynomial whose entries are `entries` (c_0, a_1, ...): reference's shape plus
+// sum_j a_j t^j, expanded to monomials, its c_0 replaced (a uniform shift).
+mapping::Polynomial polynomial_from_entries(const mapping::Polynomial& reference, const ShapeBasis& basis,
+                                            const Eigen::VectorXd& entries);
+
+// The reading model h of eq. (2) for one sensor axis (world angle `angle` from `pose`'s position)
+// and one landmark held as `entries` in slots first_slot.. : the distance, dh/d pose and dh/d each
+// entry (reading.slot = first_slot for c_0, h_more for the shape). nullopt when the axis misses it.
+std::optional<ScalarReading> range_reading(const mapping::Polynomial& reference, const ShapeBasis& basis,
+                                           const Eigen::VectorXd& entries, int first_slot, const core::Pose2& pose,
+                                           double sensor_angle, double max_distance, double domain_margin,
+                                           double* cos_incidence = nullptr);
+
+// The landmark generation function's gradient (D'Alfonso et al., eq. (5)) for a weighted LMS fit:
+// d (c_0, a_1..a_{size-1}) / d pi_k (size x 2, world frame) of the fit through `points`, at the
+// fitted `polynomial` (Gauss-Newton: the residuals' own change is left out). With size 1 it is
+// mapping::position_gradient (the shape held fixed).
+std::vector<Eigen::MatrixXd> fit_gradient(const mapping::Polynomial& polynomial, const ShapeBasis& basis,
+                                          const std::vector<mapping::WeightedPoint>& points);
 
 // Throws InputError naming the option for a value the algorithm cannot use.
 void validate(const PolynomialSlamOptions& options);
@@ -122,7 +161,10 @@ class PolynomialSlam {
   // The map; each landmark's c_0 is the filter's current estimate.
   const mapping::PolynomialMap& map() const { return map_; }
   // The variance of landmark i's c_0 (i indexes map().landmarks).
-  double position_variance(int landmark) const { return filter_.position_variance(landmark); }
+  double position_variance(int landmark) const { return filter_.position_variance(first_slot(landmark)); }
+  // The filter slot of landmark i's c_0 (its shape, when in the state, follows).
+  int first_slot(int landmark) const;
+  const ShapeBasis& basis(int landmark) const { return bases_[std::size_t(landmark)].basis; }
   const PolynomialEkf& filter() const { return filter_; }
   const SlamThresholds& thresholds() const { return thresholds_; }
   const PolynomialSlamCounters& counters() const { return counters_; }
@@ -138,13 +180,20 @@ class PolynomialSlam {
   void merge_new(long id);
   std::vector<SourcePoint> samples_of(int index, int count) const;
   mapping::Polynomial current(int index) const;
+  Eigen::VectorXd entries(int index) const;
   void sync_positions();
+
+  struct LandmarkState {
+    mapping::Polynomial reference;  // the fit it was made from
+    ShapeBasis basis;
+  };
 
   PolynomialSlamOptions options_;
   Eigen::Matrix3d initial_covariance_;
   Eigen::Matrix3d process_noise_;
   PolynomialEkf filter_;
-  mapping::PolynomialMap map_;  // landmark i <-> filter slot i
+  mapping::PolynomialMap map_;  // landmark i <-> filter slots first_slot(i) ..
+  std::vector<LandmarkState> bases_;  // one per landmark
   SlamThresholds thresholds_;
   PolynomialSlamCounters counters_;
   long step_ = 0;

@@ -57,6 +57,15 @@ TEST(SlamScenario, DefaultsFillAMinimalScenario) {
   EXPECT_EQ(s.robots[0].path.size(), 1u);
   EXPECT_EQ(s.range.angles_rad.size(), 5u);
   EXPECT_EQ(room_walls(s.room).size(), 4u);
+  // D'Alfonso et al.'s filter unless asked: c_0 only, the estimate starting at the truth.
+  EXPECT_FALSE(s.polynomial.shape_in_state);
+  EXPECT_FALSE(s.sampled_start);
+  const SlamScenario t = parse_slam_scenario(
+      std::string(kMinimal) + "initial_sigma: {sampled: true}\npolynomial: {shape_in_state: true, feature_noise: 1.0e-6}\n",
+      "min.yaml");
+  EXPECT_TRUE(t.sampled_start);
+  EXPECT_TRUE(t.polynomial.shape_in_state);
+  EXPECT_DOUBLE_EQ(t.polynomial.feature_noise, 1e-6);
 }
 
 TEST(SlamScenario, BadInputNamesTheFileAndKey) {
@@ -66,6 +75,7 @@ TEST(SlamScenario, BadInputNamesTheFileAndKey) {
   expect_input_error([&] { parse_slam_scenario(with("steps: 0\n"), "s.yaml"); }, {"steps"});
   expect_input_error([&] { parse_slam_scenario(with("polynomial: {rho: [0.3, 0.1]}\n"), "s.yaml"); }, {"polynomial.rho"});
   expect_input_error([&] { parse_slam_scenario(with("polynomial: {epsilon_z: 0}\n"), "s.yaml"); }, {"epsilon_z"});
+  expect_input_error([&] { parse_slam_scenario(with("polynomial: {feature_noise: -1}\n"), "s.yaml"); }, {"feature_noise"});
   expect_input_error([&] { parse_slam_scenario(with("single_robot: zz\n"), "s.yaml"); }, {"single_robot", "zz"});
   expect_input_error([&] { parse_slam_scenario("room: {boundary: [[0, 0], [1, 0]]}\nrobots: {team: []}\n", "s.yaml"); },
                      {"room.boundary"});

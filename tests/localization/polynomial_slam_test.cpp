@@ -345,6 +345,119 @@ TEST(PolynomialSlam, AShortNoisyPieceOfStraightWallBecomesALine) {
   EXPECT_LT(line_error, cubic_error);
 }
 
+// A cubic along x1 on [2, 4], held as a reference plus corrections a_1..a_3 in t = (xi - 3) / 1.
+struct HeldCubic {
+  mapping::Polynomial reference;
+  ShapeBasis basis;
+  Eigen::VectorXd entries;
+};
+HeldCubic held_cubic() {
+  HeldCubic h;
+  h.reference.axis = mapping::PolynomialAxis::X1;
+  h.reference.shape = {0.02, -0.1, 0.3};
+  h.reference.position = 1.5;
+  h.reference.lo = 2.0;
+  h.reference.hi = 4.0;
+  h.basis = {3.0, 1.0, 4};
+  h.entries = Eigen::Vector4d(1.45, 0.03, -0.02, 0.01);
+  return h;
+}
+
+TEST(PolynomialSlam, ShapeEntriesAreAUniformShiftPlusCentredPowers) {
+  const HeldCubic h = held_cubic();
+  const mapping::Polynomial p = polynomial_from_entries(h.reference, h.basis, h.entries);
+  for (double xi : {2.0, 2.7, 3.0, 3.9}) {
+    const double t = xi - 3.0;
+    const double expected = h.reference.value(xi) - h.reference.position + h.entries(0) + h.entries(1) * t +
+                            h.entries(2) * t * t + h.entries(3) * t * t * t;
+    EXPECT_NEAR(p.value(xi), expected, 1e-12);
+  }
+}
+
+TEST(PolynomialSlam, ReadingJacobiansMatchNumericalDifferentiation) {
+  // dh / d(x, y, theta) and dh / d(c_0, a_1..a_3) of eq. (2)'s distance along a sensor axis, against
+  // central differences, for axes meeting the cubic at several places and angles.
+  const HeldCubic h = held_cubic();
+  const double e = 1e-6;
+  int checked = 0;
+  for (const core::Pose2& pose : {core::Pose2(2.5, 0.2, 1.2), core::Pose2(3.4, 0.0, 1.7), core::Pose2(3.0, -0.5, 1.0)}) {
+    for (double beta : {-0.4, 0.0, 0.3}) {
+      const auto r = range_reading(h.reference, h.basis, h.entries, 7, pose, beta, 5.0, 0.0);
+      if (!r) continue;
+      ++checked;
+      const auto h_at = [&](const core::Pose2& x, const Eigen::VectorXd& entries) {
+        const auto q = range_reading(h.reference, h.basis, entries, 7, x, beta, 5.0, 0.0);
+        EXPECT_TRUE(q.has_value());
+        return q ? q->predicted : 0.0;
+      };
+      for (int i = 0; i < 3; ++i) {
+        core::Pose2 plus = pose, minus = pose;
+        (i == 0 ? plus.x : i == 1 ? plus.y : plus.theta) += e;
+        (i == 0 ? minus.x : i == 1 ? minus.y : minus.theta) -= e;
+        EXPECT_NEAR(r->h_pose(i), (h_at(plus, h.entries) - h_at(minus, h.entries)) / (2 * e), 1e-6) << "pose " << i;
+      }
+      ASSERT_EQ(r->slot, 7);
+      ASSERT_EQ(r->h_more.size(), 3u);
+      for (int j = 0; j < 4; ++j) {
+        Eigen::VectorXd plus = h.entries, minus = h.entries;
+        plus(j) += e;
+        minus(j) -= e;
+        const double analytic = j == 0 ? r->h_slot : r->h_more[std::size_t(j - 1)].second;
+        if (j > 0) {
+          EXPECT_EQ(r->h_more[std::size_t(j - 1)].first, 7 + j);
+        }
+        EXPECT_NEAR(analytic, (h_at(pose, plus) - h_at(pose, minus)) / (2 * e), 1e-6) << "entry " << j;
+      }
+    }
+  }
+  EXPECT_GE(checked, 5);
+}
+
+TEST(PolynomialSlam, FitGradientMatchesNumericalDifferentiation) {
+  // eq. (5)'s d (c_0, a_1..a_q) / d pi_k of the weighted LMS fit, against refitting with one
+  // point moved, for a fit through points on a cubic (where the Gauss-Newton gradient is exact),
+  // along x1 and along x2; with size 1 it is mapping::position_gradient.
+  for (const auto axis : {mapping::PolynomialAxis::X1, mapping::PolynomialAxis::X2}) {
+    mapping::Polynomial truth;
+    truth.axis = axis;
+    truth.shape = {0.05, -0.2, 0.4};
+    truth.position = 0.8;
+    std::vector<mapping::WeightedPoint> points;
+    for (int k = 0; k <= 12; ++k) points.push_back({truth.world(Eigen::Vector2d(1.0 + 0.1 * k, truth.value(1.0 + 0.1 * k))), 1.0 + 0.1 * (k % 3)});
+    const auto fit = mapping::fit_polynomial(points, 3, axis);
+    ASSERT_TRUE(fit);
+    const ShapeBasis basis{1.6, 0.6, 4};
+    const auto entries_of = [&](const mapping::Polynomial& p) {
+      // p = reference shape + c_0 + sum a_j t^j: solve for (c_0, a) at four values of t.
+      Eigen::Matrix4d a;
+      Eigen::Vector4d b;
+      for (int i = 0; i < 4; ++i) {
+        const double xi = 1.2 + 0.3 * i;
+        a.row(i) = basis.at(xi).transpose();
+        b(i) = p.value(xi) - (fit->polynomial.value(xi) - fit->polynomial.position);
+      }
+      return Eigen::Vector4d(a.lu().solve(b));
+    };
+    const auto grad = fit_gradient(fit->polynomial, basis, points);
+    const ShapeBasis c0_only{1.6, 0.6, 1};
+    const auto grad_c0 = fit_gradient(fit->polynomial, c0_only, points);
+    const auto fixed_shape = mapping::position_gradient(fit->polynomial, points);
+    const double e = 1e-6;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      EXPECT_NEAR((grad_c0[k].row(0).transpose() - fixed_shape[k]).norm(), 0.0, 1e-12);
+      for (int d = 0; d < 2; ++d) {
+        auto plus = points, minus = points;
+        plus[k].position(d) += e;
+        minus[k].position(d) -= e;
+        const auto fp = mapping::fit_polynomial(plus, 3, axis), fm = mapping::fit_polynomial(minus, 3, axis);
+        ASSERT_TRUE(fp && fm);
+        const Eigen::Vector4d numeric = (entries_of(fp->polynomial) - entries_of(fm->polynomial)) / (2 * e);
+        EXPECT_LT((grad[k].col(d) - numeric).norm(), 1e-5) << "point " << k << " coordinate " << d;
+      }
+    }
+  }
+}
+
 TEST(PolynomialSlam, OptionsAreValidated) {
   PolynomialSlamOptions o;
   o.rho_max = 0.01;
