@@ -282,7 +282,8 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   // bare rectangular hall merged turned a half turn, because the wrong placement laid more of one
   // map on the other). In a house the turned placement lays the other rooms of b on a's free
   // space, and the probe does not count it.
-  const bool one_room = best_q.beyond_room <= co.zero_beyond_corner && turned >= co.min_turned_share;
+  const bool one_room =
+      co.min_turned_share > 0.0 && best_q.beyond_room <= co.zero_beyond_corner && turned >= co.min_turned_share;
   if (one_room) result.distinctiveness = 0.0;
   const double support_factor = support(result.evidence * result.distinctiveness);
   const double corner_factor =
