@@ -81,13 +81,14 @@ struct Args {
   bool peer = true;
   double clutter = 1.0;      // scales the clutter rates (0: none)
   std::uint64_t seed = 1;
+  int build_part = -1, build_parts = 0;  // --build-maps K/N: only build the cached maps of plans K, K + N, ... and stop
 };
 
 [[noreturn]] void usage(const std::string& problem) {
   std::cerr << "fleetmap_bench_merging_real: " << problem << "\n"
             << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
             << "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
-            << "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S]\n";
+            << "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S] [--build-maps K/N]\n";
   std::exit(2);
 }
 
@@ -129,6 +130,14 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--no-peer") a.peer = false;
     else if (k == "--clutter") a.clutter = number(value());
     else if (k == "--seed") a.seed = std::uint64_t(number(value()));
+    else if (k == "--build-maps") {
+      const std::string v = value();
+      const std::size_t slash = v.find('/');
+      if (slash == std::string::npos) usage("--build-maps: '" + v + "' is not K/N");
+      a.build_part = int(number(v.substr(0, slash)));
+      a.build_parts = int(number(v.substr(slash + 1)));
+      if (a.build_parts < 1 || a.build_part < 0 || a.build_part >= a.build_parts) usage("--build-maps: '" + v + "' needs 0 <= K < N");
+    }
     else if (k == "--overlaps") {
       a.overlaps.clear();
       std::string list = value();
@@ -554,6 +563,15 @@ int main(int argc, char** argv) {
     std::sort(plans.begin(), plans.end());
     if (plans.size() < 2) usage("--plans: " + args.plans.string() + " holds fewer than two map_server YAML plans");
     std::vector<PlanMap> maps, second;
+    if (args.build_parts > 0) {
+      // Only fill the cache (run N of these at once, K = 0 .. N-1, to use N cores).
+      for (std::size_t i = std::size_t(args.build_part); i < plans.size(); i += std::size_t(args.build_parts)) {
+        std::cerr << fmt::format("maps: {}/{} {}\n", i + 1, plans.size(), plans[i].stem().string());
+        build_plan_map(plans[i], int(i), 0, args.cache);
+        if (args.two_robots > 0) build_plan_map(plans[i], int(i), 1, args.cache);
+      }
+      return 0;
+    }
     for (std::size_t i = 0; i < plans.size(); ++i) {
       std::cerr << fmt::format("\rmaps: {}/{} {}      ", i + 1, plans.size(), plans[i].stem().string()) << std::flush;
       maps.push_back(build_plan_map(plans[i], int(i), 0, args.cache));

@@ -87,12 +87,17 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
   }
 }
 
-// The points farther than `tolerance` from the `lines` straight lines that hold the most points,
-// taken one after another: a Hough transform (1 degree, 1 cell) picks each line, a total least
-// squares fit to the points within 2 tolerances of it places it.
-int beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double tolerance) {
+// The points farther than `tolerance` from the straight lines that hold the most points, taken one
+// after another: element l after l + 1 lines. A Hough transform (1 degree, 1 cell) picks each line,
+// a total least squares fit to the points within 2 tolerances of it places it.
+std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double tolerance) {
   constexpr int kAngles = 180;
-  for (int l = 0; l < lines && points.size() >= 2; ++l) {
+  std::vector<int> left;
+  for (int l = 0; l < lines; ++l) {
+    if (points.size() < 2) {
+      left.push_back(int(points.size()));
+      continue;
+    }
     Eigen::Vector2d lo = points.front(), hi = points.front();
     for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     const Eigen::Vector2d mid = 0.5 * (lo + hi);
@@ -103,7 +108,8 @@ int beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double toleranc
       const double th = std::numbers::pi * k / kAngles;
       const Eigen::Vector2d n(std::cos(th), std::sin(th));
       for (const auto& p : points) {
-        const int r = int(std::lround(n.dot(p - mid))) + offset;
+        // Offset first, so that rounding is truncation of a positive number (std::lround is a call).
+        const int r = int(n.dot(p - mid) + offset + 0.5);
         const std::size_t i = std::size_t(k * rho_bins + std::clamp(r, 0, rho_bins - 1));
         if (++votes[i] > best_votes) best_votes = votes[i], best = int(i);
       }
@@ -124,8 +130,9 @@ int beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double toleranc
       on = c;
     }
     std::erase_if(points, [&](const Eigen::Vector2d& p) { return std::abs(n.dot(p - on)) <= tolerance; });
+    left.push_back(int(points.size()));
   }
-  return int(points.size());
+  return left;
 }
 
 }  // namespace
@@ -142,7 +149,9 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   q.contradicted = t.contradicted;
   q.score = t.matched - options.contradiction_weight * t.contradicted;
   q.agreement = t.matched + t.contradicted > 0 ? double(t.matched) / double(t.matched + t.contradicted) : 0.0;
-  q.beyond_corner = beyond_lines(t.structure_positions, 2, 2.0);
+  const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0);
+  q.beyond_corner = left[1];
+  q.beyond_room = left[3];
   if (t.positions.size() < 3) return q;
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   for (const auto& p : t.positions) c += p;

@@ -57,6 +57,9 @@ struct AlignmentQuality {
   // straight lines that hold the most of them: 0 when all the common walls are one corner (two
   // walls), which fits any other corner of a bare room as well.
   int beyond_corner = 0;
+  // The same for the four lines that hold the most: 0 when the common walls are the sides of one
+  // rectangular room (or fewer lines), which fits itself turned a half turn.
+  int beyond_room = 0;
   double overlap_radius = 0.0;  // RMS distance of the matched walls from their centroid, in cells
   Eigen::Vector2d overlap_centre = Eigen::Vector2d::Zero();  // that centroid, in a's cells
 };

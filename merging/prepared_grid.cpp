@@ -240,6 +240,85 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
   }
 }
 
+namespace {
+
+// Max pooling of a mask by 2.
+cv::Mat pool_mask(const cv::Mat& m) {
+  cv::Mat out = cv::Mat::zeros((m.rows + 1) / 2, (m.cols + 1) / 2, CV_8U);
+  for (int y = 0; y < m.rows; ++y) {
+    const auto* r = m.ptr<std::uint8_t>(y);
+    auto* o = out.ptr<std::uint8_t>(y / 2);
+    for (int x = 0; x < m.cols; ++x) o[x / 2] |= r[x];
+  }
+  return out;
+}
+
+// The points of `from` inside `box` where `mask` (box's size) is set, moved to the box's cells;
+// `keep` gets the kept indices.
+std::vector<Eigen::Vector2f> points_inside(const std::vector<Eigen::Vector2f>& from, const cv::Rect& box,
+                                           const cv::Mat& mask, std::vector<std::size_t>& keep) {
+  std::vector<Eigen::Vector2f> out;
+  keep.clear();
+  const Eigen::Vector2f o(float(box.x), float(box.y));
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    const int x = int(from[i].x()) - box.x, y = int(from[i].y()) - box.y;
+    if (x < 0 || y < 0 || x >= box.width || y >= box.height || mask.at<std::uint8_t>(y, x) == 0) continue;
+    out.push_back(from[i] - o);
+    keep.push_back(i);
+  }
+  return out;
+}
+
+}  // namespace
+
+PreparedGrid::PreparedGrid(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options,
+                           Eigen::Vector2i& origin)
+    : grid_(source.grid_) {
+  const GridLevel& s0 = source.level(0);
+  cv::Mat m0 = mask & (s0.occupied | s0.free);
+  std::vector<cv::Point> nonzero;
+  cv::findNonZero(m0, nonzero);
+  cv::Rect box = nonzero.empty() ? cv::Rect(0, 0, 1, 1) : cv::boundingRect(nonzero);
+  const int coarsest = source.level(source.level_count() - 1).factor;
+  const int x0 = box.x / coarsest * coarsest, y0 = box.y / coarsest * coarsest;
+  box = cv::Rect(x0, y0, box.x + box.width - x0, box.y + box.height - y0);
+  origin = Eigen::Vector2i(x0, y0);
+  cv::Mat level_mask = m0(box);
+  std::vector<std::size_t> keep;
+  for (int k = 0; k < source.level_count(); ++k) {
+    const GridLevel& s = source.level(k);
+    const int f = s.factor;
+    // This level's cells under the box (the box's corner is on a cell boundary of every level).
+    const cv::Rect cut(x0 / f, y0 / f, std::min(s.width() - x0 / f, (box.width + f - 1) / f),
+                       std::min(s.height() - y0 / f, (box.height + f - 1) / f));
+    if (k > 0) {
+      if (std::max(levels_.back().width(), levels_.back().height()) / 2 < options.min_level_size) break;
+      level_mask = pool_mask(level_mask)(cv::Rect(0, 0, cut.width, cut.height));
+    }
+    GridLevel l;
+    l.factor = f;
+    l.occupied = s.occupied(cut) & level_mask;
+    l.free = s.free(cut) & level_mask;
+    l.walls = s.walls(cut) & level_mask;
+    l.wall_distance = s.wall_distance(cut);
+    l.free_band = s.free_band(cut) & level_mask;
+    l.clutter = s.clutter(cut) & level_mask;
+    l.wall_points = points_inside(s.wall_points, cut, level_mask, keep);
+    for (std::size_t i : keep) l.wall_normals.push_back(s.wall_normals[i]), l.wall_clutter.push_back(s.wall_clutter[i]);
+    l.interior_points = points_inside(s.interior_points, cut, level_mask, keep);
+    levels_.push_back(std::move(l));
+  }
+  const Eigen::Vector2f o = origin.cast<float>();
+  for (const auto& w : source.walls()) {
+    const int x = int(w.position.x()) - x0, y = int(w.position.y()) - y0;
+    if (x < 0 || y < 0 || x >= box.width || y >= box.height || m0.at<std::uint8_t>(y + y0, x + x0) == 0) continue;
+    WallPoint moved = w;
+    moved.position -= o;
+    walls_.push_back(moved);
+  }
+  known_cells_ = cv::countNonZero(levels_.front().occupied | levels_.front().free);
+}
+
 int PreparedGrid::level_for_size(int cells) const {
   for (int k = 0; k < level_count(); ++k) {
     if (std::max(levels_[std::size_t(k)].width(), levels_[std::size_t(k)].height()) <= cells) return k;

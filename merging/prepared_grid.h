@@ -98,6 +98,13 @@ struct PrepareOptions {
 class PreparedGrid {
  public:
   explicit PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOptions& options = {});
+  // The part of `source` under `mask` (CV_8U, source's size; nonzero = kept), cut to the mask's
+  // box with `origin` (a multiple of the coarsest level's factor, so that every level is cut at a
+  // cell boundary): source's cells, walls, clutter and distance fields, masked, without preparing
+  // them again. Distances still count walls just outside the mask, so a mask should have a margin
+  // of a few cells around what matters. grid() stays source's grid (for its resolution). An empty
+  // mask gives a grid without walls.
+  PreparedGrid(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options, Eigen::Vector2i& origin);
 
   int width() const { return levels_.front().width(); }
   int height() const { return levels_.front().height(); }

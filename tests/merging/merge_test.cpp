@@ -7,6 +7,8 @@
 #include <optional>
 #include <tuple>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "core/angle.h"
 #include "merging/evaluation.h"
 #include "tests/merging/merging_test_support.h"
@@ -160,6 +162,31 @@ TEST(AlignMaps, TwoCornersOfABareHallAreRefused) {
   const MergeResult r = align_maps(a, b);
   EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
   EXPECT_NE(r.reason.find("corner"), std::string::npos) << r.reason;
+}
+
+// Two robots' maps of a bare rectangular hall (HouseExpo plan 84537130db40 after 534 steps of
+// three robots in the simulator, ideal localization; tests/data/houseexpo): the hall fits itself
+// turned a half turn, and which placement wins is a matter of which lays more of one map on the
+// other. Here the right one would (merged at 0.95 without the opt-in test). (During that run the maps of
+// step 534 merged turned a half turn, 33 m off; that attempt is not caught yet: bench/README.md.)
+TEST(AlignMaps, OneRectangularRoomTurnedAHalfTurnIsRefused) {
+  const auto load = [](const std::string& name) {
+    const cv::Mat img = cv::imread(std::string(FLEETMAP_SOURCE_DIR) + "/tests/data/houseexpo/" + name, cv::IMREAD_GRAYSCALE);
+    mapping::OccupancyGrid g(core::GridGeometry(0.05, img.cols, img.rows));
+    for (int r = 0; r < img.rows; ++r)
+      for (int x = 0; x < img.cols; ++x) {
+        const int v = img.at<std::uint8_t>(r, x);  // map_server trinary: 0 occupied, 254 free, 205 unknown
+        if (v != 205) g.set_state({x, img.rows - 1 - r}, v < 100 ? mapping::CellState::Occupied : mapping::CellState::Free);
+      }
+    return g;
+  };
+  const auto a = load("bare_hall_robot_1.png"), b = load("bare_hall_robot_3.png");
+  ASSERT_GT(a.count(mapping::CellState::Occupied), 1000);
+  MergeOptions options;
+  options.confidence.min_turned_share = 0.1;  // the test is opt-in (ConfidenceOptions)
+  const MergeResult r = align_maps(a, b, options);
+  EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
+  EXPECT_NE(r.reason.find("rectangular room"), std::string::npos) << r.reason;
 }
 
 // Two views sharing a fifth of their area (a room or two) of a generated world with speckle and

@@ -24,6 +24,41 @@ TEST(PreparedGrid, WallsAreOccupiedCellsNextToFreeOnes) {
   EXPECT_FLOAT_EQ(p.level(0).distance_at(1.0f, 2.0f, -1.0f), 0.0f);
 }
 
+// The part under a mask is b's own prepared data, cut at a cell boundary of every level: the same
+// walls, cells and distances, moved by the cut's origin, and nothing outside the mask.
+TEST(PreparedGrid, MaskedPartIsTheSourcesDataMovedByTheCutsOrigin) {
+  std::vector<std::string> rows(120, std::string(100, '.'));
+  for (int r = 10; r < 110; r += 20) rows[std::size_t(r)].replace(5, 90, std::string(90, '#'));  // five walls
+  const auto g = grid_from_text(rows);
+  const PreparedGrid source(g);
+  cv::Mat mask = cv::Mat::zeros(source.height(), source.width(), CV_8U);
+  mask(cv::Rect(37, 43, 40, 50)).setTo(255);
+  Eigen::Vector2i origin;
+  const PreparedGrid part(source, mask, PrepareOptions{}, origin);
+  const int coarsest = source.level(source.level_count() - 1).factor;
+  EXPECT_EQ(origin.x() % coarsest, 0);
+  EXPECT_EQ(origin.y() % coarsest, 0);
+  std::size_t inside = 0;
+  for (const auto& w : source.walls())
+    inside += mask.at<std::uint8_t>(int(w.position.y()), int(w.position.x())) != 0;
+  ASSERT_GT(inside, 0u);
+  EXPECT_EQ(part.walls().size(), inside);
+  for (const auto& w : part.walls()) {
+    const Eigen::Vector2f at = w.position + origin.cast<float>();
+    EXPECT_NE(mask.at<std::uint8_t>(int(at.y()), int(at.x())), 0);
+    EXPECT_NE(source.level(0).walls.at<std::uint8_t>(int(at.y()), int(at.x())), 0);
+  }
+  // A free cell inside: its distance to the walls is the source's.
+  const Eigen::Vector2i cell(50, 55);
+  const Eigen::Vector2i moved = cell - origin;
+  EXPECT_TRUE(part.level(0).is_free(moved.x(), moved.y()));
+  EXPECT_FLOAT_EQ(part.level(0).distance_at(float(moved.x()), float(moved.y()), -1.0f),
+                  source.level(0).distance_at(float(cell.x()), float(cell.y()), -1.0f));
+  // Outside the mask (inside the cut's box) nothing is known.
+  EXPECT_FALSE(part.level(0).known(0, 0));
+  EXPECT_EQ(part.level_count() <= source.level_count(), true);
+}
+
 TEST(PreparedGrid, SpecksAreNoise) {
   std::vector<std::string> rows(20, std::string(20, '.'));
   rows[3][3] = '#';                             // a one-cell speck
