@@ -296,6 +296,8 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
   const LandmarkWorld w = make_landmark_world(o, c.fields.empty() ? o.fields : c.fields);
   sim::LandmarkSensorOptions sensor = o.sensor;
   sim::RobotDetectorOptions camera = o.camera;
+  sim::RobotOptions robot = o.robot;
+  robot.max_speed_mps = o.speed_mps;
   if (range_noise) sensor.range_noise_m = camera.range_noise_m = *range_noise;
   const sim::World world(open_ground(w, c), w.landmarks);
   const core::Random base = core::Random(o.seed).fork(std::uint64_t(run) + 1);
@@ -312,7 +314,7 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
                                             std::max(sensor.bearing_noise_rad, localization::kMinMeasurementStd))
                             .asDiagonal();
 
-  std::vector<core::Pose2> truth, odometry(std::size_t(n));
+  std::vector<core::Pose2> truth, odometry(static_cast<std::size_t>(n));
   std::vector<std::vector<localization::Odometry>> commands;
   std::vector<localization::FastSlam2> filters;
   std::vector<core::Random> motion_rng, sensor_rng, camera_rng;
@@ -320,13 +322,12 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
   out.case_name = c.name;
   out.run = run;
   out.range_noise = sensor.range_noise_m;
-  out.truth_paths.resize(std::size_t(n));
+  out.truth_paths.resize(static_cast<std::size_t>(n));
   const core::Transform2 leader_from_world = c.robots[0].start.as_transform().inverse();
   for (int i = 0; i < n; ++i) {
     const auto& r = c.robots[std::size_t(i)];
     truth.push_back(r.start);
-    commands.push_back(path_commands(r.start, r.path, std::min(o.speed_mps, o.robot.max_speed_mps), c.steps, o.period_s,
-                                     o.robot.max_turn_rate_rps));
+    commands.push_back(path_commands(r.start, r.path, o.speed_mps, c.steps, o.period_s, robot.max_turn_rate_rps));
     // Each robot's map frame is its start: it knows its pose there exactly.
     filters.emplace_back(core::Pose2(), Eigen::Matrix3d::Zero(), f, base.fork(100 + std::uint64_t(i)).seed());
     motion_rng.push_back(base.fork(200 + std::uint64_t(i)));
@@ -346,7 +347,7 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
   for (int k = 1; k <= c.steps; ++k) {
     for (int i = 0; i < n; ++i) {
       const auto& u = commands[std::size_t(i)][std::size_t(k - 1)];
-      const sim::MoveResult mv = sim::move_robot(world, i, truth, o.robot, {u.v, u.omega}, o.period_s, o.noise,
+      const sim::MoveResult mv = sim::move_robot(world, i, truth, robot, {u.v, u.omega}, o.period_s, o.noise,
                                                  motion_rng[std::size_t(i)]);
       truth[std::size_t(i)] = mv.pose;
       odometry[std::size_t(i)] = localization::integrate_motion(odometry[std::size_t(i)], mv.odometry);
@@ -362,7 +363,7 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
     const auto maps_of = [&](int i, localization::ParticleMap which) {
       return landmark_map(filters[std::size_t(i)].map(which), w, o.signature_noise, base.fork(500 + std::uint64_t(i)));
     };
-    std::vector<std::vector<sim::Detection>> seen(std::size_t(n));
+    std::vector<std::vector<sim::Detection>> seen(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) seen[std::size_t(i)] = sim::detect_robots(world, i, truth, camera, camera_rng[std::size_t(i)]);
     const auto find = [&](int a, int b) -> const sim::Detection* {
       for (const auto& d : seen[std::size_t(a)]) {

@@ -78,15 +78,6 @@ std::string matrix_text(const core::Transform2& t, const std::string& indent) {
   return out;
 }
 
-std::string method_name(merging::AlignmentMethod m) {
-  switch (m) {
-    case merging::AlignmentMethod::DataAssociation: return "data association";
-    case merging::AlignmentMethod::InterRobotObservation: return "inter-robot observations";
-    case merging::AlignmentMethod::None: return "none";
-  }
-  return "none";
-}
-
 std::string table1(const LandmarkExperimentResult& r) {
   if (r.table1.empty()) return "";
   const Summary s = summarize(r.table1, false, 0);
@@ -215,7 +206,7 @@ cv::Mat global_map_picture(const LandmarkCaseRun& run) {
   const auto px = [&](const Eigen::Vector2d& p) {
     return cv::Point2d(margin + (p.x() - lo.x()) * scale, size - margin - (p.y() - lo.y()) * scale);
   };
-  viz::Drawing d(int(size), int(size) + 30);
+  viz::Drawing d(static_cast<int>(size), static_cast<int>(size) + 30);
   for (const auto& p : run.truth_in_leader) d.circle(px(p), 4.0, {170, 170, 170}, false, 1.0);
   for (std::size_t i = 0; i < run.truth_paths.size(); ++i) {
     std::vector<cv::Point2d> line;

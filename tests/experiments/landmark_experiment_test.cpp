@@ -59,10 +59,11 @@ TEST(LandmarkExperiment, BothMethodsRecoverTheTransformBetweenTheRobotsFrames) {
   for (int kind = 0; kind < 2; ++kind) {
     const MethodOutcome& da = r.data_association[kind];
     ASSERT_TRUE(da.transform.has_value()) << "kind " << kind;
-    // The maps' errors are a few centimetres (0.05 m readings, 35 m of driving): the transform
-    // from many landmarks is as good.
+    // What is left is how far each robot's map turned and slid from its true frame while it
+    // drove (0.3 degrees of heading noise per step: dead reckoning would drift ~0.05 rad over the
+    // 90 steps); the transform from many landmarks adds little to that.
     EXPECT_LT(da.error.translation(), 0.5) << "kind " << kind;
-    EXPECT_LT(da.error.theta, 0.02) << "kind " << kind;
+    EXPECT_LT(da.error.theta, 0.05) << "kind " << kind;
     EXPECT_LT(da.landmark_rms_x, 0.5);
     EXPECT_LT(da.landmark_rms_y, 0.5);
     // The observation carries both robots' pose errors and the 0.5 degree bearing over ~5 m.
