@@ -387,12 +387,13 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
       rep.leader = c.robots[0].name;
       rep.follower = c.robots[std::size_t(j)].name;
       rep.truth = frame_of(0).inverse() * frame_of(j);
-      const merging::Rendezvous meeting{filters[0].pose(), filters[std::size_t(j)].pose(),
-                                        {lj->range, lj->bearing, jl->range, jl->bearing}};
       core::Random ransac = base.fork(600 + std::uint64_t(j) + 10 * std::uint64_t(k));
       for (int kind = 0; kind < 2; ++kind) {
         const auto which = kind == 0 ? localization::ParticleMap::MaxWeight : localization::ParticleMap::Combined;
         const RobotLandmarkMap self = maps_of(0, which), other = maps_of(j, which);
+        // Each map with the pose that goes with it (the maximum-weight particle's, or the mean).
+        const merging::Rendezvous meeting{filters[0].pose(which), filters[std::size_t(j)].pose(which),
+                                          {lj->range, lj->bearing, jl->range, jl->bearing}};
         const auto evaluate = [&](MethodOutcome& m, const std::optional<core::Transform2>& t) {
           m.transform = t;
           if (!t) return;

@@ -116,7 +116,8 @@ struct FollowerReport {
   core::Transform2 truth;        // the follower's frame into the leader's
   int overlap = 0;               // candidate matches by signature (Fig. 3's count)
   int shared = 0;                // landmarks both maps truly hold
-  // [0]: the maximum-weight particle's maps, [1]: the combined maps (eq. (14)-(15)).
+  // [0]: the maximum-weight particle's maps and poses, [1]: the combined maps (eq. (14)-(15)) and
+  // the weighted mean poses.
   MethodOutcome data_association[2], observation[2];
   merging::LandmarkMethodChoice choice;  // Fig. 3 on the combined maps
   int global_landmarks = 0;              // the leader's global map after fusing this follower

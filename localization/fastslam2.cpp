@@ -246,6 +246,10 @@ core::Pose2 FastSlam2::pose() const {
   return {x, y, std::atan2(s, c)};
 }
 
+core::Pose2 FastSlam2::pose(ParticleMap which) const {
+  return which == ParticleMap::MaxWeight ? particles_[best_particle()].pose : pose();
+}
+
 Eigen::Matrix3d FastSlam2::pose_covariance() const {
   const core::Pose2 m = pose();
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();

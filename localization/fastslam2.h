@@ -41,6 +41,9 @@ struct FastSlam2Options {
   double new_landmark_gate = 27.63;   // farther than this from every landmark: a new one
 };
 
+// The map-alignment paper's two maps of a particle filter (§V.A, Table I).
+enum class ParticleMap { MaxWeight, Combined };
+
 struct FastSlam2Particle {
   core::Pose2 pose;  // the drawn pose, moved by the motion model since the last update
   // The pose's uncertainty accumulated by predictions since the pose was last drawn.
@@ -51,9 +54,6 @@ struct FastSlam2Particle {
   double selection_weight = 1.0;
   std::vector<Landmark> landmarks;  // the particle's map: one EKF per landmark
 };
-
-// The map-alignment paper's two maps of a particle filter (§V.A, Table I).
-enum class ParticleMap { MaxWeight, Combined };
 
 class FastSlam2 {
  public:
@@ -70,6 +70,8 @@ class FastSlam2 {
   // spread plus their mean accumulated covariance).
   core::Pose2 pose() const;
   Eigen::Matrix3d pose_covariance() const;
+  // The pose that goes with map(which): the maximum-weight particle's, or the weighted mean.
+  core::Pose2 pose(ParticleMap which) const;
 
   // The maximum-weight particle's landmarks, or eq. (14)-(15) of the map-alignment paper:
   // mu_i = sum_l w_l mu_i^[l], Sigma_i = sum_l w_l Sigma_i^[l] over the particles that hold landmark
