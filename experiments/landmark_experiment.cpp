@@ -202,6 +202,27 @@ LandmarkExperimentOptions parse_landmark_options(const std::string& text, const 
     p.finish();
   }
   top.finish();
+  // Robots must meet: on their noise-free paths, every follower within the camera's range of the
+  // leader at every rendezvous (checked before anything runs or is written).
+  for (const auto& c : o.cases) {
+    std::vector<std::vector<core::Pose2>> planned;
+    for (const auto& r : c.robots) {
+      planned.push_back({r.start});
+      for (const auto& u : path_commands(r.start, r.path, o.speed_mps, c.steps, o.period_s, o.robot.max_turn_rate_rps)) {
+        planned.back().push_back(localization::integrate_motion(planned.back().back(), u));
+      }
+    }
+    for (int k : c.rendezvous) {
+      for (std::size_t j = 1; j < c.robots.size(); ++j) {
+        const double d = (planned[0][std::size_t(k)].position() - planned[j][std::size_t(k)].position()).norm();
+        if (d > o.camera.max_range_m) {
+          throw InputError(fmt::format("{}: case '{}': robots {} and {} would be {:.1f} m apart at the rendezvous of step {}, "
+                                       "beyond the camera's range of {:g} m: move their paths' ends closer",
+                                       source, c.name, c.robots[0].name, c.robots[j].name, d, k, o.camera.max_range_m));
+        }
+      }
+    }
+  }
   return o;
 }
 

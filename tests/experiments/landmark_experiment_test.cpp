@@ -130,7 +130,11 @@ TEST(LandmarkExperiment, BadScenariosAreInputErrorsNamingTheKey) {
   std::string one_robot = text;
   one_robot.erase(one_robot.find("      - {name: b"), std::string("      - {name: b, start: [20, 3, 30], path: [[-15, 3]]}\n").size());
   expect_input_error([&] { parse_landmark_options(one_robot, "s.yaml"); }, {"s.yaml", "robots", "at least two"});
-  // Robots that never come within the camera's range cannot meet.
+  // Robots whose paths end beyond the camera's range cannot meet: refused before running ...
+  std::string far = text;
+  far.replace(far.find("camera: {max_range: 40"), 22, "camera: {max_range: 10");
+  expect_input_error([&] { parse_landmark_options(far, "s.yaml"); }, {"s.yaml", "case 'shared'", "apart at the rendezvous"});
+  // ... and if the noise carries them apart, the run stops with the same message.
   LandmarkExperimentOptions o = parse_landmark_options(text, "s.yaml");
   o.camera.max_range_m = 1.0;
   expect_input_error([&] { run_landmark_case(o, only_case(o), 0); }, {"case 'shared'", "do not see each other"});
