@@ -12,6 +12,7 @@
 
 #include "cli/command.h"
 #include "cli/corridor_command.h"
+#include "cli/landmark_command.h"
 #include "cli/progress.h"
 #include "cli/validators.h"
 #include "core/parallel.h"
@@ -49,6 +50,8 @@ int run_slam(const SlamFlags& f) {
   const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
   // The corridor loop of León et al. (experiment: leon_corridor) has its own runner.
   if (is_corridor_scenario_file(f.scenario)) return run_corridor_scenario(f.scenario, out, f.seed, f.quiet);
+  // The map-alignment paper's experiments (experiment: landmark_alignment) too.
+  if (is_landmark_scenario_file(f.scenario)) return run_landmark_scenario(f.scenario, out, f.runs, f.seed, f.jobs, f.quiet);
   experiments::SlamScenario s = experiments::load_slam_scenario(f.scenario);
   if (f.runs) s.runs = *f.runs;
   if (f.seed) s.seed = *f.seed;
@@ -108,7 +111,10 @@ Command add_slam_command(CLI::App& root) {
       "\n  polynomial: D'Alfonso et al.'s polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
       "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso\n\n"
       "Scenarios with `experiment: leon_corridor` (scenarios/leon_corridor.yaml) run León et al.'s corridor comparison\n"
-      "and merging by detection instead (--runs and --jobs do not apply); README.md, \"Grid SLAM and MCL (León et al.)\".");
+      "and merging by detection instead (--runs and --jobs do not apply); README.md, \"Grid SLAM and MCL (León et al.)\".\n\n"
+      "Scenarios with `experiment: landmark_alignment` (scenarios/landmark_alignment.yaml) run the map-alignment paper's\n"
+      "experiments: FastSLAM 2.0 landmark maps aligned by data association or inter-robot observations, Tables I-III,\n"
+      "Fig. 2 and the leader/follower merges; README.md, \"Landmark map alignment (map-alignment paper)\".");
   auto f = std::make_shared<SlamFlags>();
   app->add_option("--scenario", f->scenario, "SLAM scenario YAML (see scenarios/dalfonso_3robots.yaml)")
       ->required()

@@ -100,6 +100,8 @@ struct LocalizerOptions {
   // `mcl` and `rbpf`: particles per robot.
   int mcl_particles = 2000;
   int rbpf_particles = 30;
+  // `fastslam2`: particles per robot (Bailey's FastSLAM 2.0 implementation uses 100).
+  int fastslam_particles = 100;
   // `rbpf`: each particle's search starts from its odometry step drawn with the process noise
   // (false: from the odometry step itself, so one particle is the scan matcher).
   bool rbpf_sample_motion = true;

@@ -168,6 +168,7 @@ void read_localization(io::YamlMap& top, Scenario& s) {
     o.initial_theta = deg2rad(loc.number("initial_sigma_heading_deg", rad2deg(o.initial_theta), limits::kAngleDeg));
     o.mcl_particles = int(loc.number("mcl_particles", o.mcl_particles, limits::kMclParticles));
     o.rbpf_particles = int(loc.number("rbpf_particles", o.rbpf_particles, limits::kRbpfParticles));
+    o.fastslam_particles = int(loc.number("fastslam_particles", o.fastslam_particles, limits::kRbpfParticles));
     for (double r : loc.numbers("lost_robots")) {
       if (r != std::floor(r) || r < 1) {
         throw InputError(loc.where("lost_robots") + ": expected robot numbers from 1, got " + fmt(r));
@@ -282,6 +283,7 @@ void validate_scenario(const Scenario& s) {
   check("localization.initial_sigma_heading_deg", rad2deg(o.initial_theta), limits::kAngleDeg);
   check("localization.mcl_particles", o.mcl_particles, limits::kMclParticles);
   check("localization.rbpf_particles", o.rbpf_particles, limits::kRbpfParticles);
+  check("localization.fastslam_particles", o.fastslam_particles, limits::kRbpfParticles);
   check("communication.range", s.communication.range_m, limits::kCommRange);
   const auto& e = s.exploration;
   check("exploration.beta", e.strategy_options.beta, limits::kWeight);
@@ -311,7 +313,8 @@ void validate_scenario(const Scenario& s) {
     if (r < 1 || r > count) throw InputError("localization.lost_robots: robot " + std::to_string(r) + " does not exist (robots 1.." + std::to_string(count) + ")");
   }
   // Landmark localizers without landmarks would quietly be dead reckoning.
-  if ((s.localization == "ekf" || s.localization == "ekf-slam") && s.landmarks.empty() && s.landmarks_along_walls <= 0.0) {
+  if ((s.localization == "ekf" || s.localization == "ekf-slam" || s.localization == "fastslam2") && s.landmarks.empty() &&
+      s.landmarks_along_walls <= 0.0) {
     throw InputError("localization '" + s.localization +
                      "' localizes against landmarks, and there are none: add some (landmarks: {along_walls: 0.5} places one "
                      "per 2 m of wall, landmarks: {points: [[x, y]]} where you want them), "
@@ -379,7 +382,8 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
   y << "localization:\n  method: " << s.localization << "\n  known_associations: " << (o.known_associations ? "true" : "false")
     << "\n  association_gate: " << fmt(o.association_gate) << "\n  robot_detections: " << (o.use_robot_detections ? "true" : "false")
     << "\n  initial_sigma_xy: " << fmt(o.initial_xy) << "\n  initial_sigma_heading_deg: " << fmt(rad2deg(o.initial_theta)) << "\n";
-  y << "  mcl_particles: " << o.mcl_particles << "\n  rbpf_particles: " << o.rbpf_particles << "\n";
+  y << "  mcl_particles: " << o.mcl_particles << "\n  rbpf_particles: " << o.rbpf_particles
+    << "\n  fastslam_particles: " << o.fastslam_particles << "\n";
   if (!s.lost_robots.empty()) {
     y << "  lost_robots: [";
     for (std::size_t i = 0; i < s.lost_robots.size(); ++i) y << (i ? ", " : "") << s.lost_robots[i];
