@@ -82,8 +82,9 @@ TEST_P(EveryStrategy, JointStrategiesNeverShareATargetWhileThereAreEnough) {
     std::set<int> used;
     for (int t : a) {
       // Coordinated and optimized give every robot a target when there are enough (the auction may
-      // leave a robot out when another one is cheaper for everything).
-      if (GetParam() != "market") {
+      // leave a robot out when another one is cheaper for everything, and so may the tours, whose
+      // minimum-latency split leaves a robot free when the others reach every target sooner).
+      if (GetParam() != "market" && GetParam() != "tour") {
         ASSERT_GE(t, 0) << "every robot can reach every target: all get one";
       }
       if (t >= 0) {
