@@ -27,9 +27,9 @@ core::Registry<StrategyFactory>& strategy_registry() {
     r.add("market", "sequential single-item auction, min-max bids on wave cost (Koenig et al. 2006; Zlot et al. 2002)",
           make_market_strategy);
     r.add("tour",
-          "an open tour per robot through every frontier target, split so that the longest tour is shortest, "
-          "repaired between rounds; each robot drives to its tour's first target (after TARE, Cao et al. 2021, "
-          "and RACER, Zhou et al. 2023)",
+          "an open tour per robot through every frontier target, split so that the unknown area behind the targets "
+          "is reached soonest (least area-weighted latency), repaired between rounds; each robot drives to its tour's "
+          "first target (after TARE, Cao et al. 2021, and RACER, Zhou et al. 2023)",
           make_tour_strategy);
     return true;
   }();

@@ -36,6 +36,9 @@ struct AssignmentInput {
   // not connected), for strategies that plan tours through several targets; computed only when
   // called, during assign(). Empty: target_costs() uses straight lines.
   std::function<Eigen::MatrixXd()> target_costs_m;
+  // Per target, the never-observed area in square metres it would reveal (unknown_area_behind), for
+  // strategies that weigh targets by it; computed only when called. Empty: every target counts alike.
+  std::function<std::vector<double>()> target_gains_m2;
 };
 
 class CoordinationStrategy {

@@ -10,6 +10,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "exploration/tour_gain.h"
 #include "mapping/grid_traversal.h"
 
 namespace fleetmap::exploration {
@@ -493,6 +494,8 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
     }
     return costs;
   };
+  // The unknown area behind each target, for strategies that weigh targets by what they reveal.
+  input.target_gains_m2 = [&] { return unknown_area_behind(map, targets, options_.sensor_range_m); };
   const std::vector<int> choice = strategy_->assign(input);
   for (std::size_t k = 0; k < members.size(); ++k) {
     RobotState& r = robots_[std::size_t(members[k])];

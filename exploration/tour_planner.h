@@ -2,7 +2,9 @@
 // Open tours for a team of robots through a set of targets, split so that the longest tour is as
 // short as it can be found (the min-max multiple travelling salesman problem with open tours, as
 // the multi-robot exploration planners of Cao et al. 2021 (TARE) and Zhou et al. 2023 (RACER)
-// pose it): cheapest min-max insertion, then local search with 2-opt, relocate and exchange moves.
+// pose it), or so that the weighted sum of the times the targets are reached is (the multi-robot
+// minimum-latency problem): cheapest insertion, then local search with 2-opt, relocate and
+// exchange moves.
 // Pure data in, tours out: the costs come from waves over a robot's map (see tour_strategy.cpp).
 #include <Eigen/Core>
 
@@ -27,7 +29,8 @@ struct TourOptions {
   // Every robot that can reach a target gets one while there are enough to go round (taken from a
   // tour of two or more where the longest tour grows least), and no move empties a tour: the
   // min-max split alone leaves a robot idle whenever it is farther from every target than the
-  // longest tour, yet an exploring robot finds new frontiers on its way.
+  // longest tour, yet an exploring robot finds new frontiers on its way. plan_tours only: the
+  // minimum-latency tours of plan_latency_tours leave a robot free only when that is better.
   bool every_robot_busy = true;
 };
 
@@ -47,5 +50,18 @@ double tour_length(const TourProblem& problem, int robot, const std::vector<int>
 // every_robot_busy). The same problem and initial tours give the same
 // tours. The objective, compared in this order: the longest tour, then the sum of the tours.
 Tours plan_tours(const TourProblem& problem, const Tours& initial = {}, const TourOptions& options = {});
+
+// Tours that reveal the most, soonest: the weighted sum, over the targets, of the time each is
+// reached (its weight times the length of its robot's tour up to it) is made as small as the search
+// finds (the multi-robot minimum-latency problem; with the unknown area behind each target as its
+// weight, the area the team reveals over time, as TARE and RACER weigh tours by their gain).
+// Unlike the min-max split, every tour counts: a robot near a target takes it rather than a far one,
+// and a robot with nothing near stays free. Same input rules as plan_tours; `weight` has one
+// non-negative entry per target (empty: all 1).
+Tours plan_latency_tours(const TourProblem& problem, const std::vector<double>& weight, const Tours& initial = {},
+                         const TourOptions& options = {});
+
+// The weighted latency of robot `robot`'s tour (+inf when a leg is not possible).
+double tour_latency(const TourProblem& problem, const std::vector<double>& weight, int robot, const std::vector<int>& tour);
 
 }  // namespace fleetmap::exploration

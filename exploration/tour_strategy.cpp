@@ -12,14 +12,22 @@ namespace fleetmap::exploration {
 namespace {
 
 // Multi-robot frontier tours, after TARE (Cao et al. 2021) and RACER (Zhou et al. 2023): every
-// frontier target is a node, with wave costs from each robot and between the targets; every robot
-// gets an open tour, and the targets are split among the robots so that the longest tour is as
-// short as the search finds (plan_tours). Each robot drives to its tour's first target. Legs
-// between targets are shortened by the sensor range (a target is seen from that far).
+// frontier target is a node, with wave costs from each robot and between the targets, weighted by
+// the never-observed area behind it (unknown_area_behind, split among the targets so that no area
+// counts twice); every robot gets an open tour, and the targets are split among the robots so that
+// the weighted sum of the times at which they are reached is as small as the search finds
+// (plan_latency_tours): the team reveals the most area soonest. Each robot drives to its tour's
+// first target.
+//
+// Why not the min-max split (the longest tour as short as possible, plan_tours): measured on the
+// wave-algorithm paper's maps it was slower than Burgard's utility reduction (bench/README.md,
+// "Tour strategy"): once one tour is the longest, the others are free to grow up to it, so robots
+// drove across the map to targets idle robots stood beside, and every frontier piece counted the
+// same whatever lay behind it.
 //
 // Tours are repaired, not planned afresh, each round (RACER's incremental update): the previous
 // round's tours are the starting solution, with the targets that vanished dropped and the new ones
-// inserted, so a robot keeps its plan unless a move makes the team's tours shorter, and robots do
+// inserted, so a robot keeps its plan unless a move makes the team's tours better, and robots do
 // not swap targets back and forth. A group of robots plans with its own members' earlier tours only:
 // robots that cannot talk never see one another's plans.
 class Tour final : public CoordinationStrategy {
@@ -35,16 +43,20 @@ class Tour final : public CoordinationStrategy {
     problem.start_cost.resize(Eigen::Index(n), Eigen::Index(m));
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t t = 0; t < m; ++t) problem.start_cost(Eigen::Index(i), Eigen::Index(t)) = input.robots[i].cost_m[t];
-    // Costs between targets only matter when some robot has two or more to visit. A robot sees a
-    // target from up to the sensor range away, so the leg to the next target is only the way to
-    // within that range of it (as in fleetmap's lower bound on exploration time): targets a robot
-    // passes within sensor range of cost nothing more, the tours gather targets that one robot sees
-    // together, and the min-max split sends the other robots elsewhere.
+    // Costs between targets only matter when some robot has two or more to visit. They are the
+    // whole wave cost: shortening legs by the sensor range (a target is seen from afar) made chains
+    // of targets free, and one robot took them all.
     problem.between = m > 1 ? target_costs(input) : Eigen::MatrixXd::Zero(Eigen::Index(m), Eigen::Index(m));
-    problem.between = (problem.between.array() - input.sensor_range_m).max(0.0).matrix();
+    // A target's weight: the unknown area behind it plus kBaseWeight, so that a frontier piece with
+    // nothing measurable behind it (the last corners, which 99% needs) is still worth a visit.
+    std::vector<double> weight;
+    if (input.target_gains_m2) {
+      weight = input.target_gains_m2();
+      for (double& w : weight) w += kBaseWeight;
+    }
 
     const std::lock_guard<std::mutex> lock(mutex_);
-    const Tours tours = plan_tours(problem, previous_tours(input, problem));
+    const Tours tours = plan_latency_tours(problem, weight, previous_tours(input, problem));
     for (std::size_t i = 0; i < n; ++i) {
       auto& kept = memory_[input.robots[i].team_index];
       kept.clear();
@@ -92,6 +104,7 @@ class Tour final : public CoordinationStrategy {
   }
 
   static constexpr double kSameTarget = 1.0;  // metres
+  static constexpr double kBaseWeight = 1.0;  // square metres
   // Per robot (team index): the goals of its last tour, in the frame of the map it was planned on.
   // The strategy's only state; assign() is const for its callers, so it is mutable and guarded.
   mutable std::map<int, std::vector<Eigen::Vector2d>> memory_;
