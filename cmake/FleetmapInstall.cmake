@@ -7,9 +7,14 @@ include(CMakePackageConfigHelpers)
 # The modules a program can link, lowest layer first (DESIGN.md §1). The CLI is not among them.
 set(FLEETMAP_MODULES core mapping io viz maps localization merging planning exploration sim sweep experiments)
 
-# Headers that stay inside the build: they use third-party types in their declarations and only
-# the modules' own sources need them.
-set(FLEETMAP_INTERNAL_HEADERS "")
+# Headers that stay inside the build: they use third-party types (cv::Mat, YAML::Node,
+# nlohmann::json) in their declarations, and only fleetmap's own sources and the CLI need them.
+# The pictures (viz/, the run, sweep and experiment reports) are OpenCV images throughout.
+set(FLEETMAP_INTERNAL_HEADERS
+  io/yaml_reader.h io/map_image.h maps/generated_maps.h sim/scenario_yaml.h sim/run_output.h
+  sweep/sweep_report.h experiments/slam_output.h experiments/corridor_output.h)
+file(GLOB viz_headers RELATIVE ${PROJECT_SOURCE_DIR} CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/viz/*.h)
+list(APPEND FLEETMAP_INTERNAL_HEADERS ${viz_headers})
 
 set(FLEETMAP_INSTALL_MAPSDIR ${CMAKE_INSTALL_DATADIR}/fleetmap/maps)
 set(FLEETMAP_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/fleetmap)
@@ -18,7 +23,8 @@ set(public_headers "")
 foreach(module IN LISTS FLEETMAP_MODULES)
   file(GLOB headers RELATIVE ${PROJECT_SOURCE_DIR} CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/${module}/*.h)
   list(APPEND public_headers ${headers})
-  set_target_properties(fleetmap_${module} PROPERTIES EXPORT_NAME ${module})
+  # Position-independent: the libraries go into the Python extension and consumers' shared libraries.
+  set_target_properties(fleetmap_${module} PROPERTIES EXPORT_NAME ${module} POSITION_INDEPENDENT_CODE ON)
   add_library(fleetmap::${module} ALIAS fleetmap_${module})
 endforeach()
 if(FLEETMAP_INTERNAL_HEADERS)
