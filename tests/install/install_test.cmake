@@ -1,7 +1,8 @@
 # Installs the build into a prefix under WORK_DIR, then configures, builds and runs the consumer
 # project against it: what a program of its own goes through with find_package(fleetmap).
 # cmake -DBUILD_DIR=<fleetmap build> -DWORK_DIR=<scratch> -DCONSUMER_DIR=<tests/install/consumer>
-#       -DGENERATOR=<generator> -DCXX_COMPILER=<c++> [-DLAUNCHER=<ccache>] -P install_test.cmake
+#       -DGENERATOR=<generator> -DCXX_COMPILER=<c++> [-DLAUNCHER=<ccache>]
+#       [-DPYTHON=<python> -DPYTHON_DIR=<the package's folder under the prefix>] -P install_test.cmake
 function(run what)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0)
@@ -35,3 +36,10 @@ run("configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/
     -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} ${launcher})
 run("build the consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/consumer-build)
 run("run the consumer" ${WORK_DIR}/consumer-build/consumer)
+
+# The Python package from the prefix: it imports from there and finds the installed maps.
+if(PYTHON)
+  run("import the installed Python package" ${CMAKE_COMMAND} -E env PYTHONPATH=${prefix}/${PYTHON_DIR} FLEETMAP_MAPS_DIR=
+      ${PYTHON} -c "import fleetmap, os, sys; assert fleetmap.__file__.startswith(sys.argv[1]), fleetmap.__file__; \
+assert os.environ['FLEETMAP_MAPS_DIR'].startswith(sys.argv[1]); print(fleetmap.load_map('office'))" ${prefix})
+endif()
