@@ -18,8 +18,10 @@ class GreedyLargestFrontier:
     def assign(self, positions, targets, costs, claimed):
         # positions (R, 2) m; targets (T, 4): goal x, goal y, frontier cells, region;
         # costs (R, T) wave metres (inf: unreachable); claimed (K, 2): goals teammates drive to.
-        gain = targets[:, 2] / (1.0 + costs)  # R x T, 0 where unreachable
         out, taken = [-1] * len(positions), set()
+        if len(targets) == 0:
+            return out
+        gain = targets[:, 2] / (1.0 + costs)  # R x T, 0 where unreachable
         for r in np.argsort(np.min(costs, axis=1)):  # the robot nearest to a target chooses first
             for t in np.argsort(-gain[r]):
                 if t not in taken and math.isfinite(costs[r, t]):

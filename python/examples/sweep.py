@@ -21,4 +21,4 @@ for (map_name, strategy, robots), runs in sorted(series.items()):
     coverage = statistics.mean(r["coverage"] for r in runs)
     steps = [r["steps_to_95"] for r in runs if r["steps_to_95"] is not None]
     print(f"{map_name:10s} {strategy:14s} {robots} robots: coverage {coverage:.1%}, "
-          f"steps to 95% {statistics.mean(steps) if steps else '-'} over {len(runs)} runs")
+          f"steps to 95% {f'{statistics.mean(steps):.0f}' if steps else '-'} over {len(runs)} runs")
