@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "maps/builtin_maps.h"
+#include "io/map_image.h"
 #include "io/map_io.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "io/file_io.h"
+#include "io/map_image.h"
 #include "io/map_io.h"
 
 namespace fleetmap::cli {

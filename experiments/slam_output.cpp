@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 #include "io/file_io.h"
+#include "io/map_image.h"
 #include "localization/metrics.h"
 #include "io/map_io.h"
 #include "viz/render.h"

@@ -9,6 +9,7 @@
 #include "io/file_io.h"
 #include "io/yaml_reader.h"
 #include "sim/scenario.h"
+#include "sim/scenario_yaml.h"
 
 namespace fleetmap::experiments {
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "io/map_image.h"
 #include "io/map_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

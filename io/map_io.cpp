@@ -17,6 +17,7 @@
 
 #include "core/error.h"
 #include "io/file_io.h"
+#include "io/map_image.h"
 #include "io/yaml_reader.h"
 
 namespace fleetmap::io {
@@ -450,6 +451,23 @@ void save_map_yaml(const mapping::OccupancyGrid& grid, const fs::path& yaml_path
   meta.resolution = grid.resolution();
   meta.origin = grid.geometry().origin();
   io::write_file_atomic(yaml_path, format_map_yaml(meta));
+}
+
+MapImage map_image(const mapping::OccupancyGrid& grid) {
+  const cv::Mat image = grid_to_image(grid);
+  return {image.cols, image.rows, std::vector<std::uint8_t>(image.datastart, image.dataend)};
+}
+
+mapping::OccupancyGrid grid_from_map_image(const MapImage& image, const MapYaml& meta,
+                                           const mapping::OccupancyGridOptions& grid_options) {
+  if (image.width <= 0 || image.height <= 0 ||
+      image.pixels.size() != std::size_t(image.width) * std::size_t(image.height)) {
+    throw InputError("map image: expected width x height pixels, got " + std::to_string(image.pixels.size()) + " for " +
+                     std::to_string(image.width) + " x " + std::to_string(image.height));
+  }
+  // OpenCV reads the pixels in place; grid_from_image only reads them.
+  const cv::Mat view(image.height, image.width, CV_8UC1, const_cast<std::uint8_t*>(image.pixels.data()));
+  return grid_from_image(view, meta, grid_options);
 }
 
 }  // namespace fleetmap::io

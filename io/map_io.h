@@ -2,8 +2,6 @@
 // Map files: PNG/PGM images and ROS map_server YAML, with map_server's semantics
 // (image row 0 is the top, cell row 0 the bottom; occ = (255 - mean(RGB)) / 255, inverted by
 // `negate`; Occupied when occ > occupied_thresh, Free when occ < free_thresh).
-#include <opencv2/core/mat.hpp>
-
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -48,14 +46,19 @@ MapYaml parse_map_yaml(std::string_view text, const std::string& source);
 // The YAML text map_saver writes (the image path as given).
 std::string format_map_yaml(const MapYaml& yaml);
 
-// Decodes the bytes of a PNG or PGM map image, refusing images over `options.max_cells` from their
-// header before decoding. Returns 8-bit 1-4 channel pixels; throws InputError naming `source`.
-cv::Mat decode_map_image(const std::string& bytes, const std::string& source, const MapLoadOptions& options = {});
-// Builds a grid from a decoded image (8-bit, 1 to 4 channels) with map_server's rules.
-mapping::OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta,
-                              const mapping::OccupancyGridOptions& grid_options = {});
-// The map_saver image: 254 free, 0 occupied, 205 unknown, 8-bit single channel, top row first.
-cv::Mat grid_to_image(const mapping::OccupancyGrid& grid);
+// A map image as map_saver writes it: 8-bit grey, 254 free, 0 occupied, 205 unknown, row-major,
+// top row first (image row 0 is the map's last cell row).
+struct MapImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> pixels;  // width * height
+};
+// The map_saver image of a grid.
+MapImage map_image(const mapping::OccupancyGrid& grid);
+// A grid from a grey image with map_server's rules (`meta`'s thresholds, mode, resolution and
+// origin). Throws InputError when the pixels are not width * height or the image is empty.
+mapping::OccupancyGrid grid_from_map_image(const MapImage& image, const MapYaml& meta,
+                                           const mapping::OccupancyGridOptions& grid_options = {});
 
 // Loads a map from a map_server YAML (.yaml / .yml) or an image (PNG, PGM, ...).
 // Throws InputError naming the file for anything missing, unreadable, empty or too large.
@@ -65,15 +68,10 @@ mapping::OccupancyGrid load_map(const std::filesystem::path& path, const MapLoad
 // For checks that no output replaces an input; a YAML that cannot be read gives just itself.
 std::vector<std::filesystem::path> map_files(const std::filesystem::path& path);
 
-// The bytes of `image` in the format an extension names (".png", ".pgm"). Throws InputError
-// naming `what` when fleetmap cannot write that format for this image.
-std::string encode_image(const std::string& extension, const cv::Mat& image, const std::string& what);
 // Throws InputError (before any work) unless pictures can be written to `path`: a .png name, or
 // the standard output ("-", which gets PNG).
 void check_picture_path(const std::filesystem::path& path, const std::string& what);
 
-// Encodes `image` (extension picks the format) and writes it atomically.
-void write_image(const std::filesystem::path& path, const cv::Mat& image);
 // Saves the map_saver image of the grid as PNG or PGM (by extension).
 void save_map_image(const mapping::OccupancyGrid& grid, const std::filesystem::path& path);
 // Saves `<yaml_path stem>.pgm` beside the YAML and the YAML that map_server loads back.

@@ -5,8 +5,8 @@
 // with d taken from an OpenCV distance transform of a window of a grid. The field is a table of
 // log p per cell of that window; points outside the window count as far from every wall.
 #include <Eigen/Core>
-#include <opencv2/core.hpp>
 
+#include <cmath>
 #include <functional>
 #include <vector>
 

@@ -1,4 +1,5 @@
 #include "maps/builtin_maps.h"
+#include "maps/generated_maps.h"
 
 #include <algorithm>
 #include <cmath>

@@ -2,8 +2,6 @@
 // The built-in maps: the wave-algorithm paper's four 200x200 environments (Fig. 5: empty, unstructured, office,
 // corridor) and more (cave, maze, warehouse, campus). Each is a PNG + map_server YAML pair in
 // maps/, made by generate_builtin_map(); regenerating gives the committed files bit for bit.
-#include <opencv2/core/mat.hpp>
-
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -34,16 +32,6 @@ std::vector<BuiltinMapInfo> builtin_maps();
 bool is_builtin_map(std::string_view name);
 // "empty, unstructured, ..." for messages.
 std::string builtin_map_names();
-
-struct GeneratedMap {
-  cv::Mat image;          // 8-bit grey, 254 free, 0 occupied, top row first
-  io::MapYaml yaml;  // image: <name>.png
-};
-
-// Deterministic: the same image and YAML on every call. Throws InputError for unknown names.
-GeneratedMap generate_builtin_map(std::string_view name);
-// The bytes of the committed files: the PNG encoding of the image, and the YAML text.
-std::string encode_png(const cv::Mat& image);
 
 // Where the built-in map files live: $FLEETMAP_MAPS_DIR if set, else the source tree's maps/,
 // else <executable>/../share/fleetmap/maps.

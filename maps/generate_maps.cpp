@@ -8,6 +8,7 @@
 
 #include "io/file_io.h"
 #include "maps/builtin_maps.h"
+#include "maps/generated_maps.h"
 
 int main(int argc, char** argv) {
   namespace fm = fleetmap;

@@ -9,6 +9,7 @@ packages=(
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libexpat1-dev
+  pybind11-dev python3-dev python3-numpy
   slurm-wlm
 )
 # `--robustness` adds clang and its libFuzzer runtime, for the fuzzing stage of .ci/run.

@@ -1,5 +1,7 @@
 #include "sim/run_metrics.h"
 
+#include "sim/run_output.h"
+
 namespace fleetmap::sim {
 
 RunTotals run_totals(const RunResult& r) {
@@ -16,6 +18,10 @@ RunTotals run_totals(const RunResult& r) {
   t.position_rmse_m = r.robots.empty() ? 0.0 : rmse_sum / double(r.robots.size());
   for (const auto& m : r.merges) (m.merged ? t.merges_made : t.merges_refused) += 1;
   return t;
+}
+
+std::string metrics_json_text(const RunResult& result, const std::string& map_label) {
+  return metrics_json(result, map_label).dump(2) + "\n";
 }
 
 }  // namespace fleetmap::sim

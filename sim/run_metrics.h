@@ -1,6 +1,7 @@
 #pragma once
 // The totals of a run that metrics.json, results.csv and the run summary all report, computed in
 // one place from the run's record.
+#include <string>
 #include <vector>
 
 #include "localization/metrics.h"
@@ -17,5 +18,9 @@ struct RunTotals {
 };
 
 RunTotals run_totals(const RunResult& result);
+
+// The text of metrics.json as `fleetmap explore` writes it (indented JSON), for programs that link
+// fleetmap; `map_label` is the map's name in it.
+std::string metrics_json_text(const RunResult& result, const std::string& map_label);
 
 }  // namespace fleetmap::sim

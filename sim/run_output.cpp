@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "io/file_io.h"
 #include "localization/metrics.h"
+#include "io/map_image.h"
 #include "io/map_io.h"
 #include "io/octomap_io.h"
 #include "sim/run_metrics.h"
@@ -271,7 +272,7 @@ std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& m
     io::save_map_yaml(r.robot_maps[i], yaml);
     for (const auto& f : io::map_output_files(yaml)) add(f);
   }
-  io::write_file_atomic(dir / "metrics.json", metrics_json(r, map_label).dump(2) + "\n");
+  io::write_file_atomic(dir / "metrics.json", metrics_json_text(r, map_label));
   add(dir / "metrics.json");
   io::save_map_yaml(r.merged, dir / "map.yaml");
   add(dir / "map.pgm");

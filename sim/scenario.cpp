@@ -1,4 +1,5 @@
 #include "sim/scenario.h"
+#include "sim/scenario_yaml.h"
 
 #include <algorithm>
 #include <cmath>

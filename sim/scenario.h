@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "core/transform2.h"
-#include "io/yaml_reader.h"
 #include "exploration/team_explorer.h"
 #include "localization/localizer.h"
 #include "merging/merge.h"
@@ -111,14 +110,6 @@ std::vector<std::string> merging_names();
 std::vector<std::string> path_planner_names();
 
 // Parses scenario YAML; `source` names it in errors and `base_dir` anchors relative map paths.
-// The `noise:` mapping of a scenario ({position: m, heading_deg: deg} per step), keys not given
-// taken from `fallback`. Throws InputError naming the key.
-MotionNoise read_motion_noise(io::YamlMap noise, const MotionNoise& fallback);
-
-// A detector mapping ({max_range, fov_deg, range_noise, bearing_noise_deg}: the scenario's
-// `sensors.robots`, the SLAM scenario's `sensors.camera`), keys not given taken from `fallback`.
-RobotDetectorOptions read_robot_detector(io::YamlMap detector, const RobotDetectorOptions& fallback);
-
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 Scenario load_scenario(const std::filesystem::path& path);
 // The map to load: a built-in name as is (unless a file of that name is in the scenario's folder),

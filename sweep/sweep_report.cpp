@@ -11,6 +11,7 @@
 #include "core/format.h"
 #include "core/error.h"
 #include "io/file_io.h"
+#include "io/map_image.h"
 #include "io/map_io.h"
 #include "viz/plot.h"
 

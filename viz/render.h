@@ -1,7 +1,7 @@
 #pragma once
 // Every picture fleetmap draws: a grid in map colours (unknown grey, free white, occupied black)
 // with overlays (paths, robots, cells such as frontiers, points such as landmarks), a legend and a
-// scale bar. Images are OpenCV BGR matrices; writing them is map_io's write_image.
+// scale bar. Images are OpenCV BGR matrices; writing them is io/map_image.h's write_image.
 #include <Eigen/Core>
 #include <opencv2/core/mat.hpp>
 

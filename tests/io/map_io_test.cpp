@@ -1,3 +1,4 @@
+#include "io/map_image.h"
 #include "io/map_io.h"
 
 #include <gtest/gtest.h>

@@ -1,10 +1,12 @@
 #include "maps/builtin_maps.h"
+#include "maps/generated_maps.h"
 
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include "io/file_io.h"
+#include "io/map_image.h"
 #include "io/map_io.h"
 #include "tests/test_support.h"
 

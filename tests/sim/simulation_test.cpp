@@ -6,6 +6,7 @@
 
 #include "core/angle.h"
 #include "maps/builtin_maps.h"
+#include "io/map_image.h"
 #include "io/map_io.h"
 #include "sim/run_output.h"
 #include "tests/sim/sim_test_maps.h"

@@ -1,0 +1,342 @@
+// The C++ half of the Python package `fleetmap` (pybind11): maps as numpy arrays, exploration runs,
+// map merging, path planning, sweeps, and coordination strategies written in Python. The Python
+// half (fleetmap/__init__.py) turns scenario dicts and files into the YAML text read here and wraps
+// the results; fleetmap/__init__.pyi documents both.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/error.h"
+#include "exploration/strategy.h"
+#include "io/map_io.h"
+#include "maps/builtin_maps.h"
+#include "merging/merge.h"
+#include "planning/free_space.h"
+#include "planning/planner.h"
+#include "sim/run_metrics.h"
+#include "sim/run_output.h"
+#include "sim/scenario.h"
+#include "sim/simulation.h"
+#include "sweep/sweep.h"
+#include "sweep/sweep_results.h"
+#include "sweep/sweep_runner.h"
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+using namespace fleetmap;
+
+namespace {
+
+using Array2 = py::array_t<double>;
+
+// Poses as rows (x, y, theta).
+py::array_t<double> pose_rows(const std::vector<core::Pose2>& poses) {
+  py::array_t<double> out({py::ssize_t(poses.size()), py::ssize_t(3)});
+  auto a = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    a(py::ssize_t(i), 0) = poses[i].x, a(py::ssize_t(i), 1) = poses[i].y, a(py::ssize_t(i), 2) = poses[i].theta;
+  }
+  return out;
+}
+
+py::array_t<double> point_rows(const std::vector<Eigen::Vector2d>& points) {
+  py::array_t<double> out({py::ssize_t(points.size()), py::ssize_t(2)});
+  auto a = out.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < points.size(); ++i) a(py::ssize_t(i), 0) = points[i].x(), a(py::ssize_t(i), 1) = points[i].y();
+  return out;
+}
+
+py::tuple pose_tuple(const core::Pose2& p) { return py::make_tuple(p.x, p.y, p.theta); }
+
+// The map_saver image of a grid: uint8 (height, width), top row first, 254 free, 0 occupied, 205 unknown.
+py::array_t<std::uint8_t> grid_image(const mapping::OccupancyGrid& grid) {
+  io::MapImage image = io::map_image(grid);
+  py::array_t<std::uint8_t> out({py::ssize_t(image.height), py::ssize_t(image.width)});
+  std::copy(image.pixels.begin(), image.pixels.end(), out.mutable_data());
+  return out;
+}
+
+mapping::OccupancyGrid grid_from_array(const py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>& array,
+                                       double resolution, const core::Pose2& origin) {
+  if (array.ndim() != 2 || array.shape(0) == 0 || array.shape(1) == 0) {
+    throw InputError("map image: expected a non-empty 2-D array (rows, columns), got " + std::to_string(array.ndim()) +
+                     " dimensions");
+  }
+  if (!(resolution >= io::kResolutionRange.lo && resolution <= io::kResolutionRange.hi)) {
+    throw InputError("map resolution: expected " + core::expected_text(io::kResolutionRange) + " metres per cell");
+  }
+  io::MapImage image;
+  image.height = int(array.shape(0));
+  image.width = int(array.shape(1));
+  image.pixels.assign(array.data(), array.data() + array.size());
+  io::MapYaml meta;
+  meta.resolution = resolution;
+  meta.origin = origin;
+  return io::grid_from_map_image(image, meta);
+}
+
+// A finished exploration run and the label its map goes by.
+struct Run {
+  sim::RunResult result;
+  std::string label;
+};
+
+Run explore(const std::string& yaml, const std::string& source, const std::string& base_dir) {
+  sim::Scenario s = sim::parse_scenario(yaml, source, base_dir);
+  s.map = sim::map_source(s);
+  io::MapLoadOptions load;
+  load.default_resolution = s.map_resolution_m;
+  auto truth = maps::load_map_source(s.map, load);
+  Run run{{}, sweep::map_label(s.map)};
+  sim::Simulation simulation(s, std::move(truth));
+  run.result = simulation.run();
+  return run;
+}
+
+// A sweep's rows as results.csv has them: the header, then one line per run, in the sweep's order.
+std::vector<std::string> run_sweep(const std::string& yaml, const std::string& source, const std::string& base_dir,
+                                   int jobs) {
+  const sweep::Sweep spec = sweep::parse_sweep(yaml, source, base_dir);
+  sweep::SweepMaps truths;
+  for (const auto& m : spec.maps) {
+    io::MapLoadOptions load;
+    load.default_resolution = spec.base.map_resolution_m;
+    truths.emplace(sweep::map_label(m), maps::load_map_source(m, load));
+  }
+  sweep::check_placements(spec, truths);
+  const auto runs = sweep::sweep_runs(spec);
+  std::vector<sweep::RunRecord> records;
+  std::mutex mutex;
+  sweep::run_sweep(spec, runs, truths, {jobs}, [&](const sweep::RunRecord& r) {
+    const std::lock_guard<std::mutex> lock(mutex);
+    records.push_back(r);
+  });
+  sweep::sort_records(records, runs);
+  std::vector<std::string> lines{sweep::results_header()};
+  for (const auto& r : records) lines.push_back(sweep::format_record(r));
+  return lines;
+}
+
+// A coordination strategy whose assign() is a Python object's method:
+//   assign(positions (R, 2), targets (T, 4): goal x, goal y, frontier cells, region,
+//          costs (R, T) wave metres (inf: unreachable), claimed (K, 2)) -> R target indices or -1.
+// Simulations run with the GIL released (sweeps on several threads); each call takes it.
+class PythonStrategy final : public exploration::CoordinationStrategy {
+ public:
+  PythonStrategy(std::string name, bool joint, py::object instance)
+      : name_(std::move(name)), joint_(joint), instance_(std::move(instance)) {}
+  ~PythonStrategy() override {
+    py::gil_scoped_acquire gil;
+    instance_ = py::object();
+  }
+  std::string name() const override { return name_; }
+  bool joint() const override { return joint_; }
+
+  std::vector<int> assign(const exploration::AssignmentInput& input) const override {
+    py::gil_scoped_acquire gil;
+    const auto robots = py::ssize_t(input.robots.size()), targets = py::ssize_t(input.targets.size());
+    std::vector<Eigen::Vector2d> positions;
+    for (const auto& r : input.robots) positions.push_back(r.position_m);
+    py::array_t<double> target_rows({targets, py::ssize_t(4)});
+    auto t = target_rows.mutable_unchecked<2>();
+    for (py::ssize_t k = 0; k < targets; ++k) {
+      const auto& target = input.targets[std::size_t(k)];
+      t(k, 0) = target.goal_m.x(), t(k, 1) = target.goal_m.y(), t(k, 2) = target.cells, t(k, 3) = target.region;
+    }
+    py::array_t<double> costs({robots, targets});
+    auto c = costs.mutable_unchecked<2>();
+    for (py::ssize_t r = 0; r < robots; ++r) {
+      for (py::ssize_t k = 0; k < targets; ++k) c(r, k) = input.robots[std::size_t(r)].cost_m[std::size_t(k)];
+    }
+    std::vector<int> out;
+    try {
+      const py::object answer =
+          instance_.attr("assign")(point_rows(positions), target_rows, costs, point_rows(input.claimed));
+      for (const auto& item : answer) out.push_back(item.cast<int>());
+    } catch (const py::error_already_set& e) {
+      throw Error("strategy '" + name_ + "': assign raised " + std::string(e.what()));
+    } catch (const py::cast_error& e) {
+      throw Error("strategy '" + name_ + "': assign must return a sequence of integers");
+    }
+    if (out.size() != input.robots.size()) {
+      throw Error("strategy '" + name_ + "': assign returned " + std::to_string(out.size()) + " targets for " +
+                  std::to_string(input.robots.size()) + " robots");
+    }
+    for (const int k : out) {
+      if (k < -1 || k >= targets) {
+        throw Error("strategy '" + name_ + "': target index " + std::to_string(k) + " is not -1 or in 0.." +
+                    std::to_string(targets - 1));
+      }
+    }
+    return out;
+  }
+
+ private:
+  std::string name_;
+  bool joint_;
+  py::object instance_;
+};
+
+void register_python_strategy(const std::string& name, const py::object& cls, const std::string& help, bool joint) {
+  if (!py::hasattr(cls, "assign")) throw InputError("register_strategy '" + name + "': the class has no assign method");
+  // The registry keeps its factories for the life of the process, beyond the interpreter's; the
+  // class is held by a reference that is never released, so no Python object dies without it.
+  PyObject* held = cls.ptr();
+  Py_INCREF(held);
+  exploration::register_strategy(name, help.empty() ? "written in Python" : help,
+                                 [name, held, joint](const exploration::StrategyOptions&) {
+                                   py::gil_scoped_acquire gil;
+                                   py::object instance = py::reinterpret_borrow<py::object>(held)();
+                                   return std::make_unique<PythonStrategy>(name, joint, std::move(instance));
+                                 });
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_fleetmap, m) {
+  m.doc() = "fleetmap's C++ core; use the package `fleetmap`, which wraps it.";
+  // pybind11 tries the most recently registered translator first: InputError (an Error) goes last.
+  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
+  py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+
+  py::class_<mapping::OccupancyGrid>(m, "Map", "An occupancy grid map.")
+      .def_static(
+          "from_image",
+          [](const py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>& image, double resolution,
+             std::tuple<double, double, double> origin) {
+            return grid_from_array(image, resolution, {std::get<0>(origin), std::get<1>(origin), std::get<2>(origin)});
+          },
+          py::arg("image"), py::arg("resolution") = 0.05, py::arg("origin") = std::make_tuple(0.0, 0.0, 0.0))
+      .def_property_readonly("image", &grid_image)
+      .def_property_readonly("width", &mapping::OccupancyGrid::width)
+      .def_property_readonly("height", &mapping::OccupancyGrid::height)
+      .def_property_readonly("resolution", &mapping::OccupancyGrid::resolution)
+      .def_property_readonly("origin", [](const mapping::OccupancyGrid& g) { return pose_tuple(g.geometry().origin()); })
+      .def_property_readonly("free_cells", [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Free); })
+      .def_property_readonly("occupied_cells",
+                             [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Occupied); })
+      .def(
+          "save",
+          [](const mapping::OccupancyGrid& g, const std::string& file) {
+            const fs::path path(file);
+            const auto ext = path.extension().string();
+            if (ext == ".yaml" || ext == ".yml") io::save_map_yaml(g, path);
+            else io::save_map_image(g, path);
+          },
+          py::arg("path"))
+      .def("__repr__", [](const mapping::OccupancyGrid& g) {
+        return "<fleetmap.Map " + std::to_string(g.width()) + " x " + std::to_string(g.height()) + " cells of " +
+               std::to_string(g.resolution()) + " m>";
+      });
+
+  m.def(
+      "load_map",
+      [](const std::string& source, double resolution) {
+        io::MapLoadOptions load;
+        load.default_resolution = resolution;
+        return maps::load_map_source(source, load);
+      },
+      py::arg("source"), py::arg("resolution") = 0.05);
+  m.def("map_names", [] {
+    std::vector<std::string> names;
+    for (const auto& info : maps::builtin_maps()) names.push_back(info.name);
+    return names;
+  });
+  m.def("strategy_names", &exploration::strategy_names);
+  m.def("planner_names", &planning::planner_names);
+  m.def("merge_method_names", &merging::merge_method_names);
+
+  py::class_<Run>(m, "Run")
+      .def_property_readonly("label", [](const Run& r) { return r.label; })
+      .def_property_readonly("steps", [](const Run& r) { return r.result.steps; })
+      .def_property_readonly("finished", [](const Run& r) { return r.result.finished; })
+      .def("metrics_json", [](const Run& r) { return sim::metrics_json_text(r.result, r.label); })
+      .def_property_readonly("coverage", [](const Run& r) { return py::array_t<double>(py::ssize_t(r.result.coverage.size()), r.result.coverage.data()); })
+      .def_property_readonly("trajectories", [](const Run& r) {
+        std::vector<py::array_t<double>> out;
+        for (const auto& t : r.result.robots) out.push_back(pose_rows(t.truth));
+        return out;
+      })
+      .def_property_readonly("estimates", [](const Run& r) {
+        std::vector<py::array_t<double>> out;
+        for (const auto& t : r.result.robots) out.push_back(pose_rows(t.estimate));
+        return out;
+      })
+      .def_property_readonly("merged_map", [](const Run& r) { return r.result.merged; })
+      .def_property_readonly("robot_maps", [](const Run& r) { return r.result.robot_maps; })
+      .def(
+          "write_outputs",
+          [](const Run& r, const std::string& dir) {
+            std::vector<std::string> files;
+            for (const auto& p : sim::write_run_outputs(r.result, r.label, dir)) files.push_back(p.string());
+            return files;
+          },
+          py::arg("folder"));
+  m.def("_explore", &explore, py::arg("yaml"), py::arg("source"), py::arg("base_dir"),
+        py::call_guard<py::gil_scoped_release>());
+  m.def("_sweep", &run_sweep, py::arg("yaml"), py::arg("source"), py::arg("base_dir"), py::arg("jobs"),
+        py::call_guard<py::gil_scoped_release>());
+
+  py::class_<merging::MergeResult>(m, "MergeResult", "Map b aligned to map a.")
+      .def_readonly("merged", &merging::MergeResult::merged)
+      .def_readonly("confidence", &merging::MergeResult::confidence)
+      .def_readonly("acceptance", &merging::MergeResult::acceptance)
+      .def_readonly("method", &merging::MergeResult::method)
+      .def_readonly("reason", &merging::MergeResult::reason)
+      .def_property_readonly("transform", [](const merging::MergeResult& r) {
+        return py::make_tuple(r.transform.translation().x(), r.transform.translation().y(), r.transform.rotation());
+      })
+      .def("__repr__", [](const merging::MergeResult& r) {
+        return std::string("<fleetmap.MergeResult ") + (r.merged ? "merged" : "not merged") +
+               ", confidence " + std::to_string(r.confidence) + ">";
+      });
+  m.def(
+      "_merge_maps",
+      [](const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b, const std::string& method,
+         double min_confidence, std::uint64_t seed) {
+        merging::MergeOptions options;
+        options.method = method;
+        options.min_confidence = min_confidence;
+        options.seed = seed;
+        return merging::align_maps(a, b, options);
+      },
+      py::arg("a"), py::arg("b"), py::arg("method"), py::arg("min_confidence"), py::arg("seed"),
+      py::call_guard<py::gil_scoped_release>());
+
+  py::class_<planning::PlanResult>(m, "PlanResult", "A planned path.")
+      .def_property_readonly("success", &planning::PlanResult::success)
+      .def_property_readonly("status", [](const planning::PlanResult& r) { return std::string(planning::to_string(r.status)); })
+      .def_readonly("planner", &planning::PlanResult::planner)
+      .def_readonly("length_m", &planning::PlanResult::length_m)
+      .def_readonly("detail", &planning::PlanResult::detail)
+      .def_property_readonly("path", [](const planning::PlanResult& r) { return point_rows(r.path); })
+      .def("__repr__", [](const planning::PlanResult& r) {
+        return "<fleetmap.PlanResult " + std::string(planning::to_string(r.status)) + ", " + std::to_string(r.length_m) + " m>";
+      });
+  m.def(
+      "_plan_path",
+      [](const mapping::OccupancyGrid& map, std::pair<double, double> start, std::pair<double, double> goal,
+         const std::string& planner, double robot_radius, double time_budget, std::uint64_t seed) {
+        planning::FreeSpaceOptions space_options;
+        space_options.robot_radius_m = robot_radius;
+        const planning::FreeSpace space(map, space_options);
+        planning::PlannerOptions options;
+        options.time_budget_s = time_budget;
+        options.seed = seed;
+        return planning::make_planner(planner)->plan(space, {start.first, start.second}, {goal.first, goal.second},
+                                                     options);
+      },
+      py::arg("map"), py::arg("start"), py::arg("goal"), py::arg("planner"), py::arg("robot_radius"),
+      py::arg("time_budget"), py::arg("seed"), py::call_guard<py::gil_scoped_release>());
+
+  m.def("_register_strategy", &register_python_strategy, py::arg("name"), py::arg("cls"), py::arg("help"),
+        py::arg("joint"));
+}

@@ -1,0 +1,206 @@
+"""fleetmap from Python: multi-robot exploration, mapping, map merging and path planning.
+
+Runs explorations from a scenario (a dict, a YAML file, or keyword arguments) and returns their
+metrics and per-step arrays; loads and saves maps as numpy arrays (map_server's 0 occupied,
+254 free, 205 unknown); merges two maps; plans paths; runs benchmark sweeps; and registers
+coordination strategies written in Python, which scenarios and sweeps then use by name like the
+built-in ones.
+
+    import fleetmap
+    run = fleetmap.explore(map="office", robots=2, steps=50, seed=1)
+    print(run.metrics["coverage"], run.coverage[-1], run.trajectories[0].shape)
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _fleetmap
+from ._fleetmap import (  # noqa: F401  (re-exported)
+    Error,
+    InputError,
+    Map,
+    MergeResult,
+    PlanResult,
+    load_map,
+    map_names,
+    merge_method_names,
+    planner_names,
+    strategy_names,
+)
+
+__all__ = [
+    "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
+    "explore", "sweep", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
+    "map_names", "strategy_names", "planner_names", "merge_method_names",
+]
+
+# The built-in maps ship beside the installed package (share/fleetmap/maps); the C++ side looks
+# there when the source tree's maps/ is not around and FLEETMAP_MAPS_DIR is not set.
+_installed_maps = Path(__file__).resolve().parent.parent.parent.parent.parent / "share" / "fleetmap" / "maps"
+if "FLEETMAP_MAPS_DIR" not in os.environ and _installed_maps.is_dir():
+    os.environ["FLEETMAP_MAPS_DIR"] = str(_installed_maps)
+
+PathLike = Union[str, os.PathLike]
+
+
+def _yaml_value(value: Any) -> Any:
+    """JSON is YAML: only infinities need spelling as fleetmap's parsers read them ('inf')."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return "inf" if value > 0 else "-inf"
+    if isinstance(value, Mapping):
+        return {str(k): _yaml_value(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_yaml_value(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _spec_text(spec: Union[None, Mapping[str, Any], PathLike], keys: Mapping[str, Any], what: str):
+    """(YAML text, source name, base folder) of a dict, a YAML file or keyword arguments."""
+    if spec is None:
+        data: dict = {}
+    elif isinstance(spec, Mapping):
+        data = dict(spec)
+    else:
+        path = Path(spec)
+        if keys:
+            raise InputError(f"{path}: give either a {what} file or keyword arguments, not both")
+        try:
+            text = path.read_text()
+        except OSError as e:
+            raise InputError(f"{path}: cannot read the {what} file ({e.strerror})") from None
+        return text, str(path), str(path.parent)
+    data.update(keys)
+    return json.dumps(_yaml_value(data)), f"{what} (Python)", os.getcwd()
+
+
+class ExplorationResult:
+    """One exploration run.
+
+    Attributes:
+        metrics: the dict that `fleetmap explore` writes as metrics.json.
+        coverage: float array (steps + 1,): the share of the observable space the team's merged
+            map has observed after each step (index 0: the first scan).
+        trajectories: per robot, its true poses, float array (steps + 1, 3) of x, y (m), theta (rad).
+        estimates: per robot, its estimated poses in the world frame, same shape.
+        merged_map: the merged map (a Map) at the end.
+        robot_maps: each robot's own map (in its own frame).
+        steps: steps taken; finished: every robot ran out of reachable frontiers before the limit.
+    """
+
+    def __init__(self, run: "_fleetmap.Run"):
+        self._run = run
+        self.metrics: dict = json.loads(run.metrics_json())
+        self.coverage: np.ndarray = run.coverage
+        self.trajectories: list = run.trajectories
+        self.estimates: list = run.estimates
+        self.steps: int = run.steps
+        self.finished: bool = run.finished
+
+    @property
+    def merged_map(self) -> Map:
+        return self._run.merged_map
+
+    @property
+    def robot_maps(self) -> list:
+        return self._run.robot_maps
+
+    def save(self, folder: PathLike) -> list:
+        """Writes the run's files as `fleetmap explore` does (merged.png, robot_<k>.png,
+        metrics.json, map.pgm + map.yaml, map.bt, scenario.yaml) into `folder`; returns their paths."""
+        return self._run.write_outputs(str(folder))
+
+    def __repr__(self) -> str:
+        return (f"<fleetmap.ExplorationResult {self._run.label}: {self.steps} steps, "
+                f"coverage {self.coverage[-1]:.3f}>")
+
+
+def explore(scenario: Union[None, Mapping[str, Any], PathLike] = None, **keys: Any) -> ExplorationResult:
+    """Runs one exploration and returns its ExplorationResult.
+
+    `scenario` is a scenario dict (the keys of a scenario YAML file, e.g. {"map": "office",
+    "robots": 2, "exploration": {"strategy": "coordinated"}}), the path of a scenario YAML file, or
+    None; keyword arguments are further top-level scenario keys (map, robots, steps, seed, ...) and
+    override the dict's. `strategy="name"` is short for exploration: {strategy: name}.
+    Bad scenarios raise InputError (a ValueError) naming the key.
+    """
+    if "strategy" in keys:
+        strategy = keys.pop("strategy")
+        exploration = dict((scenario or {}).get("exploration", {}) if isinstance(scenario, Mapping) else {})
+        exploration.update(keys.pop("exploration", {}))
+        exploration["strategy"] = strategy
+        keys["exploration"] = exploration
+    text, source, base = _spec_text(scenario, keys, "scenario")
+    return ExplorationResult(_fleetmap._explore(text, source, base))
+
+
+_TEXT_COLUMNS = {"map", "strategy", "variant", "localization", "merging", "settings"}
+
+
+def _number(text: str) -> Any:
+    if text == "":
+        return None
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return {"true": True, "false": False}.get(text, text)
+
+
+def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, **keys: Any) -> list:
+    """Runs a benchmark sweep (every map x strategy x team size x seed) and returns its rows.
+
+    `spec` is a sweep dict or sweep YAML file (keys as `fleetmap bench --sweep`: maps, strategies,
+    robots, seeds, steps, comm_range, vary, ...); keyword arguments add keys. Returns one dict per
+    run with the columns of bench's results.csv (numbers as int/float, empty cells as None), in the
+    sweep's order. `jobs` runs that many simulations at once.
+    """
+    text, source, base = _spec_text(spec, keys, "sweep")
+    lines = _fleetmap._sweep(text, source, base, int(jobs))
+    rows = csv.DictReader(io.StringIO("\n".join(lines) + "\n"))
+    return [{k: v if k in _TEXT_COLUMNS else _number(v) for k, v in row.items()} for row in rows]
+
+
+def save_map(map: Map, path: PathLike) -> None:
+    """Saves a map: a .yaml path writes map_server's YAML and a .pgm beside it; .png/.pgm the image."""
+    map.save(str(path))
+
+
+def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1) -> MergeResult:
+    """Aligns map b to map a. The result's `transform` (tx, ty, theta) takes b's cells into a's
+    cells; `confidence` is in [0, 1] and `merged` says whether it reached `min_confidence`."""
+    return _fleetmap._merge_maps(a, b, method, min_confidence, seed)
+
+
+def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: str = "astar",
+              robot_radius: float = 0.2, time_budget: float = 1.0, seed: int = 1) -> PlanResult:
+    """Plans a path for a round robot from `start` to `goal` (x, y in metres) on `map`, unknown
+    cells counting as obstacles. `planner` is one of planner_names(). The result's `path` is an
+    (N, 2) array of waypoints; `status` says why there is none."""
+    return _fleetmap._plan_path(map, (float(start[0]), float(start[1])), (float(goal[0]), float(goal[1])),
+                                planner, float(robot_radius), float(time_budget), int(seed))
+
+
+def register_strategy(name: str, cls: type, help: str = "", joint: bool = True) -> None:
+    """Registers a coordination strategy written in Python under `name`.
+
+    `cls` is a class (or any callable) that makes one strategy object per run. Its method
+        assign(positions, targets, costs, claimed) -> sequence of ints
+    gets the robots to assign now as an (R, 2) array of positions (m), the frontier targets as a
+    (T, 4) array (goal x, goal y, frontier cells in the piece, frontier region index), the wave
+    costs (R, T) in metres (inf: unreachable) and the goals other robots already drive to (K, 2);
+    it returns, per robot, a target index or -1 for none. With `joint`, every robot that can talk
+    is reassigned together; otherwise only the robot that needs a target. Scenarios and sweeps then
+    use `name` like a built-in strategy.
+    """
+    _fleetmap._register_strategy(name, cls, help, bool(joint))

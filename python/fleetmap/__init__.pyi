@@ -1,0 +1,96 @@
+# Type hints of the package `fleetmap` (the Python half in __init__.py, the C++ half in _fleetmap).
+import os
+from typing import Any, Mapping, Optional, Protocol, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+PathLike = Union[str, os.PathLike]
+
+class InputError(ValueError):
+    """Bad input: a scenario key, a map file, a name; the message names it."""
+
+class Error(RuntimeError):
+    """Any other failure inside fleetmap."""
+
+class Map:
+    """An occupancy grid map (cells Free, Occupied or Unknown)."""
+    @staticmethod
+    def from_image(image: npt.ArrayLike, resolution: float = 0.05,
+                   origin: Tuple[float, float, float] = (0.0, 0.0, 0.0)) -> "Map":
+        """A map from a uint8 (rows, columns) image, top row first, read with map_server's rules:
+        dark (0) occupied, light (254) free, mid-grey (205) unknown. `origin`: the pose (x, y, theta)
+        of the lower-left corner in metres."""
+    @property
+    def image(self) -> npt.NDArray[np.uint8]:
+        """The map_saver image: uint8 (height, width), top row first, 254 free, 0 occupied, 205 unknown."""
+    @property
+    def width(self) -> int: ...
+    @property
+    def height(self) -> int: ...
+    @property
+    def resolution(self) -> float:
+        """Metres per cell."""
+    @property
+    def origin(self) -> Tuple[float, float, float]:
+        """The pose (x, y, theta) of the lower-left corner."""
+    @property
+    def free_cells(self) -> int: ...
+    @property
+    def occupied_cells(self) -> int: ...
+    def save(self, path: PathLike) -> None:
+        """.yaml: map_server YAML plus a .pgm beside it; .png / .pgm: the image alone."""
+
+class MergeResult:
+    merged: bool
+    confidence: float
+    acceptance: float
+    method: str
+    reason: str
+    @property
+    def transform(self) -> Tuple[float, float, float]:
+        """(tx, ty, theta): b's cells into a's cells (the best candidate even when not merged)."""
+
+class PlanResult:
+    planner: str
+    length_m: float
+    detail: str
+    @property
+    def success(self) -> bool: ...
+    @property
+    def status(self) -> str: ...
+    @property
+    def path(self) -> npt.NDArray[np.float64]:
+        """(N, 2) waypoints in metres, from the start to the goal; empty unless success."""
+
+class ExplorationResult:
+    metrics: dict
+    coverage: npt.NDArray[np.float64]
+    trajectories: list[npt.NDArray[np.float64]]
+    estimates: list[npt.NDArray[np.float64]]
+    steps: int
+    finished: bool
+    @property
+    def merged_map(self) -> Map: ...
+    @property
+    def robot_maps(self) -> list[Map]: ...
+    def save(self, folder: PathLike) -> list[str]: ...
+
+class Strategy(Protocol):
+    """What register_strategy expects of the objects its class makes."""
+    def assign(self, positions: npt.NDArray[np.float64], targets: npt.NDArray[np.float64],
+               costs: npt.NDArray[np.float64], claimed: npt.NDArray[np.float64]) -> Sequence[int]: ...
+
+def explore(scenario: Union[None, Mapping[str, Any], PathLike] = None, **keys: Any) -> ExplorationResult: ...
+def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, **keys: Any) -> list[dict[str, Any]]: ...
+def load_map(source: str, resolution: float = 0.05) -> Map:
+    """A built-in map by name (map_names()) or a PNG/PGM/map_server YAML file."""
+def save_map(map: Map, path: PathLike) -> None: ...
+def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1) -> MergeResult: ...
+def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: str = "astar",
+              robot_radius: float = 0.2, time_budget: float = 1.0, seed: int = 1) -> PlanResult: ...
+def register_strategy(name: str, cls: Any, help: str = "", joint: bool = True) -> None: ...
+def map_names() -> list[str]: ...
+def strategy_names() -> list[str]: ...
+def planner_names() -> list[str]: ...
+def merge_method_names() -> list[str]: ...

@@ -1,0 +1,61 @@
+"""Merging two maps (transform and confidence) and planning a path on a map."""
+import math
+import unittest
+
+import numpy as np
+
+import fleetmap
+
+
+class MergeTest(unittest.TestCase):
+    def test_two_overlapping_parts_of_a_map_are_aligned(self):
+        office = fleetmap.load_map("office").image
+        # a: the left 130 columns; b: the right 130 columns (top row first), so b's cell x is a's x - 70.
+        a = fleetmap.Map.from_image(office[:, :130].copy())
+        b = fleetmap.Map.from_image(office[:, 70:].copy())
+        result = fleetmap.merge_maps(a, b)
+        self.assertTrue(result.merged, result.reason)
+        self.assertGreaterEqual(result.confidence, 0.5)
+        tx, ty, theta = result.transform
+        # Sub-cell accuracy is the refinement's goal; half a cell and half a degree leave room for it.
+        self.assertAlmostEqual(tx, 70.0, delta=0.5)
+        self.assertAlmostEqual(ty, 0.0, delta=0.5)
+        self.assertAlmostEqual(theta, 0.0, delta=math.radians(0.5))
+
+    def test_maps_with_nothing_in_common_are_not_merged(self):
+        empty = np.full((60, 60), 205, np.uint8)
+        empty[10:50, 10:50] = 254
+        result = fleetmap.merge_maps(fleetmap.Map.from_image(empty), fleetmap.Map.from_image(empty))
+        self.assertFalse(result.merged)
+        self.assertTrue(result.reason)
+
+
+class PlanTest(unittest.TestCase):
+    def test_a_path_joins_start_and_goal_through_free_space(self):
+        office = fleetmap.load_map("office")
+        free = np.argwhere(office.image == 254)  # (row, column) of free cells
+        res = office.resolution
+
+        def metres(rc):
+            return ((rc[1] + 0.5) * res, (office.height - 1 - rc[0] + 0.5) * res)
+
+        start, goal = metres(free[len(free) // 3]), metres(free[2 * len(free) // 3])
+        result = fleetmap.plan_path(office, start, goal, planner="astar", robot_radius=0.0)
+        self.assertTrue(result.success, result.detail)
+        path = result.path
+        self.assertEqual(path.shape[1], 2)
+        np.testing.assert_allclose(path[0], start)
+        np.testing.assert_allclose(path[-1], goal)
+        self.assertGreaterEqual(result.length_m, math.dist(start, goal) - 1e-9)
+        self.assertAlmostEqual(result.length_m, np.linalg.norm(np.diff(path, axis=0), axis=1).sum(), places=6)
+
+    def test_a_goal_in_a_wall_is_refused(self):
+        office = fleetmap.load_map("office")
+        result = fleetmap.plan_path(office, (1.0, 1.0), (0.01, 0.01))
+        self.assertFalse(result.success)
+        self.assertIn("obstacle", result.status.lower() + result.detail.lower())
+        self.assertEqual(result.path.shape, (0, 2))
+
+
+if __name__ == "__main__":
+    unittest.main()
