@@ -8,6 +8,7 @@
 
 #include "core/format.h"
 #include "io/file_io.h"
+#include "io/map_image.h"
 #include "io/map_io.h"
 #include "viz/drawing.h"
 #include "viz/plot.h"

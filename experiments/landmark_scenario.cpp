@@ -10,6 +10,7 @@
 #include "experiments/slam_experiment.h"
 #include "io/yaml_reader.h"
 #include "sim/scenario.h"
+#include "sim/scenario_yaml.h"
 
 namespace fleetmap::experiments {
 
