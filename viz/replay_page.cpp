@@ -255,6 +255,7 @@ const mainScale = onlyMap ? Math.max(1, parseInt(opts.scale || '4', 10))
                           : fitScale(mainBox, Math.max(400, Math.min(900, window.innerWidth - 460)), 760);
 main.width = Math.round((mainBox[2] - mainBox[0]) * mainScale);
 main.height = Math.round((mainBox[3] - mainBox[1]) * mainScale);
+document.getElementById('mainPanel').style.maxWidth = Math.max(300, main.width) + 'px';
 
 // Canvas pixels of a world (frame) point on a layer drawn with `box` at `scale`.
 function toPx(layer, box, scale, x, y) {
