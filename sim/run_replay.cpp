@@ -105,6 +105,20 @@ void RunReplay::mark_frontiers(const Simulation& sim, const std::vector<int>& ch
   }
 }
 
+void RunReplay::relate(Recorded& own, const std::vector<int>& own_changed, const std::vector<int>& merged_changed,
+                       bool all) const {
+  const auto at = [&](std::size_t i) {
+    own.relative[i] = own.cells[i] == base(merged_.cells[i]) ? ReplayCell::AsMerged : own.cells[i];
+  };
+  if (all || own.relative.size() != own.cells.size()) {
+    own.relative.resize(own.cells.size());
+    for (std::size_t i = 0; i < own.cells.size(); ++i) at(i);
+    return;
+  }
+  for (int i : own_changed) at(std::size_t(i));
+  for (int i : merged_changed) at(std::size_t(i));
+}
+
 void RunReplay::add_step(const Simulation& sim) {
   const int n = sim.scenario().robot_count;
   if (robots_.empty()) {
@@ -128,8 +142,15 @@ void RunReplay::add_step(const Simulation& sim) {
   const std::vector<core::Pose2> truth = sim.true_poses();
   for (int i = 0; i < n; ++i) {
     Recorded& own = own_[std::size_t(i)];
-    refresh(own, sim.robot_map(i));
-    own.layer.add_step(own.geometry, own.cells);
+    const bool new_geometry = own.cells.empty() || !(own.geometry == sim.robot_map(i).geometry());
+    const std::vector<int> own_changed = refresh(own, sim.robot_map(i));
+    if (own.geometry == merged_.geometry) {
+      relate(own, own_changed, changed, first || new_geometry);
+      own.layer.add_step(own.geometry, own.relative, true);
+    } else {
+      own.relative.clear();
+      own.layer.add_step(own.geometry, own.cells);
+    }
 
     viz::ReplayRobot& r = robots_[std::size_t(i)];
     r.truth.push_back(truth[std::size_t(i)]);

@@ -28,11 +28,16 @@ class RunReplay {
     core::GridGeometry geometry;
     std::vector<float> log_odds;
     std::vector<viz::ReplayCell> cells;
+    // A robot's map on the merged map's grid is stored against it: AsMerged where they agree.
+    std::vector<viz::ReplayCell> relative;
   };
   // Brings `r` up to `map`; returns the changed cells' indices.
   static std::vector<int> refresh(Recorded& r, const mapping::OccupancyGrid& map);
   // Marks the frontier cells of the merged map around the cells that changed.
   void mark_frontiers(const Simulation& sim, const std::vector<int>& changed, bool all);
+  // Brings `own.relative` up to its cells against the merged map, looking again only at `changed`
+  // cells of either unless `all`.
+  void relate(Recorded& own, const std::vector<int>& own_changed, const std::vector<int>& merged_changed, bool all) const;
 
   exploration::FrontierOptions frontier_options_;
   Recorded merged_;

@@ -84,17 +84,18 @@ std::string encode_changes(const std::vector<ReplayCell>& before, const std::vec
   return out.empty() ? std::string() : base64(out);
 }
 
-void ReplayLayer::add_step(const core::GridGeometry& geometry, const std::vector<ReplayCell>& cells) {
+void ReplayLayer::add_step(const core::GridGeometry& geometry, const std::vector<ReplayCell>& cells, bool relative) {
   if (std::int64_t(cells.size()) != geometry.cell_count()) throw Error("replay layer " + name_ + ": one code per cell expected");
-  if (steps_ == 0 || !(geometry == geometry_)) {
+  if (steps_ == 0 || !(geometry == geometry_) || relative != relative_) {
     const auto& o = geometry.origin();
     json frame = {{"step", steps_},          {"width", geometry.width()}, {"height", geometry.height()},
                   {"resolution", geometry.resolution()}, {"origin", {o.x, o.y, o.theta}},
-                  {"cells", encode_runs(cells)}};
+                  {"relative", relative},   {"cells", encode_runs(cells)}};
     bytes_ += frame["cells"].get_ref<const std::string&>().size();
     frames_.push_back(std::move(frame));
     changes_.push_back("");
     geometry_ = geometry;
+    relative_ = relative;
   } else {
     std::string changes = encode_changes(cells_, cells);
     bytes_ += changes.size();

@@ -20,7 +20,8 @@
 namespace fleetmap::viz {
 
 // What a replay cell shows. The page colours the first three as the map pictures do (colorize).
-enum class ReplayCell : std::uint8_t { Unknown = 0, Free = 1, Occupied = 2, Frontier = 3 };
+// In a layer stored relative to the merged map, the fourth code means "as the merged map".
+enum class ReplayCell : std::uint8_t { Unknown = 0, Free = 1, Occupied = 2, Frontier = 3, AsMerged = 3 };
 
 // A grid that changes step by step. Each step's cells are stored as the changes from the step
 // before (cell, old code, new code: the page steps backward as well as forward); a step whose
@@ -31,11 +32,13 @@ class ReplayLayer {
   ReplayLayer() = default;
   explicit ReplayLayer(std::string name) : name_(std::move(name)) {}
   // The layer at the next step (the first call is step 0): one code per cell of `geometry`, row-major
-  // from the lower-left cell as OccupancyGrid indexes them.
-  void add_step(const core::GridGeometry& geometry, const std::vector<ReplayCell>& cells);
+  // from the lower-left cell as OccupancyGrid indexes them. `relative`: the cells are stored against
+  // the merged layer of the same step and geometry (AsMerged where they agree), which a robot's map
+  // mostly does when the robots share their maps: its changes then cost little.
+  void add_step(const core::GridGeometry& geometry, const std::vector<ReplayCell>& cells, bool relative = false);
   int steps() const { return steps_; }
   const std::string& name() const { return name_; }
-  // {"name", "frames": [{"step", "width", "height", "resolution", "origin": [x, y, theta], "cells"}],
+  // {"name", "frames": [{"step", "width", "height", "resolution", "origin": [x, y, theta], "relative", "cells"}],
   //  "changes": [one base64 string per step, "" when nothing changed]}.
   nlohmann::json to_json() const;
   // The encoded bytes (base64 text) of every frame and change so far.
@@ -44,6 +47,7 @@ class ReplayLayer {
  private:
   std::string name_;
   core::GridGeometry geometry_;
+  bool relative_ = false;
   std::vector<ReplayCell> cells_;
   int steps_ = 0;
   nlohmann::json frames_ = nlohmann::json::array(), changes_ = nlohmann::json::array();
@@ -100,7 +104,8 @@ nlohmann::json replay_json(const Replay& replay);
 // The page. Its address may carry options after '#', joined by '&': step=K (open at step K),
 // robot=R (the robot whose own map is shown, from 1), overlays=0 (the maps alone: no robots,
 // paths or frontier colour), and for tests and pictures only=map (nothing but the whole merged
-// grid, at scale=S pixels per cell, at the page's top-left corner).
+// grid, at scale=S pixels per cell, at the page's top-left corner) or only=robot (the same for
+// robot R's own map).
 std::string replay_html(const Replay& replay);
 
 }  // namespace fleetmap::viz

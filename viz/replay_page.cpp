@@ -115,7 +115,8 @@ for (const part of location.hash.replace(/^#/, '').split('&')) {
   const kv = part.split('=');
   if (kv[0]) opts[kv[0]] = decodeURIComponent(kv[1] || '');
 }
-const onlyMap = opts.only === 'map';
+const onlyRobot = opts.only === 'robot';     // tests: a robot's own map alone, its whole grid
+const onlyMap = opts.only === 'map' || onlyRobot;
 let showOverlays = opts.overlays !== '0';
 
 function b64(s) {
@@ -169,14 +170,15 @@ class Layer {
   }
   // The cells ever known, [x0, y0, x1, y1) in cells, with a margin; null when none.
   knownBox(margin) {
-    const g = this.geom, w = g.width, h = g.height, cells = this.cells;
+    const g = this.geom, w = g.width, h = g.height, cells = this.cells, base = g.relative ? merged.cells : null;
+    const known = i => { const c = cells[i]; return c === 3 && base ? base[i] !== 0 : c !== 0; };
     let x0 = w, y0 = h, x1 = -1, y1 = -1;
     for (let y = 0; y < h; ++y) {
       const row = y * w;
       let first = -1, last = -1;
-      for (let x = 0; x < w; ++x) if (cells[row + x]) { first = x; break; }
+      for (let x = 0; x < w; ++x) if (known(row + x)) { first = x; break; }
       if (first < 0) continue;
-      for (let x = w - 1; x >= first; --x) if (cells[row + x]) { last = x; break; }
+      for (let x = w - 1; x >= first; --x) if (known(row + x)) { last = x; break; }
       if (first < x0) x0 = first; if (last > x1) x1 = last;
       if (y < y0) y0 = y; y1 = y;
     }
@@ -186,14 +188,16 @@ class Layer {
 }
 
 const COLORS = [[205, 205, 205], [255, 255, 255], [0, 0, 0], [255, 200, 0]];  // unknown, free, occupied, frontier
+// A layer stored relative to the merged map takes the merged map's cell where it holds code 3.
 function paintCells(layer, off, frontiers) {
-  const g = layer.geom, w = g.width, h = g.height;
+  const g = layer.geom, w = g.width, h = g.height, base = g.relative ? merged.cells : null;
   if (off.width !== w || off.height !== h) { off.width = w; off.height = h; }
   const ctx = off.getContext('2d'), img = ctx.createImageData(w, h), px = img.data, cells = layer.cells;
   for (let y = 0; y < h; ++y) {
     const src = (h - 1 - y) * w;  // grid rows go up, image rows down
     for (let x = 0; x < w; ++x) {
       let c = cells[src + x];
+      if (c === 3 && base) c = base[src + x];
       if (c === 3 && !frontiers) c = 1;
       const col = COLORS[c], o = 4 * (y * w + x);
       px[o] = col[0]; px[o + 1] = col[1]; px[o + 2] = col[2]; px[o + 3] = 255;
@@ -301,6 +305,16 @@ function polyline(ctx, pts, color, width, dash) {
 let robotPx = [];  // canvas pixels of each robot on the main view, for hovering
 function drawMain() {
   merged.seek(t);
+  if (onlyRobot) {
+    const layer = own[robotSel];
+    layer.seek(t);
+    paintCells(layer, offMain, false);
+    main.width = layer.geom.width * mainScale; main.height = layer.geom.height * mainScale;
+    const c = main.getContext('2d');
+    c.imageSmoothingEnabled = false;
+    c.drawImage(offMain, 0, 0, main.width, main.height);
+    return;
+  }
   paintCells(merged, offMain, showOverlays);
   const ctx = main.getContext('2d');
   ctx.imageSmoothingEnabled = false;
@@ -349,6 +363,7 @@ let ownBox = null, ownFrame = -1;
 function drawOwn() {
   if (!N) return;
   const layer = own[robotSel], r = D.robots[robotSel];
+  merged.seek(t);
   layer.seek(t);
   paintCells(layer, offOwn, false);
   // The view grows with the robot's map and never shrinks within one frame of its map.

@@ -1,5 +1,5 @@
 // `fleetmap explore --html`: the replay page, and the page in a real browser (Debian's chromium,
-// headless): the map its canvas shows at a step is the map the run wrote for that step.
+// headless): the maps its canvas shows at a step are the maps the run wrote for that step.
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -94,6 +94,13 @@ TEST(ReplayBrowser, CanvasShowsTheMapOfTheStep) {
     std::string first;
     EXPECT_EQ(wrong_cells(shot, *map, kScale, first), 0) << "step " << step << ", first at " << first;
   }
+  // A robot's own map (in its own frame, stored against the merged map) at step 4: robot_2.yaml of
+  // the early run.
+  const auto own = io::load_map(dir / "early" / "robot_2.yaml");
+  const cv::Mat own_shot = screenshot(dir, page, "step=4&only=robot&robot=2&scale=" + std::to_string(kScale), size);
+  ASSERT_FALSE(own_shot.empty());
+  std::string first_own;
+  EXPECT_EQ(wrong_cells(own_shot, own, kScale, first_own), 0) << "robot 2's map at step 4, first at " << first_own;
   // With the overlays the robots are drawn over the map: the picture differs from the bare map.
   const cv::Mat decorated = screenshot(dir, page, "step=8&only=map&scale=" + std::to_string(kScale), size);
   std::string first;
