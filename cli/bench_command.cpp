@@ -46,6 +46,7 @@ struct BenchFlags {
   std::vector<std::string> compare;
   std::string metric = "steps_to_99";
   bool quiet = false;
+  bool html = false;
 };
 
 // "1 map", "4 maps".
@@ -128,8 +129,10 @@ void check_same_sweep(const fs::path& out, const sweep::Sweep& sweep, const std:
 }
 
 // The files a bench folder holds for these maps.
-std::vector<std::string> bench_files(const std::vector<std::string>& map_labels) {
-  std::vector<std::string> files = {"results.csv", "summary.csv", "summary.md", "sweep.yaml", "scenario.yaml"};
+std::vector<std::string> bench_files(const std::vector<std::string>& map_labels,
+                                     const std::vector<sweep::SweepRun>& replayed = {}) {
+  std::vector<std::string> files = {"results.csv", "summary.csv", "summary.md", "report.html", "sweep.yaml", "scenario.yaml"};
+  for (const auto& r : replayed) files.push_back(sweep::replay_file_name(sweep::run_key(r)));
   std::vector<std::string> plots = {"efficiency"};
   for (const auto& m : map_labels) {
     plots.push_back("coverage_" + m);
@@ -143,7 +146,8 @@ std::vector<std::string> bench_files(const std::vector<std::string>& map_labels)
 }
 
 void print_outputs(const fs::path& out, const std::vector<fs::path>& reports) {
-  fmt::print("results: {}\nsummary: {}\n", (out / "results.csv").string(), (out / "summary.md").string());
+  fmt::print("results: {}\nsummary: {} (and report.html, with the plots)\n", (out / "results.csv").string(),
+             (out / "summary.md").string());
   fmt::print("plots (PNG, and SVG beside each):");
   for (const auto& p : reports) {
     if (p.extension() == ".png") fmt::print(" {}", p.filename().string());
@@ -234,8 +238,11 @@ int run_bench(const BenchFlags& f) {
   sweep::Sweep sweep;
   if (!f.sweep_file.empty()) sweep = sweep::load_sweep(f.sweep_file);
   apply_sweep_flags(sweep, f.sweep);
+  if (f.html) sweep.base.html_replay = true;
   sweep::validate_sweep(sweep);
   const std::optional<sweep::Shard> shard = f.shard.empty() ? std::nullopt : std::optional(parse_shard(f.shard));
+  const auto all_runs = sweep::sweep_runs(sweep);
+  const auto runs = shard ? sweep::shard_runs(all_runs, *shard) : all_runs;
 
   // Every output is checked before the maps are read or a run starts.
   const fs::path out = f.out.empty() ? fs::path("out/bench") : fs::path(f.out);
@@ -247,7 +254,8 @@ int run_bench(const BenchFlags& f) {
     labels.push_back(sweep::map_label(source));
     for (auto& file : maps::map_source_files(source)) inputs.push_back(std::move(file));
   }
-  io::OutputFolder folder(out, "bench", bench_files(labels), inputs, "--out " + out.string());
+  io::OutputFolder folder(out, "bench", bench_files(labels, sweep.base.html_replay ? runs : std::vector<sweep::SweepRun>{}),
+                          inputs, "--out " + out.string());
 
   sweep::SweepMaps maps;
   for (const auto& source : sweep.maps) {
@@ -261,8 +269,6 @@ int run_bench(const BenchFlags& f) {
   }
   sweep::check_placements(sweep, maps);
 
-  const auto all_runs = sweep::sweep_runs(sweep);
-  const auto runs = shard ? sweep::shard_runs(all_runs, *shard) : all_runs;
   const fs::path results = out / "results.csv";
   const std::string settings = sweep::settings_id(sweep.base);
 
@@ -286,7 +292,7 @@ int run_bench(const BenchFlags& f) {
     ProgressBar bar(!f.quiet);
     long finished = 0;
     bar.update(0, long(todo.size()));
-    sweep::run_sweep(sweep, todo, maps, {f.jobs}, [&](const sweep::RunRecord& r) {
+    sweep::run_sweep(sweep, todo, maps, {f.jobs, out}, [&](const sweep::RunRecord& r) {
       appender.append(r);
       bar.update(++finished, long(todo.size()),
                  r.key.map + " " + r.key.strategy + " " + std::to_string(r.key.robots) + "r seed " + std::to_string(r.key.seed));
@@ -302,6 +308,11 @@ int run_bench(const BenchFlags& f) {
   const auto reports = sweep::write_sweep_reports(out, records);
   std::vector<fs::path> written = {out / "sweep.yaml", out / "scenario.yaml", results};
   written.insert(written.end(), reports.begin(), reports.end());
+  // The replays of this run and of the earlier run this one resumed.
+  for (const auto& r : runs) {
+    const fs::path replay = out / sweep::replay_file_name(sweep::run_key(r));
+    if (sweep.base.html_replay && io::is_regular_file(replay)) written.push_back(replay);
+  }
   folder.finish(io::OutputFolder::names(written));
 
   if (f.quiet) {
@@ -329,7 +340,8 @@ Command add_bench_command(CLI::App& root) {
       "Runs every combination in parallel (--jobs), with a progress bar and ETA on stderr when it is a terminal,\n"
       "and writes into --out: results.csv (a row per run, appended whole and flushed), summary.csv and summary.md\n"
       "(mean, standard deviation and 95% confidence interval per map x strategy x team size (x --vary values), best marked),\n"
-      "coverage_<map>.png, time_<map>.png, efficiency.png (each also as .svg), and sweep.yaml. efficiency = lower bound / steps to 99% (README.md, \"Benchmarking\n"
+      "coverage_<map>.png, time_<map>.png, efficiency.png (each also as .svg), report.html (the tables and plots in one page,\n"
+      "with tooltips; each run linked to its replay with --html), and sweep.yaml. efficiency = lower bound / steps to 99% (README.md, \"Benchmarking\n"
       "strategies\"). Run it again with the same --out after an interruption and it finishes the sweep without\n"
       "redoing finished runs. The same flags give the same rows whatever --jobs (only wall_time_s differs).\n\n"
       "Examples:\n"
@@ -389,6 +401,9 @@ Command add_bench_command(CLI::App& root) {
                   "Metric of --compare: steps_to_95, steps_to_99, distance_m, redundancy, bytes_sent, efficiency, coverage")
       ->capture_default_str();
   app->add_flag("--quiet,-q", f->quiet, "Print only the path of results.csv; no progress bar");
+  app->add_flag("--html", f->html,
+                "Also write each run's replay page (replay_<map>_<strategy>_<robots>r_s<seed>.html, as explore --html), "
+                "linked from report.html; a sweep's scenario asks for them with outputs: {html: true}");
   return {app, [f]() { return run_bench(*f); }};
 }
 

@@ -23,6 +23,7 @@
 #include "planning/planner.h"
 #include "sim/run_metrics.h"
 #include "sim/run_output.h"
+#include "sim/run_replay.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"
 
@@ -43,6 +44,7 @@ struct ExploreFlags {
   std::optional<double> sensor_range, landmarks;
   std::string out;
   bool animate = false;
+  bool html = false;
   std::string video;  // a file name inside --out; --animate is run.mp4
   bool quiet = false;
   long long max_cells = 64'000'000;
@@ -75,6 +77,7 @@ sim::Scenario scenario_from(const ExploreFlags& f) {
   if (f.beams) s.range.beams = *f.beams, s.range.angles_rad.clear();
   if (f.landmarks) s.landmarks_along_walls = *f.landmarks;
   if (f.path_planner) s.path_planner = *f.path_planner;
+  if (f.html) s.html_replay = true;
   // Said here with the flag that helps; a scenario's own check names the keys only.
   if ((s.localization == "ekf" || s.localization == "ekf-slam") && s.landmarks.empty() && s.landmarks_along_walls <= 0.0) {
     throw InputError("localization '" + s.localization +
@@ -220,10 +223,13 @@ int run_explore(const ExploreFlags& f) {
   ProgressBar bar(!f.quiet);
   std::unique_ptr<sim::RunVideo> video;
   if (!video_name.empty()) video = std::make_unique<sim::RunVideo>(out / video_name);
+  std::optional<sim::RunReplay> replay;
+  if (s.html_replay) replay.emplace();
   const sim::RunResult result = simulation.run(
       [&](int step, int limit, double coverage) { bar.update(step, limit, "coverage " + format_percent(coverage)); },
       [&](const sim::Simulation& sim) {
         if (video) video->add_frame(sim, label);
+        if (replay) replay->add_step(sim);
       });
   bar.finish();
 
@@ -237,6 +243,10 @@ int run_explore(const ExploreFlags& f) {
                                     .dump(2) +
                                 "\n");
     written.push_back(out / "path.json");
+  }
+  if (replay) {
+    io::write_file_atomic(out / "replay.html", replay->html(result, label));
+    written.push_back(out / "replay.html");
   }
   if (video) {
     video->finish();
@@ -333,6 +343,9 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--out", f->out,
                   "Output folder: new, empty, or of an earlier explore run (its files are replaced) [default: out/<map>]");
   app->add_flag("--animate", f->animate, "Also write run.mp4 (H.264), a frame per step");
+  app->add_flag("--html", f->html,
+                "Also write replay.html: the run in a browser, from disk (timeline, play, each robot's map, "
+                "targets, paths, frontiers, coverage and events); a scenario asks for it with outputs: {html: true}");
   app->add_option("--video", f->video,
                   "Write the video under this name in --out: NAME.mp4 (H.264) or NAME.webm (VP9); implies --animate");
   app->add_flag("--quiet,-q", f->quiet, "Print only the merged map's path; no progress bar");

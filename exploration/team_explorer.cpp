@@ -71,7 +71,8 @@ void mark_robots(const mapping::OccupancyGrid& map, const std::vector<ExplorerRo
 TeamExplorer::TeamExplorer(int robots, const ExplorationOptions& options)
     : options_(options),
       strategy_(make_strategy(options.strategy, options.strategy_options)),
-      robots_(std::size_t(std::max(0, robots))) {}
+      robots_(std::size_t(std::max(0, robots))),
+      given_up_(robots_.size()) {}
 
 bool TeamExplorer::all_finished() const {
   return std::all_of(robots_.begin(), robots_.end(), [](const RobotState& r) { return r.finished; });
@@ -246,6 +247,7 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
   if (r.steps_since_progress > options_.stall_steps) {
     ++stats_.given_up_stalled;
     ++stats_.targets_given_up;
+    given_up_[std::size_t(i)].push_back({map.geometry().cell_center(r.goal), "stalled: no progress along the path"});
     fail_approach(i, Failure::Stalled, map.observed_count());
     return false;
   }
@@ -287,6 +289,7 @@ bool TeamExplorer::replan_around_new_obstacles(int i, const ExplorerRobot& robot
     if (!wave_.reached(r.goal)) {
       ++stats_.given_up_unreachable;
       ++stats_.targets_given_up;
+      given_up_[std::size_t(i)].push_back({map.geometry().cell_center(r.goal), "cut off: new obstacles closed every path"});
       fail_approach(i, Failure::Unreachable, map.observed_count());
       return false;
     }

@@ -87,6 +87,14 @@ class TeamExplorer {
   };
   const std::vector<LeftFrontier>& left_frontiers(int i) const { return robots_[std::size_t(i)].left; }
 
+  // A target robot i gave up (stalled, or cut off by new obstacles), in its map's frame at the time.
+  struct GivenUp {
+    Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();
+    std::string reason;
+  };
+  // Every target robot i gave up so far, oldest first (kept across reset_robot).
+  const std::vector<GivenUp>& given_up(int i) const { return given_up_[std::size_t(i)]; }
+
   struct Stats {
     int assignment_rounds = 0;
     int waves = 0;
@@ -164,6 +172,7 @@ class TeamExplorer {
   std::unique_ptr<CoordinationStrategy> strategy_;
   PathProvider provider_;
   std::vector<RobotState> robots_;
+  std::vector<std::vector<GivenUp>> given_up_;  // per robot
   WaveField wave_;  // reused storage
   std::vector<mapping::OccupancyGrid> coarse_;  // per robot: its map at the planning resolution
   Stats stats_;

@@ -11,6 +11,7 @@ packages=(
   libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libexpat1-dev
   pybind11-dev python3-dev python3-numpy
   slurm-wlm
+  chromium  # the tests that open fleetmap's HTML pages in a real, headless browser
 )
 # `--robustness` adds clang and its libFuzzer runtime, for the fuzzing stage of .ci/run.
 [[ "${1:-}" == "--robustness" ]] && packages+=(clang libclang-rt-14-dev)

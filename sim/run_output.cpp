@@ -253,6 +253,7 @@ std::vector<std::string> run_output_files(const Scenario& scenario) {
     for (const char* ext : {".png", ".pgm", ".yaml"}) names.push_back("robot_" + std::to_string(i) + ext);
   }
   for (const char* n : {"metrics.json", "map.pgm", "map.yaml", "map.bt", "scenario.yaml"}) names.push_back(n);
+  if (scenario.html_replay) names.push_back("replay.html");
   return names;
 }
 

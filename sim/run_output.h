@@ -24,7 +24,8 @@ cv::Mat render_merged(const RunResult& result, const std::string& map_label, con
 // Robot i's own map with its trajectory.
 cv::Mat render_robot(const RunResult& result, int robot, const std::string& map_label);
 
-// The names write_run_outputs gives its files for a run of `scenario`.
+// The names write_run_outputs gives its files for a run of `scenario`, and replay.html when the
+// scenario asks for it (written by the caller, from a RunReplay).
 std::vector<std::string> run_output_files(const Scenario& scenario);
 
 // Writes merged.png, robot_<k>.png (k from 1), metrics.json, map.pgm + map.yaml, map.bt and

@@ -242,6 +242,11 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
   read_exploration(top, s);
   read_merging(top, s);
   s.lookahead_m = top.number("lookahead", s.lookahead_m, limits::kLookahead);
+  {
+    auto outputs = top.map("outputs");
+    s.html_replay = outputs.boolean("html", s.html_replay);
+    outputs.finish();
+  }
   top.finish();
   validate_scenario(s);
   return s;
@@ -402,6 +407,7 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
   y << "merging:\n  mode: " << s.merging << "\n  method: " << s.merge_method << "\n  min_confidence: "
     << fmt(s.merge_min_confidence) << "\n  attempt_every: " << s.merge_attempt_every << "\n";
   y << "lookahead: " << fmt(s.lookahead_m) << "\n";
+  y << "outputs:\n  html: " << (s.html_replay ? "true" : "false") << "\n";
   return y.str();
 }
 

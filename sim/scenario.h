@@ -102,6 +102,9 @@ struct Scenario {
   std::string path_planner = "wave";
   double planner_time_s = 10.0;
   int planner_iterations = 2000;
+  // Outputs beyond the standard ones (`outputs:` in a scenario file): replay.html, the run in the
+  // browser (`fleetmap explore --html`).
+  bool html_replay = false;
 };
 
 // Every registered merging::MapAligner: known, rendezvous, overlap, landmarks, and any added since.

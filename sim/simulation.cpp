@@ -29,22 +29,6 @@ std::string point_text(const Eigen::Vector2d& p) { return core::format_point(p);
 
 std::string extent_text(const core::GridGeometry& g) { return core::format_extent(g); }
 
-// The explorer plans for the robots and the sensor the scenario describes: their radius, the range,
-// goals that see their unseen cell from well within range, and that count as reached close enough.
-// A short range leaves narrow unseen bands along walls the robot passed at its radius: unknown space
-// that narrow still counts as a frontier.
-exploration::ExplorationOptions explorer_options(const Scenario& s) {
-  exploration::ExplorationOptions o = s.exploration;
-  const double range = s.range.max_range_m;
-  o.traversability.robot_radius_m = s.robot.radius_m;
-  o.sensor_range_m = range;
-  o.targets.observe_range_m = std::min(o.targets.observe_range_m, 0.6 * range);
-  o.reach_tolerance_m = std::min(o.reach_tolerance_m, 0.3 * range);
-  o.targets.max_observe_range_m = std::max(o.targets.observe_range_m, range - 2.0 * o.planning_resolution_m);
-  o.targets.frontiers.min_unknown_width_m = std::min(o.targets.frontiers.min_unknown_width_m, 0.3 * range);
-  return o;
-}
-
 World make_world(const Scenario& s, mapping::OccupancyGrid truth) {
   core::Random rng = core::Random(s.seed).fork(2);
   std::vector<Eigen::Vector2d> landmarks;
@@ -60,6 +44,22 @@ World make_world(const Scenario& s, mapping::OccupancyGrid truth) {
 }
 
 }  // namespace
+
+// The explorer plans for the robots and the sensor the scenario describes: their radius, the range,
+// goals that see their unseen cell from well within range, and that count as reached close enough.
+// A short range leaves narrow unseen bands along walls the robot passed at its radius: unknown space
+// that narrow still counts as a frontier.
+exploration::ExplorationOptions explorer_options(const Scenario& s) {
+  exploration::ExplorationOptions o = s.exploration;
+  const double range = s.range.max_range_m;
+  o.traversability.robot_radius_m = s.robot.radius_m;
+  o.sensor_range_m = range;
+  o.targets.observe_range_m = std::min(o.targets.observe_range_m, 0.6 * range);
+  o.reach_tolerance_m = std::min(o.reach_tolerance_m, 0.3 * range);
+  o.targets.max_observe_range_m = std::max(o.targets.observe_range_m, range - 2.0 * o.planning_resolution_m);
+  o.targets.frontiers.min_unknown_width_m = std::min(o.targets.frontiers.min_unknown_width_m, 0.3 * range);
+  return o;
+}
 
 Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, SimulationSetup setup)
     : scenario_(scenario),

@@ -107,6 +107,9 @@ struct RunResult {
   Timings timing;
 };
 
+// The explorer's options for the robots and sensor of `scenario` (their radius, the sensor range).
+exploration::ExplorationOptions explorer_options(const Scenario& scenario);
+
 // Called after every step with (step, step limit, coverage).
 using ProgressCallback = std::function<void(int, int, double)>;
 
@@ -171,6 +174,14 @@ class Simulation {
   // The robots robot i detected this step.
   const std::vector<Detection>& detections(int i) const { return robots_[std::size_t(i)].detections; }
   std::vector<Eigen::Vector2d> path(int i) const { return explorer_.path(i); }
+  // Robot i ran out of reachable frontiers (for now: it resumes when its map grows), or its driver
+  // has no command left.
+  bool finished(int i) const;
+  // The targets robot i gave up so far, goals in its map frame at the time.
+  const std::vector<exploration::TeamExplorer::GivenUp>& given_up(int i) const { return explorer_.given_up(i); }
+  // The events so far (meetings, merges, blocked moves, finished robots), oldest first.
+  const std::vector<Event>& events() const { return events_; }
+  const std::vector<MergeRecord>& merges() const { return merges_; }
   double coverage() const { return coverage_.empty() ? 0.0 : coverage_.back(); }
   // Where robot i's map frame lies in the world (identity with merging: known).
   const core::Transform2& frame_origin(int i) const { return frame_origin_[std::size_t(robots_[std::size_t(i)].frame)]; }
@@ -188,7 +199,6 @@ class Simulation {
   core::Pose2 in_world(int i, const core::Pose2& frame_pose) const;
   void decide();
   void measure();
-  bool finished(int i) const;
   bool all_finished() const;
 
   // One robot of the run: where it truly is, what it knows (estimate, map in its map frame), its

@@ -3,6 +3,7 @@
 #include "sweep/sweep_report.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -13,6 +14,7 @@
 #include "io/file_io.h"
 #include "io/map_image.h"
 #include "io/map_io.h"
+#include "viz/html.h"
 #include "viz/plot.h"
 
 namespace fleetmap::sweep {
@@ -182,16 +184,25 @@ std::string summary_csv(const std::vector<GroupSummary>& groups) {
   return text;
 }
 
-std::string summary_markdown(const std::vector<RunRecord>& records, const std::vector<GroupSummary>& groups) {
-  const auto& metrics = report_metrics();
-  const auto maps = maps_of(records);
-  const auto strategies = strategies_of(records);
-  const auto teams = teams_of(records);
-  std::string md = "# Strategy sweep\n\n";
-  if (records.empty()) return md + "No runs yet.\n";
+namespace {
+
+// One table of the summary: a map and team size, a row per strategy (and variant).
+struct SummaryTable {
+  std::string map, heading;
+  std::vector<std::string> header;
+  struct Cell {
+    std::string text;
+    bool best = false;  // clearly the best in its column
+    std::string note;   // "(k/n)" when only k of n runs have the metric
+  };
+  std::vector<std::vector<Cell>> rows;
+};
+
+// The line under the title: what was run, with which settings.
+std::string sweep_description(const std::vector<RunRecord>& records) {
   const auto seeds = distinct<std::uint64_t>(records, [](const RunRecord& r) { return r.key.seed; });
   std::vector<std::string> team_texts;
-  for (int t : teams) team_texts.push_back(std::to_string(t));
+  for (int t : teams_of(records)) team_texts.push_back(std::to_string(t));
   const RunRecord& first = records.front();
   const std::string settings = fmt::format(
       "localization {}, merging {}, communication range {}, sensor range {:g} m, step limit {} (settings {})",
@@ -199,15 +210,16 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
       first.sensor_range_m, first.step_limit, first.settings);
   const auto variants = distinct<std::string>(records, [](const RunRecord& r) { return r.key.variant; });
   const std::string varied = variants.size() > 1 || !variants.front().empty() ? "; variants " + join(variants) : "";
-  md += std::to_string(records.size()) + " runs: maps " + join(maps) + "; strategies " + join(strategies) + varied +
-        "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) + (seeds.size() == 1 ? " seed. " : " seeds. ") + settings + ".\n\n";
-  md += "Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
-        "reached the level. **Bold**: the best strategy in the column for that map and team size (lowest; highest for "
-        "efficiency and coverage), only when its 95% interval overlaps no other row's (so never with one seed). "
-        "Efficiency = lower bound / steps to 99% (README.md, \"Benchmarking strategies\").\n";
-  for (const auto& map : maps) {
-    md += "\n## " + map + "\n";
-    for (int team : teams) {
+  return std::to_string(records.size()) + " runs: maps " + join(maps_of(records)) + "; strategies " + join(strategies_of(records)) +
+         varied + "; team sizes " + join(team_texts) + "; " + std::to_string(seeds.size()) +
+         (seeds.size() == 1 ? " seed. " : " seeds. ") + settings + ".";
+}
+
+std::vector<SummaryTable> summary_tables(const std::vector<RunRecord>& records, const std::vector<GroupSummary>& groups) {
+  const auto& metrics = report_metrics();
+  std::vector<SummaryTable> tables;
+  for (const auto& map : maps_of(records)) {
+    for (int team : teams_of(records)) {
       std::vector<const GroupSummary*> rows;
       for (const auto& g : groups) {
         if (g.map == map && g.robots == team) rows.push_back(&g);
@@ -215,33 +227,136 @@ std::string summary_markdown(const std::vector<RunRecord>& records, const std::v
       if (rows.empty()) continue;
       int lb_lo = rows.front()->lower_bound_min, lb_hi = rows.front()->lower_bound_max;
       for (const auto* g : rows) lb_lo = std::min(lb_lo, g->lower_bound_min), lb_hi = std::max(lb_hi, g->lower_bound_max);
-      md += "\n### " + team_text(team) + " (lower bound " +
-            (lb_lo == lb_hi ? std::to_string(lb_lo) : std::to_string(lb_lo) + "-" + std::to_string(lb_hi)) +
-            " steps to 99%)\n\n| strategy | runs |";
-      for (const auto& m : metrics) md += " " + m.title + " |";
-      md += "\n|---|---:|";
-      for (std::size_t m = 0; m < metrics.size(); ++m) md += "---:|";
-      md += "\n";
+      SummaryTable table;
+      table.map = map;
+      table.heading = team_text(team) + " (lower bound " +
+                      (lb_lo == lb_hi ? std::to_string(lb_lo) : std::to_string(lb_lo) + "-" + std::to_string(lb_hi)) +
+                      " steps to 99%)";
+      table.header = {"strategy", "runs"};
+      for (const auto& m : metrics) table.header.push_back(m.title);
       std::vector<const GroupSummary*> best(metrics.size(), nullptr);
       for (std::size_t m = 0; m < metrics.size(); ++m) best[m] = clearly_best(rows, m, metrics[m].higher_is_better);
       for (const auto* g : rows) {
-        md += "| " + g->series() + " | " + std::to_string(g->runs) + " |";
+        std::vector<SummaryTable::Cell> row = {{g->series()}, {std::to_string(g->runs)}};
         for (std::size_t m = 0; m < metrics.size(); ++m) {
           const SampleSummary& s = g->metrics[m];
-          std::string cell = "—";
+          SummaryTable::Cell cell{"—"};
           if (s.n > 0) {
-            cell = number(s.mean, metrics[m].decimals);
-            if (s.n > 1) cell += " ± " + number(s.half_width(), metrics[m].decimals);
-            if (best[m] == g) cell = "**" + cell + "**";
-            if (s.n < g->runs) cell += " (" + std::to_string(s.n) + "/" + std::to_string(g->runs) + ")";
+            cell.text = number(s.mean, metrics[m].decimals);
+            if (s.n > 1) cell.text += " ± " + number(s.half_width(), metrics[m].decimals);
+            cell.best = best[m] == g;
+            if (s.n < g->runs) cell.note = "(" + std::to_string(s.n) + "/" + std::to_string(g->runs) + ")";
           }
-          md += " " + cell + " |";
+          row.push_back(std::move(cell));
         }
-        md += "\n";
+        table.rows.push_back(std::move(row));
       }
+      tables.push_back(std::move(table));
+    }
+  }
+  return tables;
+}
+
+}  // namespace
+
+std::string replay_file_name(const RunKey& key) {
+  std::string name = fmt::format("replay_{}_{}_{}r_s{}", key.map, key.strategy, key.robots, key.seed);
+  if (!key.variant.empty()) name += "_" + key.variant;
+  // A plain file name whatever the map's or variant's text: other characters become '-'.
+  for (char& c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '.' && c != '-') c = '-';
+  }
+  return name + ".html";
+}
+
+std::string summary_markdown(const std::vector<RunRecord>& records, const std::vector<GroupSummary>& groups) {
+  std::string md = "# Strategy sweep\n\n";
+  if (records.empty()) return md + "No runs yet.\n";
+  md += sweep_description(records) + "\n\n";
+  md += "Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
+        "reached the level. **Bold**: the best strategy in the column for that map and team size (lowest; highest for "
+        "efficiency and coverage), only when its 95% interval overlaps no other row's (so never with one seed). "
+        "Efficiency = lower bound / steps to 99% (README.md, \"Benchmarking strategies\").\n";
+  std::string map;
+  for (const auto& table : summary_tables(records, groups)) {
+    if (table.map != map) md += "\n## " + table.map + "\n";
+    map = table.map;
+    md += "\n### " + table.heading + "\n\n|";
+    for (const auto& h : table.header) md += " " + h + " |";
+    md += "\n|---|";
+    for (std::size_t m = 1; m < table.header.size(); ++m) md += "---:|";
+    md += "\n";
+    for (const auto& row : table.rows) {
+      md += "|";
+      for (const auto& c : row) md += " " + (c.best ? "**" + c.text + "**" : c.text) + (c.note.empty() ? "" : " " + c.note) + " |";
+      md += "\n";
     }
   }
   return md;
+}
+
+std::string report_html(const std::vector<RunRecord>& records, const std::vector<GroupSummary>& groups,
+                        const std::vector<SweepPlot>& plots, const std::function<std::string(const RunKey&)>& replay_of) {
+  using viz::html_escape;
+  std::string h = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>Strategy sweep</title>\n";
+  h += std::string(viz::page_style());
+  h += "<style>svg { max-width: 100%; height: auto; } svg .tip:hover { fill-opacity: 0.35; } td.best { font-weight: bold; "
+       "background: #eaf4ea; } .plots { display: flex; flex-wrap: wrap; gap: 12px; }</style>\n</head>\n<body>\n";
+  h += "<h1>Strategy sweep</h1>\n";
+  if (records.empty()) return h + "<p>No runs yet.</p>\n</body>\n</html>\n";
+  h += "<p class=\"facts\">" + html_escape(sweep_description(records)) + "</p>\n";
+  h += "<p>Each cell: mean ± half-width of the 95% confidence interval (Student t) over seeds; (k/n) when only k of n runs "
+       "reached the level. <b>Bold</b>: the best strategy in the column for that map and team size, only when its 95% "
+       "interval overlaps no other row's. Efficiency = lower bound / steps to 99%. Rest the pointer on a plot's curve or bar "
+       "for its numbers.</p>\n";
+  std::string map;
+  for (const auto& table : summary_tables(records, groups)) {
+    if (table.map != map) {
+      h += "<h2>" + html_escape(table.map) + "</h2>\n<div class=\"plots\">\n";
+      for (const auto& p : plots) {
+        if (p.file == "coverage_" + table.map + ".png" || p.file == "time_" + table.map + ".png") {
+          const std::string svg = viz::to_svg(p.drawing);
+          h += svg.substr(svg.find("<svg"));  // inline, without the XML declaration
+        }
+      }
+      h += "</div>\n";
+    }
+    map = table.map;
+    h += "<h3>" + html_escape(table.heading) + "</h3>\n<table>\n<tr>";
+    for (std::size_t k = 0; k < table.header.size(); ++k)
+      h += std::string(k == 0 ? "<th class=\"text\">" : "<th>") + html_escape(table.header[k]) + "</th>";
+    h += "</tr>\n";
+    for (const auto& row : table.rows) {
+      h += "<tr>";
+      for (std::size_t k = 0; k < row.size(); ++k) {
+        const auto& c = row[k];
+        h += std::string(k == 0 ? "<td class=\"text\">" : c.best ? "<td class=\"best\">" : "<td>") + html_escape(c.text) +
+             (c.note.empty() ? "" : " " + html_escape(c.note)) + "</td>";
+      }
+      h += "</tr>\n";
+    }
+    h += "</table>\n";
+  }
+  for (const auto& p : plots) {
+    if (p.file != "efficiency.png") continue;
+    h += "<h2>Efficiency</h2>\n";
+    const std::string svg = viz::to_svg(p.drawing);
+    h += svg.substr(svg.find("<svg"));
+  }
+  // Every run, with its replay when one was written.
+  h += "<h2>Runs</h2>\n<details><summary>" + std::to_string(records.size()) +
+       " runs (click to show)</summary>\n<table>\n<tr><th class=\"text\">map</th><th class=\"text\">strategy</th>"
+       "<th>robots</th><th>seed</th><th>steps to 99%</th><th>coverage</th><th>distance (m)</th><th class=\"text\">replay</th></tr>\n";
+  for (const auto& r : records) {
+    const std::string replay = replay_of ? replay_of(r.key) : std::string();
+    h += "<tr><td class=\"text\">" + html_escape(r.key.map) + "</td><td class=\"text\">" + html_escape(series_label(r.key)) +
+         "</td><td>" + std::to_string(r.key.robots) + "</td><td>" + std::to_string(r.key.seed) + "</td><td>" +
+         (r.steps_to_99 ? std::to_string(*r.steps_to_99) : std::string("—")) + "</td><td>" + number(100.0 * r.coverage, 1) +
+         "%</td><td>" + number(r.distance_m, 1) + "</td><td class=\"text\">" +
+         (replay.empty() ? std::string() : "<a href=\"" + html_escape(replay) + "\">replay</a>") + "</td></tr>\n";
+  }
+  h += "</table>\n</details>\n</body>\n</html>\n";
+  return h;
 }
 
 namespace {
@@ -537,7 +652,15 @@ std::vector<fs::path> write_sweep_reports(const fs::path& dir, const std::vector
   written.push_back(dir / "summary.csv");
   io::write_file_atomic(dir / "summary.md", summary_markdown(records, groups));
   written.push_back(dir / "summary.md");
-  for (const auto& plot : sweep_plots(records)) {
+  const auto plots = sweep_plots(records);
+  // A run's replay is linked when the folder holds it.
+  const auto replay_of = [&](const RunKey& key) {
+    const std::string name = replay_file_name(key);
+    return io::is_regular_file(dir / name) ? name : std::string();
+  };
+  io::write_file_atomic(dir / "report.html", report_html(records, groups, plots, replay_of));
+  written.push_back(dir / "report.html");
+  for (const auto& plot : plots) {
     if (plot.image.empty()) continue;
     io::write_image(dir / plot.file, plot.image);
     written.push_back(dir / plot.file);

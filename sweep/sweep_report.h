@@ -83,8 +83,18 @@ struct SweepPlot {
 // per strategy on each map and on all).
 std::vector<SweepPlot> sweep_plots(const std::vector<RunRecord>& records);
 
-// Writes summary.csv, summary.md and the plots into `dir`, each plot as PNG and as SVG beside it
-// (each file atomically); returns the files.
+// report.html: the summary's tables, the plots (SVG, with tooltips on the curves and bars) and
+// every run, linked to its replay where `replay_of` names one (a file beside the report; empty: none).
+std::string report_html(const std::vector<RunRecord>& records, const std::vector<GroupSummary>& groups,
+                        const std::vector<SweepPlot>& plots, const std::function<std::string(const RunKey&)>& replay_of);
+
+// The name of a run's replay page in a bench folder: "replay_office_coordinated_4r_s3.html" (the
+// variant's settings appended).
+std::string replay_file_name(const RunKey& key);
+
+// Writes summary.csv, summary.md, report.html and the plots into `dir`, each plot as PNG and as SVG
+// beside it (each file atomically); returns the files. report.html links the runs' replays the
+// folder holds (replay_file_name).
 std::vector<std::filesystem::path> write_sweep_reports(const std::filesystem::path& dir,
                                                        const std::vector<RunRecord>& records);
 

@@ -86,6 +86,7 @@ void raster_shape(cv::Mat& img, const Shape& s, cv::Point2d offset) {
       if (s.outline) cv::polylines(img, pts, true, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
       break;
     case Shape::Circle: {
+      if (s.opacity <= 0.0) break;  // a hover spot
       const int r = std::max(1, int(std::lround(s.radius)));
       blended(img, s.opacity, [&](cv::Mat& target) {
         cv::circle(target, pts[0], r, bgr(s.color), s.filled ? cv::FILLED : thickness(s.width), cv::LINE_AA);
@@ -131,7 +132,22 @@ std::string svg_points(const std::vector<cv::Point2d>& points) {
   return out;
 }
 
+std::string svg_element(const Shape& s);
+
+// The element, with its tooltip as a <title> child.
 std::string svg_shape(const Shape& s) {
+  std::string e = svg_element(s);
+  if (s.tooltip.empty()) return e;
+  const std::string title = "<title>" + escaped(s.tooltip) + "</title>";
+  if (e.size() >= 3 && e.compare(e.size() - 3, 3, "/>\n") == 0) {
+    const std::string tag = e.substr(1, e.find_first_of(" >") - 1);
+    return e.substr(0, e.size() - 3) + ">" + title + "</" + tag + ">\n";
+  }
+  const std::size_t close = e.rfind("</");
+  return e.substr(0, close) + title + e.substr(close);
+}
+
+std::string svg_element(const Shape& s) {
   std::string attrs;
   if (!s.role.empty()) attrs += " class=\"" + escaped(s.role) + "\"";
   if (s.clip >= 0) attrs += fmt::format(" clip-path=\"url(#clip{})\"", s.clip);
@@ -210,6 +226,13 @@ void Drawing::polygon(std::vector<cv::Point2d> points, const Color& color, doubl
 
 void Drawing::rect(const cv::Rect2d& r, const Color& color, double opacity, bool outline) {
   polygon({r.tl(), {r.x + r.width, r.y}, r.br(), {r.x, r.y + r.height}}, color, opacity, outline);
+}
+
+void Drawing::hover_spot(cv::Point2d centre, double radius, std::string text) {
+  circle(centre, radius, Color{}, true);
+  shapes_.back().opacity = 0.0;
+  shapes_.back().role = "tip";
+  shapes_.back().tooltip = std::move(text);
 }
 
 void Drawing::circle(cv::Point2d centre, double radius, const Color& color, bool filled, double width) {

@@ -30,6 +30,7 @@ struct Shape {
   bool bold = false;
   int clip = -1;  // index into Drawing::clips, or -1
   std::string role;  // e.g. "series", "band": the SVG element's class, for readers and editors
+  std::string tooltip;  // the SVG element's <title>: what a browser shows when the pointer rests on it
 };
 
 class Drawing {
@@ -59,6 +60,10 @@ class Drawing {
 
   // The role of the most recently added shape (see Shape::role).
   void set_role(std::string role) { if (!shapes_.empty()) shapes_.back().role = std::move(role); }
+  // The tooltip of the most recently added shape (see Shape::tooltip).
+  void set_tooltip(std::string text) { if (!shapes_.empty()) shapes_.back().tooltip = std::move(text); }
+  // An invisible disc that only carries a tooltip (SVG); the raster shows nothing of it.
+  void hover_spot(cv::Point2d centre, double radius, std::string text);
 
   // Copies `other`'s shapes shifted by `offset` (its clips too), e.g. panels side by side.
   void place(const Drawing& other, cv::Point2d offset);

@@ -13,6 +13,11 @@ namespace fleetmap::viz {
 
 namespace {
 
+// A value in a tooltip: whole numbers as such, others with three significant digits.
+std::string tip_number(double v) {
+  return v == std::round(v) && std::abs(v) < 1e9 ? fmt::format("{:.0f}", v) : fmt::format("{:.3g}", v);
+}
+
 constexpr double kTickFont = 0.45;
 constexpr double kLabelFont = 0.5;
 constexpr double kTitleFont = 0.6;
@@ -273,6 +278,15 @@ Drawing line_plot(const LinePlot& plot, const PlotOptions& options) {
         }
         if (s.markers) d.circle(f.point(s.x[i], s.y[i]), 2.0 + widths[k], s.color);
       }
+      // Tooltips (SVG) at up to 60 points of the run: the series, x, y and the band or bar.
+      const std::size_t every = std::max<std::size_t>(1, (e - b + 59) / 60);
+      for (std::size_t i = b; i < e; i += every) {
+        std::string tip = fmt::format("{}{}{} {}: {} {}", s.label, s.label.empty() ? "" : "\n", plot.x.label.empty() ? "x" : plot.x.label,
+                                      tip_number(s.x[i]), plot.y.label.empty() ? "y" : plot.y.label, tip_number(s.y[i]));
+        if (has_band(s) && finite(s.y_low[i]) && finite(s.y_high[i]))
+          tip += fmt::format(" [{}, {}]", tip_number(s.y_low[i]), tip_number(s.y_high[i]));
+        d.hover_spot(f.point(s.x[i], s.y[i]), 2.0 + widths[k] + 3.0, std::move(tip));
+      }
     }
   }
   finish_frame(d, f, plot.x.label);
@@ -314,6 +328,9 @@ Drawing bar_chart(const BarChart& chart, const PlotOptions& options) {
       d.rect(cv::Rect2d(a, b), legend[s].color);
       d.set_role("bar");
       const double lo = value(chart.low, s, g), hi = value(chart.high, s, g);
+      d.set_tooltip(fmt::format("{}{}{}: {}{}", s < chart.series_labels.size() ? chart.series_labels[s] : "",
+                                g < chart.groups.size() ? ", " : "", g < chart.groups.size() ? chart.groups[g] : "",
+                                tip_number(v), finite(lo) && finite(hi) ? fmt::format(" [{}, {}]", tip_number(lo), tip_number(hi)) : ""));
       if (finite(lo) && finite(hi)) {
         const double mid = left + 0.5 * slot;
         const cv::Point2d p = f.point(mid, lo), q = f.point(mid, hi);

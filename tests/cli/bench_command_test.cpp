@@ -126,6 +126,25 @@ TEST(BenchCommand, TinySweepWritesEveryOutputAndItsSummaryMatchesItsRows) {
   }
 }
 
+TEST(BenchCommand, ReportPageLinksEachRunsReplay) {
+  BenchDir b;
+  const auto r = b.bench("--maps maze --strategies directional --robots 2 --seeds 2 --steps 10 --jobs 2 --html --out out");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string report = slurp(b / "out" / "report.html");
+  EXPECT_NE(report.find("<h2>maze</h2>"), std::string::npos);
+  EXPECT_NE(report.find("<svg"), std::string::npos);   // the plots, inline
+  EXPECT_NE(report.find("<title>"), std::string::npos);  // with tooltips
+  EXPECT_EQ(report.find("src="), std::string::npos);    // nothing to fetch
+  for (const char* name : {"replay_maze_directional_2r_s1.html", "replay_maze_directional_2r_s2.html"}) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(b / "out" / name)) << name;
+    EXPECT_NE(report.find(std::string("href=\"") + name + "\""), std::string::npos) << name;
+    EXPECT_NE(slurp(b / "out" / "outputs.txt").find(name), std::string::npos) << name;
+  }
+  // Without --html: the report, no replays and no links.
+  ASSERT_EQ(b.bench("--maps maze --strategies directional --robots 2 --seeds 1 --steps 10 --out plain").exit_code, 0);
+  EXPECT_EQ(slurp(b / "plain" / "report.html").find("href="), std::string::npos);
+}
+
 TEST(BenchCommand, SameRowsWhateverTheNumberOfJobs) {
   BenchDir b;
   ASSERT_EQ(b.bench(kSweep + " --jobs 1 --out one").exit_code, 0);

@@ -137,6 +137,30 @@ TEST(Plot, TheSvgIsWellFormedXmlWithOneElementPerSeriesAndBand) {
   EXPECT_NE(svg.find("width=\"" + std::to_string(img.cols) + "\" height=\"" + std::to_string(img.rows) + "\""), std::string::npos);
 }
 
+TEST(Plot, TheSvgCarriesTooltipsAndTheRasterShowsNoneOfThem) {
+  const Drawing d = line_plot(two_crossing_series(), {700, 450});
+  const std::string svg = to_svg(d);
+  const auto counts = parse_xml(svg);
+  ASSERT_TRUE(counts);
+  // A hover spot with its numbers at every point of both series (51 points each, under 60).
+  EXPECT_EQ(counts->at("circle.tip"), 2 * 51);
+  EXPECT_EQ(counts->at("title"), 2 * 51);
+  EXPECT_NE(svg.find("<title>first\nstep 10: percent 10 [0, 20]</title>"), std::string::npos);
+  // The raster shows nothing of a hover spot.
+  Drawing spot(40, 40);
+  spot.hover_spot({20, 20}, 15, "invisible");
+  const cv::Mat img = rasterize(spot);
+  EXPECT_EQ(cv::countNonZero(cv::Mat(img != cv::Scalar(255, 255, 255)).reshape(1)), 0);
+  // Bars tell their value.
+  BarChart chart;
+  chart.groups = {"office"};
+  chart.series_labels = {"coordinated"};
+  chart.values = {{0.75}};
+  chart.low = {{0.5}};
+  chart.high = {{1.0}};
+  EXPECT_NE(to_svg(bar_chart(chart)).find("<title>coordinated, office: 0.75 [0.5, 1]</title>"), std::string::npos);
+}
+
 TEST(Plot, OverlappingBandsShowBothColours) {
   // The two series cross at x = 25, y = 25: there both bands cover the background.
   LinePlot p = two_crossing_series();
