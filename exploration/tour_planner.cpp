@@ -15,15 +15,22 @@ constexpr int kStart = -1;  // the robot's own position, before its first target
 
 // The local search's state: the tours, their lengths, and costs with +inf replaced by a cost
 // above any tour without it, so that differences of lengths stay finite.
+// A leg cost no real tour can reach: unreachable legs cost this, so that any tour using one is worse
+// than every tour without.
+double impossible_cost(const TourProblem& p) {
+  double largest = 0.0;
+  for (const Eigen::MatrixXd* m : {&p.start_cost, &p.between}) {
+    for (Eigen::Index i = 0; i < m->size(); ++i) {
+      if (std::isfinite(m->data()[i])) largest = std::max(largest, std::abs(m->data()[i]));
+    }
+  }
+  return 1e6 * (largest + 1.0) * double(p.between.rows() + 1);
+}
+
 class Search {
  public:
   Search(const TourProblem& p, const TourOptions& o) : p_(p), o_(o), n_(int(p.start_cost.rows())), m_(int(p.between.rows())) {
-    double largest = 0.0;
-    for (Eigen::Index i = 0; i < p.start_cost.size(); ++i)
-      if (std::isfinite(p.start_cost.data()[i])) largest = std::max(largest, std::abs(p.start_cost.data()[i]));
-    for (Eigen::Index i = 0; i < p.between.size(); ++i)
-      if (std::isfinite(p.between.data()[i])) largest = std::max(largest, std::abs(p.between.data()[i]));
-    impossible_ = 1e6 * (largest + 1.0) * double(m_ + 1);
+    impossible_ = impossible_cost(p);
     tours_.resize(std::size_t(n_));
     length_.assign(std::size_t(n_), 0.0);
   }
@@ -320,12 +327,7 @@ class LatencySearch {
   LatencySearch(const TourProblem& p, const std::vector<double>& w, const TourOptions& o)
       : p_(p), o_(o), n_(int(p.start_cost.rows())), m_(int(p.between.rows())), w_(w) {
     if (w_.empty()) w_.assign(std::size_t(m_), 1.0);
-    double largest = 0.0;
-    for (Eigen::Index i = 0; i < p.start_cost.size(); ++i)
-      if (std::isfinite(p.start_cost.data()[i])) largest = std::max(largest, std::abs(p.start_cost.data()[i]));
-    for (Eigen::Index i = 0; i < p.between.size(); ++i)
-      if (std::isfinite(p.between.data()[i])) largest = std::max(largest, std::abs(p.between.data()[i]));
-    impossible_ = 1e6 * (largest + 1.0) * double(m_ + 1);
+    impossible_ = impossible_cost(p);
     tours_.resize(std::size_t(n_));
     cost_.assign(std::size_t(n_), 0.0);
   }
