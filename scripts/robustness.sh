@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The robustness stage of CI: the whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer
-# (g++, build-asan/), then every libFuzzer target of fuzz/ (clang, build-fuzz/) for FUZZ_SECONDS
+# The robustness stage of CI: the test suite under AddressSanitizer + UndefinedBehaviorSanitizer
+# (g++, build-asan/; every test but those labelled `slow`, which are long runs of code the other
+# tests already cover, and which the Quick-start test command has just run in the normal build), then every libFuzzer target of fuzz/ (clang, build-fuzz/) for FUZZ_SECONDS
 # seconds each (default 60) from its seed corpus.
 # Fails on a test failure, a sanitizer report, a leak, a fuzzer crash or a fuzzer timeout.
 set -euo pipefail
@@ -17,7 +18,7 @@ cmake --build build-asan
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=0:halt_on_error=1:detect_stack_use_after_return=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0}
-ctest --test-dir build-asan -j"$jobs" --output-on-failure
+ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE slow
 
 # libFuzzer needs clang: a second build with only the fuzz targets and what they link.
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DFLEETMAP_FUZZ=ON -DFLEETMAP_BUILD_BENCH=OFF \
