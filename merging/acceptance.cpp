@@ -6,6 +6,8 @@
 #include <numbers>
 #include <unordered_set>
 
+#include "merging/grid_level.h"
+
 namespace fleetmap::merging {
 
 Acceptance acceptance_index(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,

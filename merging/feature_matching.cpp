@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "merging/grid_level.h"
 #include "merging/rigid_fit.h"
 
 namespace fleetmap::merging {

@@ -5,7 +5,7 @@
 #include <limits>
 
 #include "core/error.h"
-#include "merging/prepared_grid.h"
+#include "merging/grid_level.h"
 
 namespace fleetmap::merging {
 

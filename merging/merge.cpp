@@ -11,6 +11,7 @@
 #include "core/angle.h"
 #include "core/error.h"
 #include "merging/evaluation.h"
+#include "merging/grid_level.h"
 
 namespace fleetmap::merging {
 
@@ -260,7 +261,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
     // b's prepared data, masked and cut (preparing the common part again cost a third of the time
     // of preparing the maps).
     Eigen::Vector2i origin;
-    const PreparedGrid pc(b, common_mask(a, b, result.transform, 3), options.prepare, origin);
+    const PreparedGrid pc = prepared_part(b, common_mask(a, b, result.transform, 3), options.prepare, origin);
     // When the answer lays nearly all of b on a's known cells, the probe of all of b said it all.
     if (!pc.walls().empty() && pc.walls().size() < 0.8 * b.walls().size()) {
       const Eigen::Vector2d o = origin.cast<double>();

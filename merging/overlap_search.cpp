@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/angle.h"
+#include "merging/grid_level.h"
 #include "merging/hough_spectrum.h"
 
 namespace fleetmap::merging {

@@ -1,5 +1,7 @@
 #include "merging/prepared_grid.h"
 
+#include "merging/grid_level.h"
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -238,6 +240,7 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
     w.clutter = l0.clutter.at<std::uint8_t>(p.y, p.x) != 0;
     walls_.push_back(w);
   }
+  set_sizes();
 }
 
 namespace {
@@ -271,9 +274,34 @@ std::vector<Eigen::Vector2f> points_inside(const std::vector<Eigen::Vector2f>& f
 
 }  // namespace
 
-PreparedGrid::PreparedGrid(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options,
-                           Eigen::Vector2i& origin)
-    : grid_(source.grid_) {
+PreparedGrid::PreparedGrid(const PreparedGrid& other) = default;
+PreparedGrid::PreparedGrid(PreparedGrid&& other) noexcept = default;
+PreparedGrid& PreparedGrid::operator=(const PreparedGrid& other) = default;
+PreparedGrid& PreparedGrid::operator=(PreparedGrid&& other) noexcept = default;
+PreparedGrid::~PreparedGrid() = default;
+PreparedGrid::PreparedGrid(const mapping::OccupancyGrid* grid) : grid_(grid) {}
+
+const GridLevel& PreparedGrid::level(int k) const { return levels_.at(static_cast<std::size_t>(k)); }
+
+void PreparedGrid::set_sizes() {
+  width_ = levels_.front().width();
+  height_ = levels_.front().height();
+  level_count_ = levels_.size();
+}
+
+struct PreparedGridParts {
+  static PreparedGrid cut(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options,
+                          Eigen::Vector2i& origin);
+};
+
+PreparedGrid prepared_part(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options,
+                           Eigen::Vector2i& origin) {
+  return PreparedGridParts::cut(source, mask, options, origin);
+}
+
+PreparedGrid PreparedGridParts::cut(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options,
+                                    Eigen::Vector2i& origin) {
+  PreparedGrid part(source.grid_);
   const GridLevel& s0 = source.level(0);
   cv::Mat m0 = mask & (s0.occupied | s0.free);
   std::vector<cv::Point> nonzero;
@@ -292,7 +320,7 @@ PreparedGrid::PreparedGrid(const PreparedGrid& source, const cv::Mat& mask, cons
     const cv::Rect cut(x0 / f, y0 / f, std::min(s.width() - x0 / f, (box.width + f - 1) / f),
                        std::min(s.height() - y0 / f, (box.height + f - 1) / f));
     if (k > 0) {
-      if (std::max(levels_.back().width(), levels_.back().height()) / 2 < options.min_level_size) break;
+      if (std::max(part.levels_.back().width(), part.levels_.back().height()) / 2 < options.min_level_size) break;
       level_mask = pool_mask(level_mask)(cv::Rect(0, 0, cut.width, cut.height));
     }
     GridLevel l;
@@ -306,7 +334,7 @@ PreparedGrid::PreparedGrid(const PreparedGrid& source, const cv::Mat& mask, cons
     l.wall_points = points_inside(s.wall_points, cut, level_mask, keep);
     for (std::size_t i : keep) l.wall_normals.push_back(s.wall_normals[i]), l.wall_clutter.push_back(s.wall_clutter[i]);
     l.interior_points = points_inside(s.interior_points, cut, level_mask, keep);
-    levels_.push_back(std::move(l));
+    part.levels_.push_back(std::move(l));
   }
   const Eigen::Vector2f o = origin.cast<float>();
   for (const auto& w : source.walls()) {
@@ -314,9 +342,11 @@ PreparedGrid::PreparedGrid(const PreparedGrid& source, const cv::Mat& mask, cons
     if (x < 0 || y < 0 || x >= box.width || y >= box.height || m0.at<std::uint8_t>(y + y0, x + x0) == 0) continue;
     WallPoint moved = w;
     moved.position -= o;
-    walls_.push_back(moved);
+    part.walls_.push_back(moved);
   }
-  known_cells_ = cv::countNonZero(levels_.front().occupied | levels_.front().free);
+  part.known_cells_ = cv::countNonZero(part.levels_.front().occupied | part.levels_.front().free);
+  part.set_sizes();
+  return part;
 }
 
 int PreparedGrid::level_for_size(int cells) const {

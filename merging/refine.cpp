@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "merging/grid_level.h"
+
 namespace fleetmap::merging {
 
 namespace {

@@ -7,6 +7,7 @@
 
 #include "core/angle.h"
 #include "merging/evaluation.h"
+#include "merging/grid_level.h"
 #include "tests/merging/merging_test_support.h"
 
 namespace fleetmap::merging {

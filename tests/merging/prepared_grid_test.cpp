@@ -5,6 +5,7 @@
 #include <opencv2/core.hpp>
 
 #include "merging/acceptance.h"
+#include "merging/grid_level.h"
 #include "tests/merging/merging_test_support.h"
 
 namespace fleetmap::merging {
@@ -34,7 +35,7 @@ TEST(PreparedGrid, MaskedPartIsTheSourcesDataMovedByTheCutsOrigin) {
   cv::Mat mask = cv::Mat::zeros(source.height(), source.width(), CV_8U);
   mask(cv::Rect(37, 43, 40, 50)).setTo(255);
   Eigen::Vector2i origin;
-  const PreparedGrid part(source, mask, PrepareOptions{}, origin);
+  const PreparedGrid part = prepared_part(source, mask, PrepareOptions{}, origin);
   const int coarsest = source.level(source.level_count() - 1).factor;
   EXPECT_EQ(origin.x() % coarsest, 0);
   EXPECT_EQ(origin.y() % coarsest, 0);

@@ -1,0 +1,81 @@
+#pragma once
+// The pyramid levels of a PreparedGrid (merging/prepared_grid.h): OpenCV images, inside the
+// library (not installed), read by the merge methods and the common refine / score / decide steps.
+//
+// Images here have one pixel per cell with column = cell x and row = cell y (row 0 at the
+// bottom, unlike a picture), so image coordinates are cell coordinates. A cell's centre is at
+// integer coordinates. Masks are CV_8U with 0 / 255.
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "merging/prepared_grid.h"
+
+namespace fleetmap::merging {
+
+// One pyramid level. Level k has cells of 2^k x 2^k fine cells; a coarse cell is occupied when
+// any of its fine cells is, free when one is free and none occupied (max pooling keeps thin walls).
+struct GridLevel {
+  int factor = 1;              // fine cells per cell of this level, along each axis
+  cv::Mat occupied;            // CV_8U mask
+  cv::Mat free;                // CV_8U mask
+  cv::Mat walls;               // occupied cells with a free 8-neighbour
+  cv::Mat wall_distance;       // CV_32F: distance in cells from each cell centre to the nearest wall cell
+  std::vector<Eigen::Vector2f> wall_points;  // centres of the wall cells (subsampled on big maps)
+  // For each wall point, the unit direction toward the free space it was seen from (zero where
+  // free space lies on several sides): two maps agree on a wall only when they saw it from the
+  // same side. Without it, two maps of neighbouring rooms laid edge to edge along their common
+  // wall would fit as well as the right answer.
+  std::vector<Eigen::Vector2f> wall_normals;
+  cv::Mat free_band;           // free cells next to a wall (8-neighbourhood): the walls' seen side
+  // Occupied cells of small obstacles standing alone (PrepareOptions::clutter_size_m): people,
+  // chairs, what moves between two visits. They may match the other map but never contradict it.
+  cv::Mat clutter;
+  std::vector<std::uint8_t> wall_clutter;  // per wall point: 1 when it is clutter
+  // Centres of occupied cells that are not walls (inside filled obstacles), every second row and
+  // column: on the other map's clear free space they contradict an alignment too.
+  std::vector<Eigen::Vector2f> interior_points;
+
+  int width() const { return occupied.cols; }
+  int height() const { return occupied.rows; }
+  bool known(int x, int y) const { return occupied.at<std::uint8_t>(y, x) != 0 || free.at<std::uint8_t>(y, x) != 0; }
+  bool is_free(int x, int y) const { return free.at<std::uint8_t>(y, x) != 0; }
+  // Bilinear wall distance at a continuous cell position; `outside` beyond the level's edges.
+  float distance_at(float x, float y, float outside) const;
+  // The same with the gradient of the bilinear patch (0 beyond the edges).
+  float distance_gradient_at(float x, float y, float outside, float& gx, float& gy) const;
+};
+
+// The nearest cell to a continuous coordinate, or -1 when it lies before the first cell.
+// (std::lround is a library call; this is on every hot path.)
+inline int nearest_cell(float v) { return v >= -0.5f ? int(v + 0.5f) : -1; }
+inline int nearest_cell(double v) { return v >= -0.5 ? int(v + 0.5) : -1; }
+
+// Whether a wall point of one map, moved to `p` with its normal turned to `n`, was seen from the
+// side where `target` has free space: some cell of the 3 x 3 block `distance` cells along the
+// normal is free there (a block, not a cell: far beams leave unknown gaps between free rays). A
+// point without a normal passes.
+inline bool seen_from_same_side(const GridLevel& target, const Eigen::Vector2f& p, const Eigen::Vector2f& n,
+                                float distance = 2.0f) {
+  if (n.x() == 0.0f && n.y() == 0.0f) return true;
+  const Eigen::Vector2f q = p + distance * n;
+  const int cx = nearest_cell(q.x()), cy = nearest_cell(q.y());
+  for (int y = std::max(0, cy - 1); y <= std::min(target.height() - 1, cy + 1); ++y)
+    for (int x = std::max(0, cx - 1); x <= std::min(target.width() - 1, cx + 1); ++x)
+      if (target.is_free(x, y)) return true;
+  return false;
+}
+
+// The part of `source` under `mask` (CV_8U, source's size; nonzero = kept), cut to the mask's
+// box with `origin` (a multiple of the coarsest level's factor, so that every level is cut at a
+// cell boundary): source's cells, walls, clutter and distance fields, masked, without preparing
+// them again. Distances still count walls just outside the mask, so a mask should have a margin
+// of a few cells around what matters. grid() stays source's grid (for its resolution). An empty
+// mask gives a grid without walls.
+PreparedGrid prepared_part(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options,
+                           Eigen::Vector2i& origin);
+
+}  // namespace fleetmap::merging
