@@ -191,6 +191,7 @@ struct SummaryTable {
   std::string map, heading;
   std::vector<std::string> header;
   struct Cell {
+    Cell(std::string text = {}) : text(std::move(text)) {}
     std::string text;
     bool best = false;  // clearly the best in its column
     std::string note;   // "(k/n)" when only k of n runs have the metric
@@ -245,7 +246,7 @@ std::vector<SummaryTable> summary_tables(const std::vector<RunRecord>& records, 
             cell.text = number(s.mean, metrics[m].decimals);
             if (s.n > 1) cell.text += " ± " + number(s.half_width(), metrics[m].decimals);
             cell.best = best[m] == g;
-            if (s.n < g->runs) cell.note = "(" + std::to_string(s.n) + "/" + std::to_string(g->runs) + ")";
+            if (s.n < g->runs) cell.note = fmt::format("({}/{})", s.n, g->runs);
           }
           row.push_back(std::move(cell));
         }

@@ -144,7 +144,9 @@ TEST(ObservableSpace, AgreesWithLookingFromEveryPose) {
       }
       // Never a cell no pose sees; a cell seen only from a pose whose line leaves the poses between
       // two cell centres may be missed (the boundary pose's centre is not on the line).
-      if (!seen) EXPECT_FALSE(contains(space.observable, i)) << "map " << map << " cell " << g.cell_of_index(i);
+      if (!seen) {
+        EXPECT_FALSE(contains(space.observable, i)) << "map " << map << " cell " << g.cell_of_index(i);
+      }
       missed += seen && !contains(space.observable, i);
       ++compared;
     }

@@ -29,9 +29,15 @@ struct TinySweep {
   }
 };
 
+SweepRunOptions jobs_only(int jobs) {
+  SweepRunOptions options;
+  options.jobs = jobs;
+  return options;
+}
+
 std::map<RunKey, std::string> run_all(const TinySweep& t, int jobs, int* calls = nullptr) {
   std::map<RunKey, std::string> rows;
-  run_sweep(t.sweep, sweep_runs(t.sweep), t.maps, {jobs}, [&](const RunRecord& r) {
+  run_sweep(t.sweep, sweep_runs(t.sweep), t.maps, jobs_only(jobs), [&](const RunRecord& r) {
     rows[r.key] = record_without_wall_time(r);
     if (calls) ++*calls;
   });
@@ -77,11 +83,11 @@ TEST(SweepRunner, AFailingRunStopsTheSweepAndIsRethrown) {
   t.sweep.robots = {9};
   t.sweep.maps = {"roomB", "roomA"};
   int records = 0;
-  EXPECT_THROW(run_sweep(t.sweep, sweep_runs(t.sweep), t.maps, {2}, [&](const RunRecord&) { ++records; }), InputError);
+  EXPECT_THROW(run_sweep(t.sweep, sweep_runs(t.sweep), t.maps, jobs_only(2), [&](const RunRecord&) { ++records; }), InputError);
   EXPECT_EQ(records, 0);  // the runs on roomA, after the failing ones, never started
   // An error in the callback (e.g. a full disk) stops the sweep too.
   t.sweep.maps = {"roomA"};
-  EXPECT_THROW(run_sweep(t.sweep, sweep_runs(t.sweep), t.maps, {2}, [](const RunRecord&) { throw Error("disk full"); }),
+  EXPECT_THROW(run_sweep(t.sweep, sweep_runs(t.sweep), t.maps, jobs_only(2), [](const RunRecord&) { throw Error("disk full"); }),
                Error);
 }
 
