@@ -49,7 +49,7 @@ int run_compare(const CompareOptions& o) {
   const std::vector<std::string> labels = o.labels.empty() ? default_labels(o.pages) : o.labels;
   std::vector<viz::ComparedReplay> runs;
   for (std::size_t i = 0; i < o.pages.size(); ++i) {
-    if (!fs::is_regular_file(o.pages[i])) throw InputError(o.pages[i] + ": no such file (a replay page: `fleetmap explore --html` writes replay.html)");
+    if (!fs::is_regular_file(o.pages[i])) throw InputError(o.pages[i] + ": no such file (a replay page: fleetmap explore --html writes replay.html)");
     std::string page = io::read_file(o.pages[i]);
     // The page's own name in errors: what the user typed.
     viz::replay_page_data(page, o.pages[i]);

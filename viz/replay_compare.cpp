@@ -243,7 +243,7 @@ std::string replay_page_data(std::string_view page, const std::string& name) {
   const auto start = page.find(kDataStart);
   const auto end = start == std::string_view::npos ? start : page.find("</script>", start);
   if (start == std::string_view::npos || end == std::string_view::npos || page.find("fleetmap") == std::string_view::npos)
-    throw InputError(name + ": not a fleetmap replay page (no replay data in it; `fleetmap explore --html` writes one)");
+    throw InputError(name + ": not a fleetmap replay page (no replay data in it; fleetmap explore --html writes one)");
   return std::string(page.substr(start + kDataStart.size(), end - start - kDataStart.size()));
 }
 
