@@ -64,7 +64,9 @@ canvas { display: block; image-rendering: pixelated; }
 #events div.now { background: #fff3c4; }
 .legend span { display: inline-block; margin-right: 12px; font-size: 12px; }
 .legend i { display: inline-block; width: 12px; height: 12px; vertical-align: -2px; margin-right: 4px; border: 1px solid #999; }
-#why { font-size: 12px; max-width: 560px; }
+.side { max-width: 436px; min-width: 300px; }
+#why { font-size: 12px; overflow-x: auto; }
+#why th { font-weight: 600; font-size: 11px; }
 #why table { margin: 4px 0; }
 #why td, #why th { padding: 1px 5px; }
 #why tr.chosen td { background: #e3f4e3; font-weight: 600; }
@@ -501,7 +503,17 @@ function drawOwn() {
   document.getElementById('ownText').textContent = robotState(robotSel);
 }
 
-function robotState(i) {
+// Text wrapped at spaces into lines of about `width` characters (the tooltip keeps line breaks).
+function wrap(text, width) {
+  const out = [];
+  let line = '';
+  for (const w of text.split(' ')) {
+    if (line && line.length + w.length + 1 > width) { out.push(line); line = w; } else line = line ? line + ' ' + w : w;
+  }
+  if (line) out.push(line);
+  return out.join('\n  ');
+}
+function robotState(i, why) {
   const r = D.robots[i], p = pose(r.truth, t), e = estimateAt(r, t), F = framePose(r, t), plan = planAt(r, t);
   const lines = [r.name + ' at step ' + t + (r.finished[t] === '1' ? ': no reachable frontier left' : plan.length ? ': exploring' : ': choosing a target')];
   lines.push('true pose ' + fmt(p[0]) + ', ' + fmt(p[1]) + ' m, ' + deg(p[2]) + ' deg');
@@ -517,7 +529,7 @@ function robotState(i) {
   let last = null;
   for (const ev of D.events) if (ev.step <= t && (ev.robot === i || ev.other === i) && ev.kind !== 'blocked') last = ev;
   if (last) lines.push('last event: step ' + last.step + ', ' + last.kind + ': ' + eventText(last));
-  lines.push('why its target: ' + whyText(i, decisionAt(i, t)));
+  if (why) lines.push(wrap('why its target: ' + whyText(i, decisionAt(i, t)), 80));
   return lines.join('\n');
 }
 function eventText(e) {
@@ -654,7 +666,7 @@ main.addEventListener('mousemove', e => {
   let bestD = Math.max(12, parseFloat(main.dataset.rpx || 0) + 4);
   hovered = -1;
   robotPx.forEach((q, i) => { const d = Math.hypot(q[0] - p[0], q[1] - p[1]); if (d < bestD) { bestD = d; hovered = i; } });
-  showTip(e, hovered >= 0 ? robotState(hovered) + '\n(click: show its own map)' : '');
+  showTip(e, hovered >= 0 ? robotState(hovered, true) + '\n(click: show its own map and why it chose its target)' : '');
 });
 main.addEventListener('mouseleave', () => { hovered = -1; showTip(null, ''); });
 main.addEventListener('click', () => {
