@@ -268,7 +268,7 @@ function fitScale(box, maxW, maxH) {
   return s >= 1 ? Math.floor(s) : s;
 }
 const mainScale = onlyMap ? Math.max(1, parseInt(opts.scale || '4', 10))
-                          : fitScale(mainBox, Math.max(400, Math.min(900, window.innerWidth - 460)), 760);
+                          : fitScale(mainBox, Math.max(400, Math.min(900, window.innerWidth - 510)), 760);
 main.width = Math.round((mainBox[2] - mainBox[0]) * mainScale);
 main.height = Math.round((mainBox[3] - mainBox[1]) * mainScale);
 document.getElementById('mainPanel').style.maxWidth = Math.max(300, main.width) + 'px';
