@@ -448,6 +448,7 @@ function drawCandidates(ctx, px, rpx) {
   const d = decisionAt(robotSel, t);
   if (!d || !d.r) return;
   ctx.font = 'bold 11px sans-serif';
+  const placed = [];  // score labels drawn so far: a label that would cover one is left out (the table has it)
   d.k.forEach((row, j) => {
     const c = cand(row), q = px(c.fx, c.fy), chosen = j === d.c;
     const color = chosen ? D.robots[robotSel].color : c.taken >= 0 ? D.robots[c.taken].color : '#333';
@@ -460,7 +461,10 @@ function drawCandidates(ctx, px, rpx) {
     ctx.textAlign = 'left';
     ctx.fillStyle = chosen ? '#060' : '#333';
     const label = num(c.score), w = ctx.measureText(label).width, off = Math.max(7, rpx);
-    ctx.fillText(label, q[0] + off + w > main.width ? q[0] - off - w : q[0] + off, q[1] - off);
+    const x = q[0] + off + w > main.width ? q[0] - off - w : q[0] + off, y = q[1] - off;
+    if (!chosen && placed.some(b => x < b[0] + b[2] && b[0] < x + w && Math.abs(y - b[1]) < 11)) return;
+    placed.push([x, y, w]);
+    ctx.fillText(label, x, y);
   });
   ctx.textBaseline = 'alphabetic';
 }
