@@ -345,7 +345,9 @@ Command add_explore_command(CLI::App& root) {
   app->add_flag("--animate", f->animate, "Also write run.mp4 (H.264), a frame per step");
   app->add_flag("--html", f->html,
                 "Also write replay.html: the run in a browser, from disk (timeline, play, each robot's map, "
-                "targets, paths, frontiers, coverage and events); a scenario asks for it with outputs: {html: true}");
+                "targets, paths, frontiers, coverage and events, and why each robot chose its target: the strategy's "
+                "candidates and their scores); a scenario asks for it with outputs: {html: true}; "
+                "fleetmap replay-compare puts two runs' pages side by side");
   app->add_option("--video", f->video,
                   "Write the video under this name in --out: NAME.mp4 (H.264) or NAME.webm (VP9); implies --animate");
   app->add_flag("--quiet,-q", f->quiet, "Print only the merged map's path; no progress bar");

@@ -87,6 +87,7 @@ int main(int argc, char** argv) {
   commands.push_back(fm::cli::add_merge_command(app));
   commands.push_back(fm::cli::add_plan_command(app));
   commands.push_back(fm::cli::add_slam_command(app));
+  commands.push_back(fm::cli::add_replay_compare_command(app));
 
   try {
     check_subcommand_words(app, argc, argv);

@@ -1,3 +1,5 @@
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "exploration/hungarian.h"
@@ -36,10 +38,35 @@ class Optimized final : public CoordinationStrategy {
       const int t = solution[i];
       if (t >= 0 && std::isfinite(input.robots[i].cost_m[std::size_t(t)])) out[i] = t;
     }
+    if (input.scores) explain(input, utility, scale, cost, out);
     return out;
   }
 
  private:
+  void explain(const AssignmentInput& input, const std::vector<double>& utility, double scale, const Eigen::MatrixXd& cost,
+               const std::vector<int>& out) const {
+    report_scores(input,
+                  {.terms = {"utility", "wave cost (m)", "beta * (cost / largest cost)^2"},
+                   .score = "beta * (cost / largest cost)^2 - utility",
+                   .lower_is_better = true,
+                   .rule = fmt::format("one target per robot, the assignment whose total over the team is least, solved "
+                                       "exactly (the wave algorithm paper's eq. (3), Hungarian method; beta {}; costs "
+                                       "scaled by the largest of the round)",
+                                       beta_), .robots = {}},
+                  [&](std::size_t i, std::size_t t) {
+                    const double v = input.robots[i].cost_m[t] / scale;
+                    return CandidateScore{.target = -1, .terms = {utility[t], input.robots[i].cost_m[t], beta_ * v * v},
+                                          .score = cost(Eigen::Index(i), Eigen::Index(t))};
+                  });
+    double total = 0.0;
+    int assigned = 0;
+    for (std::size_t i = 0; i < out.size(); ++i)
+      if (out[i] >= 0) total += cost(Eigen::Index(i), Eigen::Index(out[i])), ++assigned;
+    const std::string note = fmt::format("the team's least total: {:.3f} over {} robots and {} targets; largest cost {:.1f} m",
+                                         total, assigned, input.targets.size(), scale);
+    for (auto& r : input.scores->robots) r.note = note;
+  }
+
   double beta_;
 };
 

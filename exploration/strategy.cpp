@@ -90,4 +90,19 @@ void nearest_targets(const AssignmentInput& input, std::vector<int>& assignment)
   }
 }
 
+void report_scores(const AssignmentInput& input, ScoreSheet sheet,
+                   const std::function<CandidateScore(std::size_t robot, std::size_t target)>& score) {
+  if (!input.scores) return;
+  sheet.robots.resize(input.robots.size());
+  for (std::size_t i = 0; i < input.robots.size(); ++i) {
+    for (std::size_t t = 0; t < input.targets.size(); ++t) {
+      if (!std::isfinite(input.robots[i].cost_m[t])) continue;
+      CandidateScore c = score(i, t);
+      c.target = int(t);
+      sheet.robots[i].candidates.push_back(std::move(c));
+    }
+  }
+  *input.scores = std::move(sheet);
+}
+
 }  // namespace fleetmap::exploration

@@ -20,6 +20,27 @@ struct StrategyOptions {
   double directional_weight = 0.5;
 };
 
+// What a strategy weighed when it chose targets, for a replay to show why (a robot's candidates and
+// their score terms). Strategies fill it only when AssignmentInput::scores asks: no cost otherwise.
+struct CandidateScore {
+  int target = -1;            // index into AssignmentInput::targets
+  std::vector<double> terms;  // one value per ScoreSheet::terms
+  double score = 0.0;         // what the strategy ranked this candidate by (ScoreSheet::score)
+};
+
+struct RobotScores {
+  std::vector<CandidateScore> candidates;  // the targets it weighed for this robot (reachable ones)
+  std::string note;                        // the strategy's words on this robot's decision
+};
+
+struct ScoreSheet {
+  std::vector<std::string> terms;  // names of the score terms, with units, e.g. "wave cost (m)"
+  std::string score;               // the name of what candidates are ranked by
+  bool lower_is_better = true;
+  std::string rule;                // how the strategy decides, one sentence
+  std::vector<RobotScores> robots; // per robot of the input; empty: the strategy reported nothing
+};
+
 struct AssignmentRobot {
   int team_index = 0;  // this robot's place in the team, 0..team_size-1
   int team_size = 1;
@@ -39,6 +60,9 @@ struct AssignmentInput {
   // Per target, the never-observed area in square metres it would reveal (unknown_area_behind), for
   // strategies that weigh targets by it; computed only when called. Empty: every target counts alike.
   std::function<std::vector<double>()> target_gains_m2;
+  // When set, the strategy may describe its decision here (every built-in one does; one that does
+  // not leaves it empty). Null in ordinary runs.
+  ScoreSheet* scores = nullptr;
 };
 
 class CoordinationStrategy {
@@ -81,5 +105,9 @@ double cost_scale(const AssignmentInput& input);
 Eigen::MatrixXd target_costs(const AssignmentInput& input);
 // Each robot without a target takes its cheapest reachable one (taken or not).
 void nearest_targets(const AssignmentInput& input, std::vector<int>& assignment);
+// Fills input.scores, when asked, with one candidate per robot and reachable target: `score(i, t)`
+// gives robot i's candidate t (its terms and score). Header fields come from `sheet`.
+void report_scores(const AssignmentInput& input, ScoreSheet sheet,
+                   const std::function<CandidateScore(std::size_t robot, std::size_t target)>& score);
 
 }  // namespace fleetmap::exploration

@@ -346,6 +346,8 @@ void TeamExplorer::make_way(int stuck, const std::vector<ExplorerRobot>& robots,
 }
 
 void TeamExplorer::update(const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links) {
+  ++rounds_;
+  decisions_.clear();
   std::vector<ExplorerRobot> views = robots;
   coarse_.resize(robots.size());
   for (std::size_t i = 0; i < robots.size(); ++i) {
@@ -499,7 +501,10 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
   };
   // The unknown area behind each target, for strategies that weigh targets by what they reveal.
   input.target_gains_m2 = [&] { return unknown_area_behind(map, targets, options_.sensor_range_m); };
+  ScoreSheet sheet;
+  if (record_) input.scores = &sheet;
   const std::vector<int> choice = strategy_->assign(input);
+  if (record_) record(members, leader, map, targets, choice, sheet);
   for (std::size_t k = 0; k < members.size(); ++k) {
     RobotState& r = robots_[std::size_t(members[k])];
     const int t = choice[k];
@@ -542,6 +547,40 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
              *robots[std::size_t(members[k])].map);
     r.best_remaining = r.path.size();
     r.steps_since_progress = 0;
+  }
+}
+
+void TeamExplorer::record(const std::vector<int>& members, int leader, const mapping::OccupancyGrid& map,
+                          const std::vector<Target>& targets, const std::vector<int>& choice, ScoreSheet& sheet) {
+  const bool reported = sheet.robots.size() == members.size();
+  if (reported) {
+    sheet_ = sheet;
+    sheet_.robots.clear();
+  }
+  const auto& g = map.geometry();
+  for (std::size_t k = 0; k < members.size(); ++k) {
+    const RobotState& r = robots_[std::size_t(members[k])];
+    Decision d;
+    d.round = rounds_;
+    d.robot = members[k];
+    d.leader = leader;
+    d.group = members;
+    d.reported = reported;
+    d.kept = choice[k] < 0 && r.has_task;
+    if (choice[k] >= 0) d.goal_m = g.cell_center(targets[std::size_t(choice[k])].goal);
+    if (reported) {
+      d.note = std::move(sheet.robots[k].note);
+      for (auto& c : sheet.robots[k].candidates) {
+        if (c.target < 0 || std::size_t(c.target) >= targets.size()) continue;
+        const Target& target = targets[std::size_t(c.target)];
+        Candidate out{g.cell_center(target.frontier), g.cell_center(target.goal), target.cells, std::move(c.terms), c.score, -1};
+        for (std::size_t j = 0; j < members.size(); ++j)
+          if (j != k && choice[j] == c.target) out.taken_by = members[j];
+        if (choice[k] == c.target) d.chosen = int(d.candidates.size());
+        d.candidates.push_back(std::move(out));
+      }
+    }
+    decisions_.push_back(std::move(d));
   }
 }
 

@@ -95,6 +95,36 @@ class TeamExplorer {
   // Every target robot i gave up so far, oldest first (kept across reset_robot).
   const std::vector<GivenUp>& given_up(int i) const { return given_up_[std::size_t(i)]; }
 
+  // What the strategy weighed for one robot in one decision round, and what it chose: recorded
+  // only after record_decisions(true) (a replay shows them as the robot's reasons).
+  struct Candidate {
+    Eigen::Vector2d frontier_m = Eigen::Vector2d::Zero();  // the target's frontier cell, leader's map frame
+    Eigen::Vector2d goal_m = Eigen::Vector2d::Zero();      // where the robot would drive
+    int cells = 0;                                         // frontier cells of the target's piece
+    std::vector<double> terms;                             // per ScoreSheet::terms of decision_sheet()
+    double score = 0.0;
+    int taken_by = -1;  // another robot (team index) of the group got this target in the same round
+  };
+  struct Decision {
+    int round = 0;   // the update() call that made it, from 1
+    int robot = 0;   // team index
+    int leader = 0;  // the group decided on this robot's map: positions are in its map's frame
+    std::vector<int> group;             // the robots that decided together (team indices)
+    std::vector<Candidate> candidates;  // empty when the strategy reported nothing
+    int chosen = -1;                    // index into candidates; -1: none (or not reported)
+    std::optional<Eigen::Vector2d> goal_m;  // the target given, reported or not
+    bool kept = false;  // no new target: the robot keeps the one it drives to
+    bool reported = false;
+    std::string note;
+  };
+  void record_decisions(bool on) { record_ = on; }
+  // The decisions of the last update() (empty unless recording).
+  const std::vector<Decision>& decisions() const { return decisions_; }
+  int rounds() const { return rounds_; }
+  // The names of the strategy's score terms (ScoreSheet without robots) from its last report;
+  // empty terms: it reported nothing.
+  const ScoreSheet& decision_sheet() const { return sheet_; }
+
   struct Stats {
     int assignment_rounds = 0;
     int waves = 0;
@@ -165,6 +195,9 @@ class TeamExplorer {
   // The provider's path to the goal as cells, or the wave's when the provider has none.
   std::vector<Cell> plan(const mapping::OccupancyGrid& map, const ExplorerRobot& robot, const Cell& goal,
                          const WaveField& wave);
+  // Keeps what the strategy reported for the group's decision (decisions_).
+  void record(const std::vector<int>& members, int leader, const mapping::OccupancyGrid& map,
+              const std::vector<Target>& targets, const std::vector<int>& choice, ScoreSheet& sheet);
   // Finished robots standing on the path of robot `stuck` move to the nearest place clear of it.
   void make_way(int stuck, const std::vector<ExplorerRobot>& robots, const std::vector<std::vector<char>>& links);
 
@@ -176,6 +209,10 @@ class TeamExplorer {
   WaveField wave_;  // reused storage
   std::vector<mapping::OccupancyGrid> coarse_;  // per robot: its map at the planning resolution
   Stats stats_;
+  bool record_ = false;
+  int rounds_ = 0;
+  std::vector<Decision> decisions_;
+  ScoreSheet sheet_;
 };
 
 }  // namespace fleetmap::exploration

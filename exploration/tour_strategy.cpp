@@ -1,3 +1,5 @@
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -63,10 +65,51 @@ class Tour final : public CoordinationStrategy {
       for (int t : tours[i]) kept.push_back(input.targets[std::size_t(t)].goal_m);
       if (!tours[i].empty()) out[i] = tours[i].front();
     }
+    if (input.scores) explain(input, problem, weight, tours);
     return out;
   }
 
  private:
+  // Per candidate: its wave cost, the area behind it, and when the tour it belongs to reaches it.
+  static void explain(const AssignmentInput& input, const TourProblem& problem, const std::vector<double>& weight,
+                      const Tours& tours) {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::vector<double> arrival(input.targets.size(), nan);
+    std::vector<int> owner(input.targets.size(), -1);
+    for (std::size_t i = 0; i < tours.size(); ++i) {
+      double at = 0.0;
+      for (std::size_t k = 0; k < tours[i].size(); ++k) {
+        const auto t = Eigen::Index(tours[i][k]);
+        at += k == 0 ? problem.start_cost(Eigen::Index(i), t) : problem.between(Eigen::Index(tours[i][k - 1]), t);
+        arrival[std::size_t(t)] = at;
+        owner[std::size_t(t)] = int(i);
+      }
+    }
+    report_scores(input,
+                  {.terms = {"wave cost (m)", "unknown area behind (m2)", "on the tour of robot",
+                              "reached along that tour at (m)"},
+                   .score = "reached along its own tour at (m)",
+                   .lower_is_better = true,
+                   .rule = "every robot gets an open tour through the targets; the tours make the area-weighted sum of "
+                           "the times targets are reached least (minimum latency, after TARE, Cao et al. 2021, and "
+                           "RACER, Zhou et al. 2023); each robot drives to its tour's first target", .robots = {}},
+                  [&](std::size_t i, std::size_t t) {
+                    const double area = weight.empty() ? nan : weight[t] - kBaseWeight;
+                    const int o = owner[t];
+                    return CandidateScore{
+                        .terms = {input.robots[i].cost_m[t], area, o < 0 ? nan : double(input.robots[std::size_t(o)].team_index + 1),
+                                  arrival[t]},
+                        .score = o == int(i) ? arrival[t] : nan};
+                  });
+    for (std::size_t i = 0; i < tours.size(); ++i) {
+      input.scores->robots[i].note =
+          tours[i].empty() ? std::string("an empty tour: the others reach every target sooner")
+                           : fmt::format("its tour: {} target{}, {:.1f} m, weighted latency {:.0f} m*m2", tours[i].size(),
+                                         tours[i].size() == 1 ? "" : "s", tour_length(problem, int(i), tours[i]),
+                                         tour_latency(problem, weight, int(i), tours[i]));
+    }
+  }
+
   // The previous round's tours in this round's targets: each remembered goal becomes a target
   // within kSameTarget (frontiers shrink and their goals move as they are seen), nearest pairs
   // first, so a target that is still there keeps its place; goals with none (explored meanwhile)

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 
 namespace fleetmap::sim {
@@ -180,6 +181,43 @@ void RunReplay::add_step(const Simulation& sim) {
     }
     given_up_seen_[std::size_t(i)] = given_up.size();
   }
+  add_decisions(sim);
+}
+
+void RunReplay::add_decisions(const Simulation& sim) {
+  const auto& explorer = sim.explorer();
+  if (explorer.rounds() == rounds_seen_) return;
+  rounds_seen_ = explorer.rounds();
+  if (!explorer.decision_sheet().terms.empty()) sheet_ = explorer.decision_sheet();
+  const bool lower = explorer.decision_sheet().lower_is_better;
+  for (const auto& d : explorer.decisions()) {
+    const core::Transform2& to_world = sim.frame_origin(d.leader);
+    viz::ReplayDecision out;
+    out.step = sim.step_count();
+    out.leader = d.leader;
+    out.group = d.group;
+    out.weighed = int(d.candidates.size());
+    out.kept = d.kept;
+    out.reported = d.reported;
+    out.note = d.note;
+    if (d.goal_m) out.goal_m = to_world.apply(*d.goal_m);
+    // Best first (NaN scores last), the chosen one always kept.
+    std::vector<int> order(d.candidates.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = int(k);
+    const auto key = [&](int k) {
+      const double s = d.candidates[std::size_t(k)].score;
+      return std::isnan(s) ? std::numeric_limits<double>::infinity() : lower ? s : -s;
+    };
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+    for (std::size_t rank = 0; rank < order.size(); ++rank) {
+      const int k = order[rank];
+      if (int(rank) >= kCandidates && k != d.chosen) continue;
+      const auto& c = d.candidates[std::size_t(k)];
+      if (k == d.chosen) out.chosen = int(out.candidates.size());
+      out.candidates.push_back({to_world.apply(c.frontier_m), to_world.apply(c.goal_m), c.cells, c.terms, c.score, c.taken_by});
+    }
+    robots_[std::size_t(d.robot)].decisions.push_back(std::move(out));
+  }
 }
 
 std::size_t RunReplay::map_bytes() const {
@@ -220,6 +258,7 @@ std::string RunReplay::html(const RunResult& result, const std::string& map_labe
                         fmt::format("{}, confidence {:.2f}: {}", m.method, m.confidence, m.reason), std::nullopt});
   }
   r.events.insert(r.events.end(), given_up_.begin(), given_up_.end());
+  r.scores = {s.exploration.strategy, sheet_.terms, sheet_.score, sheet_.lower_is_better, sheet_.rule};
   std::stable_sort(r.events.begin(), r.events.end(), [](const auto& a, const auto& b) { return a.step < b.step; });
   return viz::replay_html(r);
 }

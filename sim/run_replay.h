@@ -16,6 +16,8 @@ class RunReplay {
   void add_step(const Simulation& sim);
   // The page: what was recorded, with the run's events and merge attempts from `result`.
   std::string html(const RunResult& result, const std::string& map_label) const;
+  // Candidates kept per decision: the best ones by the strategy's score, and the chosen one.
+  static constexpr int kCandidates = 8;
   int steps() const { return int(robots_.empty() ? 0 : robots_.front().truth.size()); }
   // The encoded maps so far (bytes of base64 text): the merged map and the robots' own maps.
   std::size_t map_bytes() const;
@@ -39,7 +41,12 @@ class RunReplay {
   // cells of either unless `all`.
   void relate(Recorded& own, const std::vector<int>& own_changed, const std::vector<int>& merged_changed, bool all) const;
 
+  // The decisions of the explorer's rounds since the last step, with their best candidates.
+  void add_decisions(const Simulation& sim);
+
   exploration::FrontierOptions frontier_options_;
+  int rounds_seen_ = 0;
+  exploration::ScoreSheet sheet_;  // names of the strategy's score terms (no robots)
   Recorded merged_;
   std::vector<Recorded> own_;
   std::vector<viz::ReplayRobot> robots_;

@@ -70,6 +70,8 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, S
       exchange_(scenario.robot_count, world_.geometry()),
       explorer_(scenario.robot_count, explorer_options(scenario)) {
   validate_scenario(scenario_);
+  // A run that writes a replay shows why each robot chose its target: the strategy reports its scores.
+  explorer_.record_decisions(scenario_.html_replay);
   {
     // A sensor that does not reach past the cell the robot stands in can never show it a place to go.
     const double cell = std::max(world_.geometry().resolution(), scenario_.exploration.planning_resolution_m);

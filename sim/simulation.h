@@ -179,6 +179,9 @@ class Simulation {
   bool finished(int i) const;
   // The targets robot i gave up so far, goals in its map frame at the time.
   const std::vector<exploration::TeamExplorer::GivenUp>& given_up(int i) const { return explorer_.given_up(i); }
+  // What the strategy weighed in the last decision round (recorded when the scenario asks for the
+  // replay page), positions in the frame of each decision's leader's map.
+  const exploration::TeamExplorer& explorer() const { return explorer_; }
   // The events so far (meetings, merges, blocked moves, finished robots), oldest first.
   const std::vector<Event>& events() const { return events_; }
   const std::vector<MergeRecord>& merges() const { return merges_; }

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <map>
 #include <cstring>
 
 #include "core/error.h"
@@ -27,6 +28,43 @@ std::uint64_t code(ReplayCell c) { return std::uint64_t(c); }
 // Positions in centimetres and headings in milliradians keep the page small.
 long cm(double metres) { return std::lround(metres * 100.0); }
 long mrad(double radians) { return std::lround(radians * 1000.0); }
+
+// A number to three decimals; NaN and infinities become null.
+json value(double v) { return std::isfinite(v) ? json(std::round(v * 1000.0) / 1000.0) : json(nullptr); }
+
+// Each distinct note once: decisions refer to it by index.
+struct Notes {
+  std::vector<std::string> texts;
+  std::map<std::string, int> index;
+  int of(const std::string& text) {
+    const auto [it, added] = index.try_emplace(text, int(texts.size()));
+    if (added) texts.push_back(text);
+    return it->second;
+  }
+};
+
+// Per decision {"s": step, "l": leader, "g": group (when not alone), "n": candidates weighed, "c": the
+// chosen one (index into "k"), "kept", "r": scores reported, "t": note, "goal": [x, y] cm,
+// "k": candidates [frontier x, y, goal x, y (cm), cells, score, taken by, terms...]}.
+json decisions_json(const std::vector<ReplayDecision>& decisions, Notes& notes) {
+  json out = json::array();
+  for (const auto& d : decisions) {
+    json one = {{"s", d.step}, {"l", d.leader}, {"n", d.weighed}, {"c", d.chosen}, {"r", d.reported ? 1 : 0}};
+    if (d.group.size() > 1) one["g"] = d.group;
+    if (d.kept) one["kept"] = 1;
+    if (!d.note.empty()) one["t"] = notes.of(d.note);
+    if (d.goal_m) one["goal"] = {cm(d.goal_m->x()), cm(d.goal_m->y())};
+    json candidates = json::array();
+    for (const auto& c : d.candidates) {
+      json row = {cm(c.frontier_m.x()), cm(c.frontier_m.y()), cm(c.goal_m.x()), cm(c.goal_m.y()), c.cells, value(c.score), c.taken_by};
+      for (double v : c.terms) row.push_back(value(v));
+      candidates.push_back(std::move(row));
+    }
+    one["k"] = std::move(candidates);
+    out.push_back(std::move(one));
+  }
+  return out;
+}
 
 json poses_json(const std::vector<core::Pose2>& poses) {
   json out = json::array();
@@ -121,6 +159,7 @@ json replay_json(const Replay& r) {
   j["own"] = json::array();
   for (const auto& layer : r.robot_maps) j["own"].push_back(layer.to_json());
   j["robots"] = json::array();
+  Notes notes;
   for (const auto& robot : r.robots) {
     json plans = json::array();
     for (const auto& plan : robot.plans) {
@@ -150,8 +189,15 @@ json replay_json(const Replay& r) {
                 {"passed", robot.passed},
                 {"finished", std::move(finished)}};
     if (r.estimates) one["estimate"] = poses_json(robot.estimate);
+    one["decisions"] = decisions_json(robot.decisions, notes);
     j["robots"].push_back(std::move(one));
   }
+  j["notes"] = notes.texts;
+  j["scores"] = {{"strategy", r.scores.strategy},
+                 {"terms", r.scores.terms},
+                 {"score", r.scores.score},
+                 {"lower", r.scores.lower_is_better},
+                 {"rule", r.scores.rule}};
   j["events"] = json::array();
   for (const auto& e : r.events) {
     json one = {{"step", e.step}, {"kind", e.kind}, {"robot", e.robot}, {"other", e.other}, {"text", e.text}};

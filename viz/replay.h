@@ -62,6 +62,38 @@ std::string encode_runs(const std::vector<ReplayCell>& cells);
 std::string encode_changes(const std::vector<ReplayCell>& before, const std::vector<ReplayCell>& after);
 std::string base64(const std::vector<std::uint8_t>& bytes);
 
+// One target a strategy weighed for a robot: where it is (world frame), its score terms and score.
+struct ReplayCandidate {
+  Eigen::Vector2d frontier_m = Eigen::Vector2d::Zero(), goal_m = Eigen::Vector2d::Zero();
+  int cells = 0;              // frontier cells of its piece
+  std::vector<double> terms;  // per ReplayScores::terms (NaN: none)
+  double score = 0.0;         // NaN: not ranked for this robot
+  int taken_by = -1;          // the robot (from 0) that got it in the same decision
+};
+
+// A robot's decision: the candidates it weighed, best first, and the one chosen.
+struct ReplayDecision {
+  int step = 0;
+  int leader = 0;           // the robot whose map the group decided on
+  std::vector<int> group;   // the robots that decided together
+  std::vector<ReplayCandidate> candidates;  // the best few (and the chosen one)
+  int weighed = 0;          // candidates the strategy weighed in all
+  int chosen = -1;          // index into candidates
+  std::optional<Eigen::Vector2d> goal_m;  // the target given (also when the strategy reported no scores)
+  bool kept = false;        // no new target: it kept its own
+  bool reported = false;    // the strategy reported its scores
+  std::string note;
+};
+
+// What the strategy's scores mean, for the page's "why" panel.
+struct ReplayScores {
+  std::string strategy;
+  std::vector<std::string> terms;
+  std::string score;
+  bool lower_is_better = true;
+  std::string rule;
+};
+
 struct ReplayRobot {
   std::string name;
   Color color;
@@ -75,6 +107,7 @@ struct ReplayRobot {
   std::vector<std::vector<Eigen::Vector2d>> plans;
   std::vector<int> plan, passed;
   std::vector<char> finished;  // per step: no reachable frontier left (for now)
+  std::vector<ReplayDecision> decisions;  // oldest first
 };
 
 struct ReplayEvent {
@@ -97,6 +130,7 @@ struct Replay {
   std::vector<ReplayLayer> robot_maps;  // each robot's own map, in its own frame
   std::vector<ReplayRobot> robots;
   std::vector<ReplayEvent> events;
+  ReplayScores scores;
 };
 
 // The data the page reads (documented by replay_html's script).

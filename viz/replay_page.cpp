@@ -64,6 +64,15 @@ canvas { display: block; image-rendering: pixelated; }
 #events div.now { background: #fff3c4; }
 .legend span { display: inline-block; margin-right: 12px; font-size: 12px; }
 .legend i { display: inline-block; width: 12px; height: 12px; vertical-align: -2px; margin-right: 4px; border: 1px solid #999; }
+.side { max-width: 436px; min-width: 300px; }
+#why { font-size: 12px; overflow-x: auto; }
+#why th { font-weight: 600; font-size: 11px; }
+#why table { margin: 4px 0; }
+#why td, #why th { padding: 1px 5px; }
+#why tr.chosen td { background: #e3f4e3; font-weight: 600; }
+#why tr.taken td { color: #888; }
+#why .rule { color: #555; }
+body.embedded .controls, body.embedded #chartsPanel, body.embedded #eventsPanel, body.embedded h1, body.embedded .facts { display: none; }
 body.only { margin: 0; }
 body.only > *:not(#main-wrap) { display: none !important; }
 body.only #main-wrap * { display: none; }
@@ -90,15 +99,16 @@ constexpr std::string_view kBody = R"HTML(</head>
 <div id="main-wrap" class="views">
   <div class="panel" id="mainPanel"><h2>Merged map (the world frame)</h2><canvas id="main"></canvas>
     <div class="legend" id="legend"></div></div>
-  <div class="panel" id="ownPanel"><h2>Own map of <select id="robot"></select> (its own frame)</h2><canvas id="own"></canvas>
+  <div class="side"><div class="panel" id="ownPanel"><h2>Own map of <select id="robot"></select> (its own frame)</h2><canvas id="own"></canvas>
     <div id="ownText" style="font-size:12px;white-space:pre"></div></div>
+  <div class="panel" id="whyPanel" style="margin-top:10px"><h2>Why <span id="whyRobot"></span> chose its target</h2><div id="why"></div></div></div>
 </div>
-<div class="panel" style="margin-top:10px">
+<div class="panel" id="chartsPanel" style="margin-top:10px">
   <h2>Coverage of the observable space, and the events (click to go to a step)</h2>
   <canvas id="curve" height="170"></canvas>
   <canvas id="timeline" height="70"></canvas>
 </div>
-<div class="panel" style="margin-top:10px"><h2>Events</h2><div id="events"></div></div>
+<div class="panel" id="eventsPanel" style="margin-top:10px"><h2>Events</h2><div id="events"></div></div>
 <div id="tip"></div>
 <script type="application/json" id="data">)HTML";
 
@@ -111,7 +121,9 @@ const D = JSON.parse(document.getElementById('data').textContent);
 const S = D.coverage.length;            // steps recorded: 0 .. S-1
 const N = D.robots.length;
 const opts = {};
-for (const part of location.hash.replace(/^#/, '').split('&')) {
+// A page shown inside the comparison page gets its options through its frame's name ("fleetmap:...").
+const framed = window.name.startsWith('fleetmap:') ? window.name.slice(9) : '';
+for (const part of (location.hash.replace(/^#/, '') + '&' + framed).split('&')) {
   const kv = part.split('=');
   if (kv[0]) opts[kv[0]] = decodeURIComponent(kv[1] || '');
 }
@@ -256,7 +268,7 @@ function fitScale(box, maxW, maxH) {
   return s >= 1 ? Math.floor(s) : s;
 }
 const mainScale = onlyMap ? Math.max(1, parseInt(opts.scale || '4', 10))
-                          : fitScale(mainBox, Math.max(400, Math.min(900, window.innerWidth - 460)), 760);
+                          : fitScale(mainBox, Math.max(400, Math.min(900, window.innerWidth - 510)), 760);
 main.width = Math.round((mainBox[2] - mainBox[0]) * mainScale);
 main.height = Math.round((mainBox[3] - mainBox[1]) * mainScale);
 document.getElementById('mainPanel').style.maxWidth = Math.max(300, main.width) + 'px';
@@ -278,7 +290,8 @@ const legend = document.getElementById('legend');
 legend.innerHTML = '<span><i style="background:#cdcdcd"></i>unknown</span><span><i style="background:#fff"></i>free</span>' +
   '<span><i style="background:#000"></i>occupied</span><span><i style="background:#ffc800"></i>frontier cells</span>' +
   '<span>solid: true trajectory' + (D.estimates ? ', dotted: estimated' : '') + '; dashed: planned path to the target (&#10005;); ' +
-  '&#9675;: start; grey &#10005;: a target given up</span>';
+  '&#9675;: start; grey &#10005;: a target given up; numbered circles: the chosen robot\'s candidate frontier targets in its last ' +
+  'decision, best first, with their scores (its target: thick ring; dashed: taken by the robot of that colour)</span>';
 
 function drawDisc(ctx, p, r, color, heading, ring) {
   ctx.beginPath(); ctx.arc(p[0], p[1], r, 0, 2 * Math.PI);
@@ -351,12 +364,109 @@ function drawMain() {
       drawCross(ctx, pts[pts.length - 1], Math.max(4, rpx * 0.8), r.color, 3);
     }
   });
+  drawCandidates(ctx, px, rpx);
   D.robots.forEach((r, i) => {
     const p = pose(r.truth, t), q = px(p[0], p[1]);
     drawDisc(ctx, q, rpx, r.color, p[2]);
     robotPx.push(q);
   });
   main.dataset.rpx = rpx;
+}
+
+// ---- Why a robot chose its target: the strategy's candidates and their scores (D.scores). ----
+// The robot's last decision at or before step k, or null.
+function decisionAt(i, k) {
+  const ds = D.robots[i].decisions || [];
+  let lo = 0, hi = ds.length;
+  while (lo < hi) { const m = (lo + hi) >> 1; if (ds[m].s <= k) lo = m + 1; else hi = m; }
+  return lo > 0 ? ds[lo - 1] : null;
+}
+// A candidate row: [frontier x, y, goal x, y (cm), cells, score, taken by, terms...].
+function cand(row) {
+  return {fx: row[0] / 100, fy: row[1] / 100, gx: row[2] / 100, gy: row[3] / 100, cells: row[4], score: row[5], taken: row[6], terms: row.slice(7)};
+}
+const num = v => v === null || v === undefined ? '–' : Math.abs(v) >= 100 ? v.toFixed(0) : Math.abs(v) >= 10 ? v.toFixed(1) : v.toFixed(3);
+const robotName = i => D.robots[i] ? D.robots[i].name : 'robot ' + (i + 1);
+// One sentence on why the chosen candidate won, from the scores alone.
+function whyText(i, d) {
+  const sc = D.scores || {};
+  if (!d) return 'No decision yet: ' + robotName(i) + ' has not asked the strategy for a target by this step.';
+  if (!d.r) return 'The strategy “' + (sc.strategy || '?') + '” reports no scores (a strategy registered by a program ' +
+    'or in Python may not): only its choice is shown' + (d.goal ? ', the target at ' + fmt(d.goal[0] / 100) + ', ' + fmt(d.goal[1] / 100) + ' m.' : '.');
+  if (d.c < 0) return d.kept ? 'No new target from this decision: it keeps driving to the one it has.'
+                             : 'No target: nothing it could reach was left for it' + (d.t !== undefined ? ' (' + D.notes[d.t] + ').' : '.');
+  const ks = d.k.map(cand), chosen = ks[d.c], better = (a, b) => sc.lower ? a < b : a > b;
+  const beaten = ks.filter((c, j) => j !== d.c && c.score !== null && better(c.score, chosen.score));
+  const free = ks.filter((c, j) => j !== d.c && c.taken < 0 && c.score !== null);
+  let text = 'Chosen: ' + sc.score + ' = ' + num(chosen.score) + ' (' + (sc.lower ? 'lower' : 'higher') + ' is better)';
+  if (!beaten.length) {
+    text += ', the best of the ' + d.n + ' candidates it weighed';
+    if (free.length) {
+      const next = free.reduce((a, b) => better(b.score, a.score) ? b : a);
+      text += '; the next free one scores ' + num(next.score) + ' (margin ' + num(Math.abs(next.score - chosen.score)) + ')';
+    }
+    text += '.';
+  } else {
+    const takers = [...new Set(beaten.filter(c => c.taken >= 0).map(c => robotName(c.taken)))];
+    const own = beaten.filter(c => c.taken < 0).length;
+    text += ', not its own best: ' + beaten.length + ' candidate' + (beaten.length > 1 ? 's' : '') + ' scored better';
+    if (takers.length) text += ', of which ' + (beaten.length - own) + ' went to ' + takers.join(', ') + ' in the same decision';
+    if (own) text += (takers.length ? ', and ' : ': ') + own + ' the team’s decision gave to nobody (' + sc.strategy + ' decides for the team, not robot by robot)';
+    text += '.';
+  }
+  return text;
+}
+function renderWhy() {
+  const el = document.getElementById('why'), sc = D.scores || {};
+  document.getElementById('whyRobot').textContent = robotName(robotSel);
+  const d = decisionAt(robotSel, t);
+  const head = [];
+  if (d) head.push('Decision at step ' + d.s + (d.s < t ? ' (' + (t - d.s) + ' steps ago)' : '') +
+                   (d.g ? ', together with ' + d.g.filter(j => j !== robotSel).map(robotName).join(', ') : ', alone') +
+                   ', on ' + robotName(d.l) + '’s map.');
+  if (sc.rule) head.push('<span class="rule">Strategy ' + esc(sc.strategy) + ': ' + esc(sc.rule) + '.</span>');
+  let html = head.map(h => '<div>' + (h.startsWith('<') ? h : esc(h)) + '</div>').join('');
+  html += '<div id="whyText"><b>' + esc(whyText(robotSel, d)) + '</b></div>';
+  if (d && d.t !== undefined) html += '<div>' + esc(D.notes[d.t]) + '</div>';
+  if (d && d.r && d.k.length) {
+    html += '<table id="whyTable"><tr><th>#</th><th class="text">frontier at (m)</th><th>cells</th>' +
+            (sc.terms || []).map(n => '<th>' + esc(n) + '</th>').join('') + '<th>' + esc(sc.score) + '</th><th class="text"></th></tr>';
+    d.k.forEach((row, j) => {
+      const c = cand(row), cls = j === d.c ? 'chosen' : c.taken >= 0 ? 'taken' : '';
+      html += '<tr class="' + cls + '" data-score="' + (c.score === null ? '' : c.score) + '" data-taken="' + c.taken + '"><td>' + (j + 1) +
+              '</td><td class="text">' + fmt(c.fx, 1) + ', ' + fmt(c.fy, 1) + '</td><td>' + c.cells + '</td>' +
+              c.terms.map(v => '<td>' + num(v) + '</td>').join('') + '<td>' + num(c.score) + '</td><td class="text">' +
+              (j === d.c ? '✓ chosen' : c.taken >= 0 ? '→ ' + esc(robotName(c.taken)) : '') + '</td></tr>';
+    });
+    html += '</table>';
+    if (d.n > d.k.length) html += '<div>The best ' + d.k.length + ' of ' + d.n + ' candidates are kept in the replay.</div>';
+  }
+  el.innerHTML = html;
+}
+// The selected robot's candidates on the merged map, numbered best first, with their scores.
+function drawCandidates(ctx, px, rpx) {
+  const d = decisionAt(robotSel, t);
+  if (!d || !d.r) return;
+  ctx.font = 'bold 11px sans-serif';
+  const placed = [];  // score labels drawn so far: a label that would cover one is left out (the table has it)
+  d.k.forEach((row, j) => {
+    const c = cand(row), q = px(c.fx, c.fy), chosen = j === d.c;
+    const color = chosen ? D.robots[robotSel].color : c.taken >= 0 ? D.robots[c.taken].color : '#333';
+    ctx.beginPath(); ctx.arc(q[0], q[1], Math.max(6, rpx * 0.9), 0, 2 * Math.PI);
+    ctx.fillStyle = 'rgba(255,255,255,0.8)'; ctx.fill();
+    ctx.setLineDash(c.taken >= 0 && !chosen ? [3, 2] : []);
+    ctx.strokeStyle = color; ctx.lineWidth = chosen ? 3 : 1.5; ctx.stroke(); ctx.setLineDash([]);
+    ctx.fillStyle = '#000'; ctx.textAlign = 'center'; ctx.textBaseline = 'middle';
+    ctx.fillText(String(j + 1), q[0], q[1]);
+    ctx.textAlign = 'left';
+    ctx.fillStyle = chosen ? '#060' : '#333';
+    const label = num(c.score), w = ctx.measureText(label).width, off = Math.max(7, rpx);
+    const x = q[0] + off + w > main.width ? q[0] - off - w : q[0] + off, y = q[1] - off;
+    if (!chosen && placed.some(b => x < b[0] + b[2] && b[0] < x + w && Math.abs(y - b[1]) < 11)) return;
+    placed.push([x, y, w]);
+    ctx.fillText(label, x, y);
+  });
+  ctx.textBaseline = 'alphabetic';
 }
 
 let ownBox = null, ownFrame = -1;
@@ -397,7 +507,17 @@ function drawOwn() {
   document.getElementById('ownText').textContent = robotState(robotSel);
 }
 
-function robotState(i) {
+// Text wrapped at spaces into lines of about `width` characters (the tooltip keeps line breaks).
+function wrap(text, width) {
+  const out = [];
+  let line = '';
+  for (const w of text.split(' ')) {
+    if (line && line.length + w.length + 1 > width) { out.push(line); line = w; } else line = line ? line + ' ' + w : w;
+  }
+  if (line) out.push(line);
+  return out.join('\n  ');
+}
+function robotState(i, why) {
   const r = D.robots[i], p = pose(r.truth, t), e = estimateAt(r, t), F = framePose(r, t), plan = planAt(r, t);
   const lines = [r.name + ' at step ' + t + (r.finished[t] === '1' ? ': no reachable frontier left' : plan.length ? ': exploring' : ': choosing a target')];
   lines.push('true pose ' + fmt(p[0]) + ', ' + fmt(p[1]) + ' m, ' + deg(p[2]) + ' deg');
@@ -413,6 +533,7 @@ function robotState(i) {
   let last = null;
   for (const ev of D.events) if (ev.step <= t && (ev.robot === i || ev.other === i) && ev.kind !== 'blocked') last = ev;
   if (last) lines.push('last event: step ' + last.step + ', ' + last.kind + ': ' + eventText(last));
+  if (why) lines.push(wrap('why its target: ' + whyText(i, decisionAt(i, t)), 80));
   return lines.join('\n');
 }
 function eventText(e) {
@@ -496,9 +617,11 @@ function render() {
   const sec = t * D.period;
   document.getElementById('stepText').textContent = 'step ' + t + ' of ' + (S - 1) + ' (' + fmt(sec, 0) + ' s), ' + (D.coverage[t] * 100).toFixed(1) + '%';
   drawMain();
-  if (!onlyMap) { drawOwn(); drawCurve(); drawTimeline(); markEvents(); }
+  if (!onlyMap) { drawOwn(); renderWhy(); drawCurve(); drawTimeline(); markEvents(); }
   document.body.dataset.step = t;
   document.body.dataset.ready = '1';
+  if (window.parent !== window) window.parent.postMessage({fleetmap: 'shown', name: window.name, step: t, height: document.body.scrollHeight,
+                                                           why: (document.getElementById('whyText') || {}).textContent || ''}, '*');
 }
 function go(k) { t = Math.min(S - 1, Math.max(0, k)); render(); }
 
@@ -547,7 +670,7 @@ main.addEventListener('mousemove', e => {
   let bestD = Math.max(12, parseFloat(main.dataset.rpx || 0) + 4);
   hovered = -1;
   robotPx.forEach((q, i) => { const d = Math.hypot(q[0] - p[0], q[1] - p[1]); if (d < bestD) { bestD = d; hovered = i; } });
-  showTip(e, hovered >= 0 ? robotState(hovered) + '\n(click: show its own map)' : '');
+  showTip(e, hovered >= 0 ? robotState(hovered, true) + '\n(click: show its own map and why it chose its target)' : '');
 });
 main.addEventListener('mouseleave', () => { hovered = -1; showTip(null, ''); });
 main.addEventListener('click', () => {
@@ -571,6 +694,9 @@ for (const c of [curve, timeline]) {
 }
 
 if (onlyMap) document.body.classList.add('only');
+if (opts.embedded) document.body.classList.add('embedded');
+// The comparison page moves both of its replays to one step.
+window.addEventListener('message', e => { if (e.data && e.data.fleetmap === 'go') go(e.data.step); });
 layout();
 window.addEventListener('resize', () => { layout(); render(); });
 render();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 
@@ -89,6 +90,52 @@ TEST_P(EveryStrategy, JointStrategiesNeverShareATargetWhileThereAreEnough) {
       }
       if (t >= 0) {
         EXPECT_TRUE(used.insert(t).second) << GetParam() << " sent two robots to target " << t;
+      }
+    }
+  }
+}
+
+// Asked for its scores (a replay records them), every built-in strategy makes the same choices and
+// says why: each robot's candidates are the targets it can reach, with one value per named term,
+// and no candidate left to nobody scores better than the one it got; the Hungarian assignment is
+// optimal instead (no swap of two robots' targets, and no move to a free target, lowers its total).
+TEST_P(EveryStrategy, ReportsScoresThatExplainTheSameChoices) {
+  const auto plain = make_strategy(GetParam()), scored = make_strategy(GetParam());
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 60; ++trial) {
+    AssignmentInput in = random_input(rng, 1 + trial % 6, 1 + trial % 11, 0.2);
+    const auto expected = plain->assign(in);
+    ScoreSheet sheet;
+    in.scores = &sheet;
+    const auto a = scored->assign(in);
+    ASSERT_EQ(a, expected) << "asking for scores changed the choice (trial " << trial << ")";
+    ASSERT_EQ(sheet.robots.size(), in.robots.size());
+    ASSERT_FALSE(sheet.terms.empty());
+    EXPECT_FALSE(sheet.rule.empty());
+    const auto better = [&](double x, double y) { return sheet.lower_is_better ? x < y - 1e-9 : x > y + 1e-9; };
+    std::set<int> given(a.begin(), a.end());
+    std::vector<std::map<int, double>> score(in.robots.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      for (const auto& c : sheet.robots[i].candidates) {
+        ASSERT_EQ(c.terms.size(), sheet.terms.size());
+        ASSERT_TRUE(std::isfinite(in.robots[i].cost_m[std::size_t(c.target)])) << "an unreachable candidate";
+        score[i][c.target] = c.score;
+      }
+      if (a[i] < 0) continue;
+      ASSERT_TRUE(score[i].count(a[i])) << "robot " << i << "'s target is not among its candidates";
+      if (GetParam() == "optimized") continue;
+      for (const auto& [t, v] : score[i])
+        EXPECT_FALSE(!given.count(t) && better(v, score[i][a[i]]))
+            << GetParam() << ": robot " << i << " got target " << a[i] << " (" << score[i][a[i]] << ") but free target " << t
+            << " scored " << v;
+    }
+    if (GetParam() != "optimized") continue;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (a[i] < 0) continue;
+      for (const auto& [t, v] : score[i]) EXPECT_FALSE(!given.count(t) && v < score[i][a[i]] - 1e-9) << "a free target is cheaper";
+      for (std::size_t j = 0; j < a.size(); ++j) {
+        if (j == i || a[j] < 0 || !score[i].count(a[j]) || !score[j].count(a[i])) continue;
+        EXPECT_LE(score[i][a[i]] + score[j][a[j]], score[i][a[j]] + score[j][a[i]] + 1e-9) << "swapping two robots' targets is cheaper";
       }
     }
   }

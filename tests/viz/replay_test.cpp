@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "core/error.h"
+#include "tests/test_support.h"
+#include "viz/replay_compare.h"
 
 namespace fleetmap::viz {
 namespace {
@@ -178,6 +181,79 @@ TEST(ReplayPage, SelfContainedAndItsDataCannotCloseTheScript) {
   EXPECT_EQ(data["robots"][0]["finished"], "01");
   EXPECT_EQ(data["robots"][0]["truth"][3], 60);  // centimetres
   EXPECT_FALSE(data["robots"][0].contains("estimate"));  // ideal localization: the truth is drawn
+}
+
+// The strategy's reasons: each decision's candidates as compact rows, NaN scores as null, and a note
+// shared by many decisions stored once.
+TEST(ReplayPage, DecisionsKeepTheirCandidatesAndNotesOnce) {
+  Replay r = tiny_replay();
+  r.scores = {"directional", {"wave cost (m)", "off its direction (0-1)"}, "rank", true, "the lowest rank wins"};
+  ReplayDecision d;
+  d.step = 1;
+  d.weighed = 5;
+  d.chosen = 0;
+  d.reported = true;
+  d.note = "its own direction: 0 deg";
+  d.goal_m = Eigen::Vector2d(0.7, 0.5);
+  d.candidates = {{{0.8, 0.5}, {0.7, 0.5}, 4, {1.23456, 0.5}, 0.9, -1},
+                  {{0.2, 0.9}, {0.2, 0.8}, 3, {2.0, std::numeric_limits<double>::quiet_NaN()}, std::numeric_limits<double>::quiet_NaN(), 0}};
+  r.robots[0].decisions = {d, d};
+  r.robots[0].decisions[1].step = 2;
+  const std::string page = replay_html(r);
+  const std::size_t start = page.find(">", page.find("id=\"data\"")) + 1;
+  const auto data = nlohmann::json::parse(page.substr(start, page.find("</script>", start) - start));
+  EXPECT_EQ(data["scores"]["terms"].size(), 2u);
+  EXPECT_EQ(data["scores"]["lower"], true);
+  ASSERT_EQ(data["robots"][0]["decisions"].size(), 2u);
+  EXPECT_EQ(data["notes"].size(), 1u);
+  const auto& first = data["robots"][0]["decisions"][0];
+  EXPECT_EQ(first["t"], 0);
+  EXPECT_EQ(first["n"], 5);
+  EXPECT_EQ(first["goal"], nlohmann::json::array({70, 50}));
+  // [frontier x, y, goal x, y (cm), cells, score, taken by, terms...], three decimals.
+  EXPECT_EQ(first["k"][0], nlohmann::json::parse("[80, 50, 70, 50, 4, 0.9, -1, 1.235, 0.5]"));
+  EXPECT_TRUE(first["k"][1][5].is_null());
+  EXPECT_TRUE(first["k"][1][8].is_null());
+  EXPECT_EQ(first["k"][1][6], 0);
+}
+
+// The comparison page holds every run's page whole (as JSON text) and a summary of each: nothing
+// is fetched, and no run's text can close the page's scripts.
+TEST(ReplayCompare, HoldsEveryRunAndItsSummary) {
+  Replay a = tiny_replay(), b = tiny_replay();
+  a.facts = {{"steps", "2"}, {"95%", "never"}};
+  b.facts = {{"steps", "2"}, {"95%", "step 1"}};
+  b.coverage = {0.1, 0.96};
+  const std::vector<ComparedReplay> runs = {{"run <a>", replay_html(a)}, {"b", replay_html(b)}};
+  const std::string page = replay_comparison_html(runs);
+  for (const char* fetch : {"http://", "https://", "src=", "<link", "@import", "url("}) EXPECT_EQ(page.find(fetch), std::string::npos) << fetch;
+  std::size_t closes = 0;
+  for (std::size_t p = page.find("</script>"); p != std::string::npos; p = page.find("</script>", p + 1)) ++closes;
+  EXPECT_EQ(closes, 4u);  // the summary, two pages, the script
+  EXPECT_NE(page.find("<title>Comparing run &lt;a&gt; and b</title>"), std::string::npos);
+  const auto script = [&](const std::string& id) {
+    const std::size_t start = page.find(">", page.find("id=\"" + id + "\"")) + 1;
+    return nlohmann::json::parse(page.substr(start, page.find("</script>", start) - start));
+  };
+  const auto summary = script("summary");
+  ASSERT_EQ(summary.size(), 2u);
+  EXPECT_EQ(summary[0]["label"], "run <a>");
+  EXPECT_EQ(summary[1]["coverage"][1], 0.96);
+  EXPECT_EQ(summary[1]["facts"][1][1], "step 1");
+  EXPECT_EQ(summary[0]["events"]["refused merge"], 1);
+  EXPECT_NEAR(summary[0]["distance"].get<double>(), 0.1, 1e-9);
+  EXPECT_EQ(script("page0").get<std::string>(), runs[0].page);
+  EXPECT_EQ(script("page1").get<std::string>(), runs[1].page);
+}
+
+TEST(ReplayCompare, RefusesWhatIsNotAReplay) {
+  fleetmap::testing::expect_input_error([] { replay_page_data("<html><body>a page</body></html>", "x.html"); },
+                                        {"x.html", "not a fleetmap replay page"});
+  const std::string page = replay_html(tiny_replay());
+  fleetmap::testing::expect_input_error([&] { replay_comparison_html({{"a", page}}); }, {"two replay pages"});
+  std::string broken = page;
+  broken.insert(broken.find(">", broken.find("id=\"data\"")) + 1, "{");
+  fleetmap::testing::expect_input_error([&] { replay_comparison_html({{"a", page}, {"b", broken}}); }, {"b:", "does not parse"});
 }
 
 }  // namespace
