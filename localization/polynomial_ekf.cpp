@@ -45,6 +45,15 @@ void symmetrise(Eigen::MatrixXd& p) {
   }
 }
 
+// Joseph form (I - KH) P (I - KH)^T + K R K^T = P - K (PH)^T - (PH) K^T + (H P H^T + R) K K^T, K = PH / s.
+void apply_gain(Eigen::MatrixXd& p, const Eigen::VectorXd& ph, double s) {
+  const Eigen::VectorXd k = ph / s;
+  p.noalias() -= k * ph.transpose();
+  p.noalias() -= ph * k.transpose();
+  p.noalias() += s * (k * k.transpose());
+  symmetrise(p);
+}
+
 }  // namespace
 
 double PolynomialEkf::innovation_variance(const ScalarReading& r) const {
@@ -55,14 +64,24 @@ void PolynomialEkf::update(double z, const ScalarReading& r) {
   const Eigen::VectorXd ph = covariance_times_h(covariance_, r);
   const double s = h_times(ph, r) + r.noise;
   if (!(s > 0.0)) return;
-  const Eigen::VectorXd k = ph / s;
-  mean_ += k * (z - r.predicted);
+  mean_ += ph * ((z - r.predicted) / s);
   mean_(2) = core::normalize_angle(mean_(2));
-  // Joseph form (I - KH) P (I - KH)^T + K R K^T = P - K (PH)^T - (PH) K^T + (H P H^T + R) K K^T.
-  covariance_.noalias() -= k * ph.transpose();
-  covariance_.noalias() -= ph * k.transpose();
-  covariance_.noalias() += s * (k * k.transpose());
-  symmetrise(covariance_);
+  apply_gain(covariance_, ph, s);
+}
+
+PolynomialEkf::UpdateOutcome PolynomialEkf::update(double z, const ReadingModel& model, double gate) {
+  const std::optional<ScalarReading> r = model(mean_);
+  if (!r) return UpdateOutcome::Lost;
+  const Eigen::VectorXd ph = covariance_times_h(covariance_, *r);
+  const double s = h_times(ph, *r) + r->noise;
+  const double nu = z - r->predicted;
+  if (!(s > 0.0) || nu * nu / s > gate) return UpdateOutcome::Gated;
+  Eigen::VectorXd next = mean_ + ph * (nu / s);
+  next(2) = core::normalize_angle(next(2));
+  if (!model(next)) return UpdateOutcome::Lost;
+  mean_ = std::move(next);
+  apply_gain(covariance_, ph, s);
+  return UpdateOutcome::Updated;
 }
 
 int PolynomialEkf::augment(const LandmarkGeneration& g) {

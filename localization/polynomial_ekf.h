@@ -8,6 +8,8 @@
 // Contract: the covariance stays symmetric (Joseph-form updates, symmetrised) and the heading in (-pi, pi].
 #include <Eigen/Core>
 
+#include <functional>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -61,6 +63,16 @@ class PolynomialEkf {
   // The EKF update with one scalar reading, Joseph form (I-KH) P (I-KH)^T + K R K^T, O(n^2).
   // Does nothing when S is not positive.
   void update(double z, const ScalarReading& r);
+
+  // The reading model at a state: nullopt when the reading does not see its landmark there.
+  using ReadingModel = std::function<std::optional<ScalarReading>(const Eigen::VectorXd& state)>;
+  enum class UpdateOutcome { Updated, Gated, Lost };
+  // The EKF update with a reading given as its model: linearised at the current state; nothing
+  // changes when the innovation fails the chi-square `gate` (nu^2 / S > gate: Gated) or when, at
+  // the updated state, the reading no longer sees its landmark (Lost: the linearisation does not
+  // hold over the step, e.g. a sensor axis moved off a short polynomial's end, and the information
+  // it would add is spurious).
+  UpdateOutcome update(double z, const ReadingModel& model, double gate);
 
   // D'Alfonso et al. eq. (4): appends c0_new and P~ = G_x P G_x^T + G_y V G_y^T; returns the new slot.
   int augment(const LandmarkGeneration& g);

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "localization/metrics.h"
 
 namespace fleetmap::localization {
 
@@ -273,13 +274,21 @@ void PolynomialSlam::update(const std::vector<double>& angles, const std::vector
       reading.noise += reading.h_slot * reading.h_slot *
                        (d * d * landmark.along_variance + lever * lever * landmark.angle_variance);
     }
-    const double s = filter_.innovation_variance(reading);
-    const double nu = y - reading.predicted;
-    if (!(s > 0.0) || nu * nu / s > options_.innovation_gate) {
+    // The reading at any state: the same landmark and axis, with this reading's noise.
+    const double noise = reading.noise;
+    const int first = first_slot(index), size = state.basis.size;
+    const auto at = [&, first, size, noise](const Eigen::VectorXd& x) -> std::optional<ScalarReading> {
+      auto m = range_reading(state.reference, state.basis, x.segment(3 + first, size), first,
+                             core::Pose2(x(0), x(1), x(2)), angles[i], y + options_.sigma_max + 1.0,
+                             options_.domain_margin);
+      if (m) m->noise = noise;
+      return m;
+    };
+    const auto outcome = filter_.update(y, at, options_.innovation_gate);
+    if (outcome != PolynomialEkf::UpdateOutcome::Updated) {
       ++counters_.rejected_readings;
       continue;
     }
-    filter_.update(y, reading);
     ++counters_.updates;
   }
   sync_positions();
@@ -295,12 +304,29 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
   if (!fit || !(fit->max_residual <= max_residual)) return std::nullopt;
   int fit_order = options_.order;
   if (options_.lowest_order) {
-    // The lowest order whose fit explains the points as well as order m does, within the noise:
-    // its weighted RMS residual at most that of order m plus half a reading's standard deviation.
+    // The lowest order whose residuals the readings' noise explains (chi-square test at 95%, V the
+    // sensor's variance), or whose fit explains the points as well as order m does (weighted RMS
+    // residual at most order m's plus half a reading's standard deviation). A higher order than
+    // the noise needs only fits the noise: points that do not spread along the boundary (one spot
+    // read again and again while the robot drives along the beam, range noise spreading them
+    // along it) give a curve bent along the beam, with a shape no later reading supports and a
+    // covariance (linearised at that shape) far too small.
     const double enough = fit->rms_residual + 0.5 * options_.range_noise;
+    const double v = std::pow(std::max(options_.range_noise, kMinRangeStd), 2);
+    const auto noise_explains = [&](const mapping::PolynomialFit& f, int order) {
+      const int dof = int(weighted.size()) - order - 1;
+      if (dof < 1) return false;
+      double sum = 0.0;
+      for (const auto& q : weighted) {
+        const Eigen::Vector2d l = f.polynomial.local(q.position);
+        sum += std::pow(l.y() - f.polynomial.value(l.x()), 2);
+      }
+      return sum / v <= chi_square_quantile(dof, 0.95);
+    };
     for (int order = 1; order < options_.order; ++order) {
       auto lower = mapping::fit_polynomial(weighted, order, axis);
-      if (lower && lower->rms_residual <= enough && lower->max_residual <= max_residual) {
+      if (lower && (lower->rms_residual <= enough || noise_explains(*lower, order)) &&
+          lower->max_residual <= max_residual) {
         // Kept as an order-m polynomial whose leading coefficients are zero.
         lower->polynomial.shape.insert(lower->polynomial.shape.begin(), std::size_t(options_.order - order), 0.0);
         fit = std::move(lower);

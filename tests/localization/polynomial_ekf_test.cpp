@@ -98,6 +98,32 @@ TEST(PolynomialEkf, JosephUpdateMatchesTheKalmanFormula) {
   EXPECT_TRUE(f.covariance().isApprox(p - k * s * k.transpose(), 1e-12));
 }
 
+// The update through a reading model: the same step as update(z, r) when the reading still sees
+// its landmark at the updated state; nothing changes when the innovation fails the gate, or when
+// the step takes the state where the reading no longer sees its landmark (here: beyond x = 0.03).
+TEST(PolynomialEkf, AModelledReadingUpdatesOnlyWhenItStillSeesItsLandmarkAfterTheStep) {
+  const auto model = [](const Eigen::VectorXd& x) -> std::optional<ScalarReading> {
+    if (x(0) > 0.03) return std::nullopt;
+    ScalarReading r;
+    r.predicted = 1.0 - x(0);
+    r.h_pose << -1.0, 0.0, 0.0;
+    r.noise = 4e-4;
+    return r;
+  };
+  PolynomialEkf plain(core::Pose2(), p0()), modelled(core::Pose2(), p0());
+  plain.update(0.98, *model(plain.mean()));
+  EXPECT_EQ(modelled.update(0.98, model, 3.84), PolynomialEkf::UpdateOutcome::Updated);
+  EXPECT_TRUE(modelled.mean().isApprox(plain.mean(), 1e-15));
+  EXPECT_TRUE(modelled.covariance().isApprox(plain.covariance(), 1e-15));
+  // nu = -0.09 against S = 0.0029: nu^2 / S = 2.8 passes the gate, but the step goes to x = 0.078.
+  PolynomialEkf lost(core::Pose2(), p0());
+  EXPECT_EQ(lost.update(0.91, model, 3.84), PolynomialEkf::UpdateOutcome::Lost);
+  EXPECT_TRUE(lost.mean().isZero());
+  EXPECT_TRUE(lost.covariance().isApprox(p0()));
+  EXPECT_EQ(lost.update(0.91, model, 2.0), PolynomialEkf::UpdateOutcome::Gated);
+  EXPECT_TRUE(lost.covariance().isApprox(p0()));
+}
+
 TEST(PolynomialEkf, RemovalDropsRowsAndColumns) {
   PolynomialEkf f(core::Pose2(), p0());
   for (int i = 0; i < 4; ++i) {

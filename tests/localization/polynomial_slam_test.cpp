@@ -472,3 +472,49 @@ TEST(PolynomialSlam, OptionsAreValidated) {
 
 }  // namespace
 }  // namespace fleetmap::localization
+
+namespace fleetmap::localization {
+namespace {
+
+// A robot drives straight at the wall x1 = 2 along a beam 40 degrees off the wall's normal, its
+// one sensor reading the same spot ten times (2 cm range noise spreads the points along the beam),
+// then turns and reads once 20 cm further along the wall. Eleven points make a cluster, then a
+// polynomial: the wall is straight and the range noise explains a line's residuals, so the filter
+// holds a line (c0 and a_1), not a curve bent along the beam whose linearised covariance would be
+// far too small.
+TEST(PolynomialSlam, PointsBunchedAlongABeamMakeALineNotACurveBentAlongIt) {
+  PolynomialSlamOptions o;
+  o.shape_in_state = true;
+  const double beam = 40.0 * std::numbers::pi / 180.0;
+  int lines = 0;
+  const int seeds = 8;
+  for (int seed = 0; seed < seeds; ++seed) {
+    core::Random rng = core::Random(17).fork(std::uint64_t(seed));
+    const core::Pose2 start(0.0, -1.5, beam);
+    PolynomialSlam slam(start, p0(), Eigen::Matrix3d::Zero(), o);
+    core::Pose2 truth = start;
+    const auto read = [&](double angle) -> std::optional<double> {
+      const double c = std::cos(truth.theta + angle);
+      return (2.0 - truth.x) / c + rng.normal(0.0, o.range_noise);
+    };
+    for (int k = 0; k < 10; ++k) {
+      if (k > 0) {
+        const Odometry u{0.05, 0.0, 1.0};
+        slam.predict(u);
+        truth = integrate_motion(truth, u);
+      }
+      slam.update({0.0}, {read(0.0)});
+    }
+    // The eleventh point, 20 cm further down the wall.
+    const double turn = std::atan2(-1.5 + 2.0 * std::tan(beam) - 0.2 - truth.y, 2.0 - truth.x) - truth.theta;
+    slam.update({turn}, {read(turn)});
+    ASSERT_EQ(slam.map().landmarks.size(), 1u) << "seed " << seed;
+    const int size = slam.basis(0).size;
+    EXPECT_LE(size, 3) << "seed " << seed;
+    if (size == 2) ++lines;
+  }
+  EXPECT_EQ(lines, seeds);
+}
+
+}  // namespace
+}  // namespace fleetmap::localization
