@@ -125,14 +125,70 @@ std::vector<std::string> run_sweep(const std::string& yaml, const std::string& s
   return lines;
 }
 
+// What a Python strategy gets besides the arrays (its assign's optional fifth argument): the
+// robots' places in the team, the strategy options, and the lazily computed target-to-target wave
+// costs and unknown areas, which exist only while assign runs.
+class AssignmentContext {
+ public:
+  AssignmentContext(const exploration::AssignmentInput& input, const exploration::StrategyOptions& options)
+      : input_(&input), options_(options) {}
+  void close() { input_ = nullptr; }
+
+  py::array_t<int> team_indices() const {
+    const auto& robots = live().robots;
+    py::array_t<int> out(py::ssize_t(robots.size()));
+    for (std::size_t r = 0; r < robots.size(); ++r) out.mutable_at(py::ssize_t(r)) = robots[r].team_index;
+    return out;
+  }
+  int team_size() const { return live().robots.empty() ? 0 : live().robots.front().team_size; }
+  double sensor_range() const { return live().sensor_range_m; }
+  double beta() const { return options_.beta; }
+  double directional_weight() const { return options_.directional_weight; }
+  py::array_t<double> target_costs() const {
+    const auto& input = live();
+    Eigen::MatrixXd costs;
+    {
+      py::gil_scoped_release release;  // wave fronts from every goal: let other runs' strategies go on
+      costs = exploration::target_costs(input);
+    }
+    const auto n = py::ssize_t(costs.rows());
+    py::array_t<double> out({n, n});
+    auto o = out.mutable_unchecked<2>();
+    for (py::ssize_t a = 0; a < n; ++a)
+      for (py::ssize_t b = 0; b < n; ++b) o(a, b) = costs(a, b);
+    return out;
+  }
+  py::array_t<double> target_gains() const {
+    const auto& input = live();
+    std::vector<double> gains;
+    if (input.target_gains_m2) {
+      py::gil_scoped_release release;
+      gains = input.target_gains_m2();
+    } else {
+      gains.assign(input.targets.size(), 1.0);
+    }
+    return py::array_t<double>(py::ssize_t(gains.size()), gains.data());
+  }
+
+ private:
+  const exploration::AssignmentInput& live() const {
+    if (!input_) throw Error("the assignment context is valid only while assign runs");
+    return *input_;
+  }
+  const exploration::AssignmentInput* input_;
+  exploration::StrategyOptions options_;
+};
+
 // A coordination strategy whose assign() is a Python object's method:
-//   assign(positions (R, 2), targets (T, 4): goal x, goal y, frontier cells, region,
-//          costs (R, T) wave metres (inf: unreachable), claimed (K, 2)) -> R target indices or -1.
+//   assign(poses (R, 3): x, y, heading, targets (T, 4): goal x, goal y, frontier cells, region,
+//          costs (R, T) wave metres (inf: unreachable), claimed (K, 2)[, context]) -> R target indices or -1.
 // Simulations run with the GIL released (sweeps on several threads); each call takes it.
 class PythonStrategy final : public exploration::CoordinationStrategy {
  public:
-  PythonStrategy(std::string name, bool joint, py::object instance)
-      : name_(std::move(name)), joint_(joint), instance_(std::move(instance)) {}
+  PythonStrategy(std::string name, bool joint, bool with_context, py::object instance,
+                 const exploration::StrategyOptions& options)
+      : name_(std::move(name)), joint_(joint), with_context_(with_context), instance_(std::move(instance)),
+        options_(options) {}
   ~PythonStrategy() override {
     py::gil_scoped_acquire gil;
     instance_ = py::object();
@@ -143,8 +199,8 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
   std::vector<int> assign(const exploration::AssignmentInput& input) const override {
     py::gil_scoped_acquire gil;
     const auto robots = py::ssize_t(input.robots.size()), targets = py::ssize_t(input.targets.size());
-    std::vector<Eigen::Vector2d> positions;
-    for (const auto& r : input.robots) positions.push_back(r.position_m);
+    std::vector<core::Pose2> poses;
+    for (const auto& r : input.robots) poses.emplace_back(r.position_m.x(), r.position_m.y(), r.heading_rad);
     py::array_t<double> target_rows({targets, py::ssize_t(4)});
     auto t = target_rows.mutable_unchecked<2>();
     for (py::ssize_t k = 0; k < targets; ++k) {
@@ -157,9 +213,17 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
       for (py::ssize_t k = 0; k < targets; ++k) c(r, k) = input.robots[std::size_t(r)].cost_m[std::size_t(k)];
     }
     std::vector<int> out;
+    // The context dies with this call even when Python keeps a reference to it.
+    py::object context = py::cast(AssignmentContext(input, options_));
+    struct Close {
+      py::object& context;
+      ~Close() { context.cast<AssignmentContext&>().close(); }
+    } close{context};
     try {
-      const py::object answer =
-          instance_.attr("assign")(point_rows(positions), target_rows, costs, point_rows(input.claimed));
+      const py::object assign = instance_.attr("assign");
+      const py::object answer = with_context_
+                                    ? assign(pose_rows(poses), target_rows, costs, point_rows(input.claimed), context)
+                                    : assign(pose_rows(poses), target_rows, costs, point_rows(input.claimed));
       for (const auto& item : answer) out.push_back(item.cast<int>());
     } catch (const py::error_already_set& e) {
       throw Error("strategy '" + name_ + "': assign raised " + std::string(e.what()));
@@ -182,20 +246,24 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
  private:
   std::string name_;
   bool joint_;
+  bool with_context_;
   py::object instance_;
+  exploration::StrategyOptions options_;
 };
 
-void register_python_strategy(const std::string& name, const py::object& cls, const std::string& help, bool joint) {
+void register_python_strategy(const std::string& name, const py::object& cls, const std::string& help, bool joint,
+                              bool with_context) {
   if (!py::hasattr(cls, "assign")) throw InputError("register_strategy '" + name + "': the class has no assign method");
   // The registry keeps its factories for the life of the process, beyond the interpreter's; the
   // class is held by a reference that is never released, so no Python object dies without it.
   PyObject* held = cls.ptr();
   Py_INCREF(held);
   exploration::register_strategy(name, help.empty() ? "written in Python" : help,
-                                 [name, held, joint](const exploration::StrategyOptions&) {
+                                 [name, held, joint, with_context](const exploration::StrategyOptions& options) {
                                    py::gil_scoped_acquire gil;
                                    py::object instance = py::reinterpret_borrow<py::object>(held)();
-                                   return std::make_unique<PythonStrategy>(name, joint, std::move(instance));
+                                   return std::make_unique<PythonStrategy>(name, joint, with_context,
+                                                                           std::move(instance), options);
                                  });
 }
 
@@ -338,5 +406,22 @@ PYBIND11_MODULE(_fleetmap, m) {
       py::arg("time_budget"), py::arg("seed"), py::call_guard<py::gil_scoped_release>());
 
   m.def("_register_strategy", &register_python_strategy, py::arg("name"), py::arg("cls"), py::arg("help"),
-        py::arg("joint"));
+        py::arg("joint"), py::arg("with_context"));
+
+  py::class_<AssignmentContext>(m, "AssignmentContext",
+                                "What a Python strategy's assign gets as its optional fifth argument; valid only "
+                                "while assign runs.")
+      .def_property_readonly("team_indices", &AssignmentContext::team_indices,
+                             "(R,) each robot's place in the team, 0..team_size-1 (the rows of poses and costs)")
+      .def_property_readonly("team_size", &AssignmentContext::team_size, "robots in the team")
+      .def_property_readonly("sensor_range", &AssignmentContext::sensor_range,
+                             "the range sensor's reach, metres (targets this close to a claimed goal see less new)")
+      .def_property_readonly("beta", &AssignmentContext::beta,
+                             "weight of travel cost against utility (scenario exploration.beta; Burgard et al. 2005)")
+      .def_property_readonly("directional_weight", &AssignmentContext::directional_weight,
+                             "scenario exploration.directional_weight")
+      .def("target_costs", &AssignmentContext::target_costs,
+           "(T, T) wave costs between the targets' goals, metres (inf: not connected); computed when called")
+      .def("target_gains", &AssignmentContext::target_gains,
+           "(T,) never-observed area each target would reveal, square metres; computed when called");
 }
