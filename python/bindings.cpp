@@ -272,8 +272,10 @@ void register_python_strategy(const std::string& name, const py::object& cls, co
 PYBIND11_MODULE(_fleetmap, m) {
   m.doc() = "fleetmap's C++ core; use the package `fleetmap`, which wraps it.";
   // pybind11 tries the most recently registered translator first: InputError (an Error) goes last.
-  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
-  py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  py::register_exception<Error>(m, "Error", PyExc_RuntimeError).doc() =
+      "A failure inside fleetmap other than bad input (a RuntimeError).";
+  py::register_exception<InputError>(m, "InputError", PyExc_ValueError).doc() =
+      "Bad input (a ValueError): a scenario key, a map file, a name; the message names it.";
 
   py::class_<mapping::OccupancyGrid>(m, "Map", "An occupancy grid map.")
       .def_static(
@@ -282,15 +284,25 @@ PYBIND11_MODULE(_fleetmap, m) {
              std::tuple<double, double, double> origin) {
             return grid_from_array(image, resolution, {std::get<0>(origin), std::get<1>(origin), std::get<2>(origin)});
           },
-          py::arg("image"), py::arg("resolution") = 0.05, py::arg("origin") = std::make_tuple(0.0, 0.0, 0.0))
-      .def_property_readonly("image", &grid_image)
-      .def_property_readonly("width", &mapping::OccupancyGrid::width)
-      .def_property_readonly("height", &mapping::OccupancyGrid::height)
-      .def_property_readonly("resolution", &mapping::OccupancyGrid::resolution)
-      .def_property_readonly("origin", [](const mapping::OccupancyGrid& g) { return pose_tuple(g.geometry().origin()); })
-      .def_property_readonly("free_cells", [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Free); })
-      .def_property_readonly("occupied_cells",
-                             [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Occupied); })
+          py::arg("image"), py::arg("resolution") = 0.05, py::arg("origin") = std::make_tuple(0.0, 0.0, 0.0),
+          "A map from a uint8 (rows, columns) image, top row first, read with map_server's rules: dark (0) "
+          "occupied, light (254) free, mid-grey (205) unknown. `origin`: the pose (x, y, theta) of the lower-left "
+          "corner in metres.")
+      .def_property_readonly("image", &grid_image,
+                             "The map_saver image: uint8 (height, width), top row first, 254 free, 0 occupied, "
+                             "205 unknown.")
+      .def_property_readonly("width", &mapping::OccupancyGrid::width, "Cells along x.")
+      .def_property_readonly("height", &mapping::OccupancyGrid::height, "Cells along y.")
+      .def_property_readonly("resolution", &mapping::OccupancyGrid::resolution, "Metres per cell.")
+      .def_property_readonly(
+          "origin", [](const mapping::OccupancyGrid& g) { return pose_tuple(g.geometry().origin()); },
+          "The pose (x, y, theta) of the lower-left corner, metres and radians.")
+      .def_property_readonly(
+          "free_cells", [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Free); },
+          "How many cells are free.")
+      .def_property_readonly(
+          "occupied_cells", [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Occupied); },
+          "How many cells are occupied.")
       .def(
           "save",
           [](const mapping::OccupancyGrid& g, const std::string& file) {
@@ -299,7 +311,7 @@ PYBIND11_MODULE(_fleetmap, m) {
             if (ext == ".yaml" || ext == ".yml") io::save_map_yaml(g, path);
             else io::save_map_image(g, path);
           },
-          py::arg("path"))
+          py::arg("path"), ".yaml / .yml: map_server YAML and a .pgm beside it; .png / .pgm: the image alone.")
       .def("__repr__", [](const mapping::OccupancyGrid& g) {
         return "<fleetmap.Map " + std::to_string(g.width()) + " x " + std::to_string(g.height()) + " cells of " +
                std::to_string(g.resolution()) + " m>";
@@ -312,15 +324,18 @@ PYBIND11_MODULE(_fleetmap, m) {
         load.default_resolution = resolution;
         return maps::load_map_source(source, load);
       },
-      py::arg("source"), py::arg("resolution") = 0.05);
+      py::arg("source"), py::arg("resolution") = 0.05,
+      "A built-in map by name (map_names()) or a PNG / PGM / map_server YAML file; `resolution` (metres per "
+      "cell) is for a bare image, a YAML has its own. Raises InputError naming the file or name.");
   m.def("map_names", [] {
     std::vector<std::string> names;
     for (const auto& info : maps::builtin_maps()) names.push_back(info.name);
     return names;
-  });
-  m.def("strategy_names", &exploration::strategy_names);
-  m.def("planner_names", &planning::planner_names);
-  m.def("merge_method_names", &merging::merge_method_names);
+  }, "The built-in maps' names (load_map, scenario key `map`).");
+  m.def("strategy_names", &exploration::strategy_names,
+        "Every coordination strategy's name, the built-in ones and those registered (scenario exploration.strategy).");
+  m.def("planner_names", &planning::planner_names, "Every path planner's name (plan_path's `planner`).");
+  m.def("merge_method_names", &merging::merge_method_names, "Every merge method's name (merge_maps's `method`).");
 
   py::class_<Run>(m, "Run")
       .def_property_readonly("label", [](const Run& r) { return r.label; })
@@ -354,14 +369,19 @@ PYBIND11_MODULE(_fleetmap, m) {
         py::call_guard<py::gil_scoped_release>());
 
   py::class_<merging::MergeResult>(m, "MergeResult", "Map b aligned to map a.")
-      .def_readonly("merged", &merging::MergeResult::merged)
-      .def_readonly("confidence", &merging::MergeResult::confidence)
-      .def_readonly("acceptance", &merging::MergeResult::acceptance)
-      .def_readonly("method", &merging::MergeResult::method)
-      .def_readonly("reason", &merging::MergeResult::reason)
-      .def_property_readonly("transform", [](const merging::MergeResult& r) {
-        return py::make_tuple(r.transform.translation().x(), r.transform.translation().y(), r.transform.rotation());
-      })
+      .def_readonly("merged", &merging::MergeResult::merged, "Whether the confidence reached min_confidence.")
+      .def_readonly("confidence", &merging::MergeResult::confidence, "In [0, 1].")
+      .def_readonly("acceptance", &merging::MergeResult::acceptance,
+                    "The share of cells known in both maps that agree at `transform` (Birk & Carpin 2006's omega).")
+      .def_readonly("method", &merging::MergeResult::method, "The method whose candidate won; empty when none.")
+      .def_readonly("reason", &merging::MergeResult::reason, "Why not merged; empty when merged.")
+      .def_property_readonly(
+          "transform",
+          [](const merging::MergeResult& r) {
+            return py::make_tuple(r.transform.translation().x(), r.transform.translation().y(),
+                                  r.transform.rotation());
+          },
+          "(tx, ty, theta): b's cells into a's cells, a = R(theta) b + t (the best candidate even when not merged).")
       .def("__repr__", [](const merging::MergeResult& r) {
         return std::string("<fleetmap.MergeResult ") + (r.merged ? "merged" : "not merged") +
                ", confidence " + std::to_string(r.confidence) + ">";
@@ -380,12 +400,16 @@ PYBIND11_MODULE(_fleetmap, m) {
       py::call_guard<py::gil_scoped_release>());
 
   py::class_<planning::PlanResult>(m, "PlanResult", "A planned path.")
-      .def_property_readonly("success", &planning::PlanResult::success)
-      .def_property_readonly("status", [](const planning::PlanResult& r) { return std::string(planning::to_string(r.status)); })
-      .def_readonly("planner", &planning::PlanResult::planner)
-      .def_readonly("length_m", &planning::PlanResult::length_m)
-      .def_readonly("detail", &planning::PlanResult::detail)
-      .def_property_readonly("path", [](const planning::PlanResult& r) { return point_rows(r.path); })
+      .def_property_readonly("success", &planning::PlanResult::success, "Whether there is a path.")
+      .def_property_readonly(
+          "status", [](const planning::PlanResult& r) { return std::string(planning::to_string(r.status)); },
+          "Why there is a path or none (e.g. 'success', 'goal in obstacle', 'no path within budget').")
+      .def_readonly("planner", &planning::PlanResult::planner, "The planner that made it.")
+      .def_readonly("length_m", &planning::PlanResult::length_m, "The path's length in metres (0 without a path).")
+      .def_readonly("detail", &planning::PlanResult::detail, "More about the status, or empty.")
+      .def_property_readonly(
+          "path", [](const planning::PlanResult& r) { return point_rows(r.path); },
+          "(N, 2) waypoints in metres from the start to the goal; empty unless success.")
       .def("__repr__", [](const planning::PlanResult& r) {
         return "<fleetmap.PlanResult " + std::string(planning::to_string(r.status)) + ", " + std::to_string(r.length_m) + " m>";
       });

@@ -21,9 +21,16 @@ import os
 from pathlib import Path
 from typing import Any, Mapping, Optional, Sequence, Union
 
-import numpy as np
+try:
+    import numpy as np
 
-from . import _fleetmap
+    from . import _fleetmap
+except ImportError as error:  # another python than the one it was built for, or no numpy
+    import sys
+
+    from ._built_for import PYTHON, VERSION
+    raise ImportError(f"fleetmap was built for {PYTHON} (Python {VERSION}, with numpy); this is {sys.executable} "
+                      f"(Python {sys.version_info.major}.{sys.version_info.minor}): {error}") from error
 from ._fleetmap import (  # noqa: F401  (re-exported)
     AssignmentContext,
     Error,
@@ -110,10 +117,12 @@ class ExplorationResult:
 
     @property
     def merged_map(self) -> Map:
+        """The merged map at the end of the run."""
         return self._run.merged_map
 
     @property
     def robot_maps(self) -> list:
+        """Each robot's own map (a Map, in its own frame)."""
         return self._run.robot_maps
 
     def save(self, folder: PathLike) -> list:
