@@ -39,7 +39,9 @@ run("configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/
     -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_PREFIX_PATH=${prefix} ${launcher})
 run("build the consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/consumer-build)
 file(REMOVE_RECURSE ${WORK_DIR}/run)
-run("run the consumer" ${WORK_DIR}/consumer-build/consumer ${WORK_DIR}/run)
+# The built-in maps from the prefix (fleetmap_MAPS_DIR), as a program finds them without the source tree.
+run("run the consumer" ${CMAKE_COMMAND} -E env FLEETMAP_MAPS_DIR=${prefix}/share/fleetmap/maps
+    ${WORK_DIR}/consumer-build/consumer ${WORK_DIR}/run)
 
 # The Python package from the prefix: it imports from there and finds the installed maps.
 if(PYTHON)
