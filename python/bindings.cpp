@@ -115,7 +115,9 @@ std::vector<std::string> run_sweep(const std::string& yaml, const std::string& s
   const auto runs = sweep::sweep_runs(spec);
   std::vector<sweep::RunRecord> records;
   std::mutex mutex;
-  sweep::run_sweep(spec, runs, truths, {jobs}, [&](const sweep::RunRecord& r) {
+  sweep::SweepRunOptions run_options;
+  run_options.jobs = jobs;
+  sweep::run_sweep(spec, runs, truths, run_options, [&](const sweep::RunRecord& r) {
     const std::lock_guard<std::mutex> lock(mutex);
     records.push_back(r);
   });
