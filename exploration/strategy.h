@@ -45,6 +45,7 @@ struct AssignmentRobot {
   int team_index = 0;  // this robot's place in the team, 0..team_size-1
   int team_size = 1;
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+  double heading_rad = 0.0;    // where the robot faces, in (-pi, pi], counter-clockwise from +x
   std::vector<double> cost_m;  // wave cost to each target's goal, metres; +inf when unreachable
 };
 

@@ -474,6 +474,7 @@ void TeamExplorer::assign_group(const std::vector<int>& members, int leader, con
     ar.team_index = i;
     ar.team_size = int(robots_.size());
     ar.position_m = robots[std::size_t(i)].pose.position();
+    ar.heading_rad = robots[std::size_t(i)].pose.theta;
     ar.cost_m.resize(targets.size());
     for (std::size_t t = 0; t < targets.size(); ++t) {
       ar.cost_m[t] = usable_by(k, targets[t].frontier, targets[t].goal, targets[t].kind)

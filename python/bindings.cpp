@@ -115,7 +115,9 @@ std::vector<std::string> run_sweep(const std::string& yaml, const std::string& s
   const auto runs = sweep::sweep_runs(spec);
   std::vector<sweep::RunRecord> records;
   std::mutex mutex;
-  sweep::run_sweep(spec, runs, truths, {jobs}, [&](const sweep::RunRecord& r) {
+  sweep::SweepRunOptions run_options;
+  run_options.jobs = jobs;
+  sweep::run_sweep(spec, runs, truths, run_options, [&](const sweep::RunRecord& r) {
     const std::lock_guard<std::mutex> lock(mutex);
     records.push_back(r);
   });
@@ -125,14 +127,70 @@ std::vector<std::string> run_sweep(const std::string& yaml, const std::string& s
   return lines;
 }
 
+// What a Python strategy gets besides the arrays (its assign's optional fifth argument): the
+// robots' places in the team, the strategy options, and the lazily computed target-to-target wave
+// costs and unknown areas, which exist only while assign runs.
+class AssignmentContext {
+ public:
+  AssignmentContext(const exploration::AssignmentInput& input, const exploration::StrategyOptions& options)
+      : input_(&input), options_(options) {}
+  void close() { input_ = nullptr; }
+
+  py::array_t<int> team_indices() const {
+    const auto& robots = live().robots;
+    py::array_t<int> out(py::ssize_t(robots.size()));
+    for (std::size_t r = 0; r < robots.size(); ++r) out.mutable_at(py::ssize_t(r)) = robots[r].team_index;
+    return out;
+  }
+  int team_size() const { return live().robots.empty() ? 0 : live().robots.front().team_size; }
+  double sensor_range() const { return live().sensor_range_m; }
+  double beta() const { return options_.beta; }
+  double directional_weight() const { return options_.directional_weight; }
+  py::array_t<double> target_costs() const {
+    const auto& input = live();
+    Eigen::MatrixXd costs;
+    {
+      py::gil_scoped_release release;  // wave fronts from every goal: let other runs' strategies go on
+      costs = exploration::target_costs(input);
+    }
+    const auto n = py::ssize_t(costs.rows());
+    py::array_t<double> out({n, n});
+    auto o = out.mutable_unchecked<2>();
+    for (py::ssize_t a = 0; a < n; ++a)
+      for (py::ssize_t b = 0; b < n; ++b) o(a, b) = costs(a, b);
+    return out;
+  }
+  py::array_t<double> target_gains() const {
+    const auto& input = live();
+    std::vector<double> gains;
+    if (input.target_gains_m2) {
+      py::gil_scoped_release release;
+      gains = input.target_gains_m2();
+    } else {
+      gains.assign(input.targets.size(), 1.0);
+    }
+    return py::array_t<double>(py::ssize_t(gains.size()), gains.data());
+  }
+
+ private:
+  const exploration::AssignmentInput& live() const {
+    if (!input_) throw Error("the assignment context is valid only while assign runs");
+    return *input_;
+  }
+  const exploration::AssignmentInput* input_;
+  exploration::StrategyOptions options_;
+};
+
 // A coordination strategy whose assign() is a Python object's method:
-//   assign(positions (R, 2), targets (T, 4): goal x, goal y, frontier cells, region,
-//          costs (R, T) wave metres (inf: unreachable), claimed (K, 2)) -> R target indices or -1.
+//   assign(poses (R, 3): x, y, heading, targets (T, 4): goal x, goal y, frontier cells, region,
+//          costs (R, T) wave metres (inf: unreachable), claimed (K, 2)[, context]) -> R target indices or -1.
 // Simulations run with the GIL released (sweeps on several threads); each call takes it.
 class PythonStrategy final : public exploration::CoordinationStrategy {
  public:
-  PythonStrategy(std::string name, bool joint, py::object instance)
-      : name_(std::move(name)), joint_(joint), instance_(std::move(instance)) {}
+  PythonStrategy(std::string name, bool joint, bool with_context, py::object instance,
+                 const exploration::StrategyOptions& options)
+      : name_(std::move(name)), joint_(joint), with_context_(with_context), instance_(std::move(instance)),
+        options_(options) {}
   ~PythonStrategy() override {
     py::gil_scoped_acquire gil;
     instance_ = py::object();
@@ -143,8 +201,8 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
   std::vector<int> assign(const exploration::AssignmentInput& input) const override {
     py::gil_scoped_acquire gil;
     const auto robots = py::ssize_t(input.robots.size()), targets = py::ssize_t(input.targets.size());
-    std::vector<Eigen::Vector2d> positions;
-    for (const auto& r : input.robots) positions.push_back(r.position_m);
+    std::vector<core::Pose2> poses;
+    for (const auto& r : input.robots) poses.emplace_back(r.position_m.x(), r.position_m.y(), r.heading_rad);
     py::array_t<double> target_rows({targets, py::ssize_t(4)});
     auto t = target_rows.mutable_unchecked<2>();
     for (py::ssize_t k = 0; k < targets; ++k) {
@@ -157,9 +215,17 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
       for (py::ssize_t k = 0; k < targets; ++k) c(r, k) = input.robots[std::size_t(r)].cost_m[std::size_t(k)];
     }
     std::vector<int> out;
+    // The context dies with this call even when Python keeps a reference to it.
+    py::object context = py::cast(AssignmentContext(input, options_));
+    struct Close {
+      py::object& context;
+      ~Close() { context.cast<AssignmentContext&>().close(); }
+    } close{context};
     try {
-      const py::object answer =
-          instance_.attr("assign")(point_rows(positions), target_rows, costs, point_rows(input.claimed));
+      const py::object assign = instance_.attr("assign");
+      const py::object answer = with_context_
+                                    ? assign(pose_rows(poses), target_rows, costs, point_rows(input.claimed), context)
+                                    : assign(pose_rows(poses), target_rows, costs, point_rows(input.claimed));
       for (const auto& item : answer) out.push_back(item.cast<int>());
     } catch (const py::error_already_set& e) {
       throw Error("strategy '" + name_ + "': assign raised " + std::string(e.what()));
@@ -182,20 +248,24 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
  private:
   std::string name_;
   bool joint_;
+  bool with_context_;
   py::object instance_;
+  exploration::StrategyOptions options_;
 };
 
-void register_python_strategy(const std::string& name, const py::object& cls, const std::string& help, bool joint) {
+void register_python_strategy(const std::string& name, const py::object& cls, const std::string& help, bool joint,
+                              bool with_context) {
   if (!py::hasattr(cls, "assign")) throw InputError("register_strategy '" + name + "': the class has no assign method");
   // The registry keeps its factories for the life of the process, beyond the interpreter's; the
   // class is held by a reference that is never released, so no Python object dies without it.
   PyObject* held = cls.ptr();
   Py_INCREF(held);
   exploration::register_strategy(name, help.empty() ? "written in Python" : help,
-                                 [name, held, joint](const exploration::StrategyOptions&) {
+                                 [name, held, joint, with_context](const exploration::StrategyOptions& options) {
                                    py::gil_scoped_acquire gil;
                                    py::object instance = py::reinterpret_borrow<py::object>(held)();
-                                   return std::make_unique<PythonStrategy>(name, joint, std::move(instance));
+                                   return std::make_unique<PythonStrategy>(name, joint, with_context,
+                                                                           std::move(instance), options);
                                  });
 }
 
@@ -204,8 +274,10 @@ void register_python_strategy(const std::string& name, const py::object& cls, co
 PYBIND11_MODULE(_fleetmap, m) {
   m.doc() = "fleetmap's C++ core; use the package `fleetmap`, which wraps it.";
   // pybind11 tries the most recently registered translator first: InputError (an Error) goes last.
-  py::register_exception<Error>(m, "Error", PyExc_RuntimeError);
-  py::register_exception<InputError>(m, "InputError", PyExc_ValueError);
+  py::register_exception<Error>(m, "Error", PyExc_RuntimeError).doc() =
+      "A failure inside fleetmap other than bad input (a RuntimeError).";
+  py::register_exception<InputError>(m, "InputError", PyExc_ValueError).doc() =
+      "Bad input (a ValueError): a scenario key, a map file, a name; the message names it.";
 
   py::class_<mapping::OccupancyGrid>(m, "Map", "An occupancy grid map.")
       .def_static(
@@ -214,15 +286,25 @@ PYBIND11_MODULE(_fleetmap, m) {
              std::tuple<double, double, double> origin) {
             return grid_from_array(image, resolution, {std::get<0>(origin), std::get<1>(origin), std::get<2>(origin)});
           },
-          py::arg("image"), py::arg("resolution") = 0.05, py::arg("origin") = std::make_tuple(0.0, 0.0, 0.0))
-      .def_property_readonly("image", &grid_image)
-      .def_property_readonly("width", &mapping::OccupancyGrid::width)
-      .def_property_readonly("height", &mapping::OccupancyGrid::height)
-      .def_property_readonly("resolution", &mapping::OccupancyGrid::resolution)
-      .def_property_readonly("origin", [](const mapping::OccupancyGrid& g) { return pose_tuple(g.geometry().origin()); })
-      .def_property_readonly("free_cells", [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Free); })
-      .def_property_readonly("occupied_cells",
-                             [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Occupied); })
+          py::arg("image"), py::arg("resolution") = 0.05, py::arg("origin") = std::make_tuple(0.0, 0.0, 0.0),
+          "A map from a uint8 (rows, columns) image, top row first, read with map_server's rules: dark (0) "
+          "occupied, light (254) free, mid-grey (205) unknown. `origin`: the pose (x, y, theta) of the lower-left "
+          "corner in metres.")
+      .def_property_readonly("image", &grid_image,
+                             "The map_saver image: uint8 (height, width), top row first, 254 free, 0 occupied, "
+                             "205 unknown.")
+      .def_property_readonly("width", &mapping::OccupancyGrid::width, "Cells along x.")
+      .def_property_readonly("height", &mapping::OccupancyGrid::height, "Cells along y.")
+      .def_property_readonly("resolution", &mapping::OccupancyGrid::resolution, "Metres per cell.")
+      .def_property_readonly(
+          "origin", [](const mapping::OccupancyGrid& g) { return pose_tuple(g.geometry().origin()); },
+          "The pose (x, y, theta) of the lower-left corner, metres and radians.")
+      .def_property_readonly(
+          "free_cells", [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Free); },
+          "How many cells are free.")
+      .def_property_readonly(
+          "occupied_cells", [](const mapping::OccupancyGrid& g) { return g.count(mapping::CellState::Occupied); },
+          "How many cells are occupied.")
       .def(
           "save",
           [](const mapping::OccupancyGrid& g, const std::string& file) {
@@ -231,7 +313,7 @@ PYBIND11_MODULE(_fleetmap, m) {
             if (ext == ".yaml" || ext == ".yml") io::save_map_yaml(g, path);
             else io::save_map_image(g, path);
           },
-          py::arg("path"))
+          py::arg("path"), ".yaml / .yml: map_server YAML and a .pgm beside it; .png / .pgm: the image alone.")
       .def("__repr__", [](const mapping::OccupancyGrid& g) {
         return "<fleetmap.Map " + std::to_string(g.width()) + " x " + std::to_string(g.height()) + " cells of " +
                std::to_string(g.resolution()) + " m>";
@@ -244,15 +326,18 @@ PYBIND11_MODULE(_fleetmap, m) {
         load.default_resolution = resolution;
         return maps::load_map_source(source, load);
       },
-      py::arg("source"), py::arg("resolution") = 0.05);
+      py::arg("source"), py::arg("resolution") = 0.05,
+      "A built-in map by name (map_names()) or a PNG / PGM / map_server YAML file; `resolution` (metres per "
+      "cell) is for a bare image, a YAML has its own. Raises InputError naming the file or name.");
   m.def("map_names", [] {
     std::vector<std::string> names;
     for (const auto& info : maps::builtin_maps()) names.push_back(info.name);
     return names;
-  });
-  m.def("strategy_names", &exploration::strategy_names);
-  m.def("planner_names", &planning::planner_names);
-  m.def("merge_method_names", &merging::merge_method_names);
+  }, "The built-in maps' names (load_map, scenario key `map`).");
+  m.def("strategy_names", &exploration::strategy_names,
+        "Every coordination strategy's name, the built-in ones and those registered (scenario exploration.strategy).");
+  m.def("planner_names", &planning::planner_names, "Every path planner's name (plan_path's `planner`).");
+  m.def("merge_method_names", &merging::merge_method_names, "Every merge method's name (merge_maps's `method`).");
 
   py::class_<Run>(m, "Run")
       .def_property_readonly("label", [](const Run& r) { return r.label; })
@@ -286,14 +371,19 @@ PYBIND11_MODULE(_fleetmap, m) {
         py::call_guard<py::gil_scoped_release>());
 
   py::class_<merging::MergeResult>(m, "MergeResult", "Map b aligned to map a.")
-      .def_readonly("merged", &merging::MergeResult::merged)
-      .def_readonly("confidence", &merging::MergeResult::confidence)
-      .def_readonly("acceptance", &merging::MergeResult::acceptance)
-      .def_readonly("method", &merging::MergeResult::method)
-      .def_readonly("reason", &merging::MergeResult::reason)
-      .def_property_readonly("transform", [](const merging::MergeResult& r) {
-        return py::make_tuple(r.transform.translation().x(), r.transform.translation().y(), r.transform.rotation());
-      })
+      .def_readonly("merged", &merging::MergeResult::merged, "Whether the confidence reached min_confidence.")
+      .def_readonly("confidence", &merging::MergeResult::confidence, "In [0, 1].")
+      .def_readonly("acceptance", &merging::MergeResult::acceptance,
+                    "The share of cells known in both maps that agree at `transform` (Birk & Carpin 2006's omega).")
+      .def_readonly("method", &merging::MergeResult::method, "The method whose candidate won; empty when none.")
+      .def_readonly("reason", &merging::MergeResult::reason, "Why not merged; empty when merged.")
+      .def_property_readonly(
+          "transform",
+          [](const merging::MergeResult& r) {
+            return py::make_tuple(r.transform.translation().x(), r.transform.translation().y(),
+                                  r.transform.rotation());
+          },
+          "(tx, ty, theta): b's cells into a's cells, a = R(theta) b + t (the best candidate even when not merged).")
       .def("__repr__", [](const merging::MergeResult& r) {
         return std::string("<fleetmap.MergeResult ") + (r.merged ? "merged" : "not merged") +
                ", confidence " + std::to_string(r.confidence) + ">";
@@ -312,12 +402,16 @@ PYBIND11_MODULE(_fleetmap, m) {
       py::call_guard<py::gil_scoped_release>());
 
   py::class_<planning::PlanResult>(m, "PlanResult", "A planned path.")
-      .def_property_readonly("success", &planning::PlanResult::success)
-      .def_property_readonly("status", [](const planning::PlanResult& r) { return std::string(planning::to_string(r.status)); })
-      .def_readonly("planner", &planning::PlanResult::planner)
-      .def_readonly("length_m", &planning::PlanResult::length_m)
-      .def_readonly("detail", &planning::PlanResult::detail)
-      .def_property_readonly("path", [](const planning::PlanResult& r) { return point_rows(r.path); })
+      .def_property_readonly("success", &planning::PlanResult::success, "Whether there is a path.")
+      .def_property_readonly(
+          "status", [](const planning::PlanResult& r) { return std::string(planning::to_string(r.status)); },
+          "Why there is a path or none (e.g. 'success', 'goal in obstacle', 'no path within budget').")
+      .def_readonly("planner", &planning::PlanResult::planner, "The planner that made it.")
+      .def_readonly("length_m", &planning::PlanResult::length_m, "The path's length in metres (0 without a path).")
+      .def_readonly("detail", &planning::PlanResult::detail, "More about the status, or empty.")
+      .def_property_readonly(
+          "path", [](const planning::PlanResult& r) { return point_rows(r.path); },
+          "(N, 2) waypoints in metres from the start to the goal; empty unless success.")
       .def("__repr__", [](const planning::PlanResult& r) {
         return "<fleetmap.PlanResult " + std::string(planning::to_string(r.status)) + ", " + std::to_string(r.length_m) + " m>";
       });
@@ -338,5 +432,22 @@ PYBIND11_MODULE(_fleetmap, m) {
       py::arg("time_budget"), py::arg("seed"), py::call_guard<py::gil_scoped_release>());
 
   m.def("_register_strategy", &register_python_strategy, py::arg("name"), py::arg("cls"), py::arg("help"),
-        py::arg("joint"));
+        py::arg("joint"), py::arg("with_context"));
+
+  py::class_<AssignmentContext>(m, "AssignmentContext",
+                                "What a Python strategy's assign gets as its optional fifth argument; valid only "
+                                "while assign runs.")
+      .def_property_readonly("team_indices", &AssignmentContext::team_indices,
+                             "(R,) each robot's place in the team, 0..team_size-1 (the rows of poses and costs)")
+      .def_property_readonly("team_size", &AssignmentContext::team_size, "robots in the team")
+      .def_property_readonly("sensor_range", &AssignmentContext::sensor_range,
+                             "the range sensor's reach, metres (targets this close to a claimed goal see less new)")
+      .def_property_readonly("beta", &AssignmentContext::beta,
+                             "weight of travel cost against utility (scenario exploration.beta; Burgard et al. 2005)")
+      .def_property_readonly("directional_weight", &AssignmentContext::directional_weight,
+                             "scenario exploration.directional_weight")
+      .def("target_costs", &AssignmentContext::target_costs,
+           "(T, T) wave costs between the targets' goals, metres (inf: not connected); computed when called")
+      .def("target_gains", &AssignmentContext::target_gains,
+           "(T,) never-observed area each target would reveal, square metres; computed when called");
 }

@@ -257,6 +257,10 @@ std::vector<std::string> run_output_files(const Scenario& scenario) {
   return names;
 }
 
+std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& map_label, const fs::path& dir) {
+  return write_run_outputs(r, map_label, dir, viz::Overlays{});
+}
+
 std::vector<fs::path> write_run_outputs(const RunResult& r, const std::string& map_label, const fs::path& dir,
                                         const viz::Overlays& extra) {
   io::ensure_directory(dir);

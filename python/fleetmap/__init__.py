@@ -13,6 +13,7 @@ built-in ones.
 from __future__ import annotations
 
 import csv
+import inspect
 import io
 import json
 import math
@@ -20,10 +21,18 @@ import os
 from pathlib import Path
 from typing import Any, Mapping, Optional, Sequence, Union
 
-import numpy as np
+try:
+    import numpy as np
 
-from . import _fleetmap
+    from . import _fleetmap
+except ImportError as error:  # another python than the one it was built for, or no numpy
+    import sys
+
+    from ._built_for import PYTHON, VERSION
+    raise ImportError(f"fleetmap was built for {PYTHON} (Python {VERSION}, with numpy); this is {sys.executable} "
+                      f"(Python {sys.version_info.major}.{sys.version_info.minor}): {error}") from error
 from ._fleetmap import (  # noqa: F401  (re-exported)
+    AssignmentContext,
     Error,
     InputError,
     Map,
@@ -37,7 +46,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
 )
 
 __all__ = [
-    "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
+    "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
     "explore", "sweep", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
     "map_names", "strategy_names", "planner_names", "merge_method_names",
 ]
@@ -108,10 +117,12 @@ class ExplorationResult:
 
     @property
     def merged_map(self) -> Map:
+        """The merged map at the end of the run."""
         return self._run.merged_map
 
     @property
     def robot_maps(self) -> list:
+        """Each robot's own map (a Map, in its own frame)."""
         return self._run.robot_maps
 
     def save(self, folder: PathLike) -> list:
@@ -191,16 +202,44 @@ def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: 
                                 planner, float(robot_radius), float(time_budget), int(seed))
 
 
+def _takes_context(name: str, cls: Any) -> bool:
+    """Whether cls's assign takes the optional context after its four arrays."""
+    assign = cls.assign
+    try:
+        parameters = list(inspect.signature(assign).parameters.values())
+    except (TypeError, ValueError):  # no signature to read: the four arrays only
+        return False
+    if any(p.kind == p.VAR_POSITIONAL for p in parameters):
+        return True
+    positional = [p for p in parameters if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    # A plain method read from the class still lists self.
+    if inspect.isfunction(assign) and not isinstance(inspect.getattr_static(cls, "assign"), staticmethod):
+        positional = positional[1:]
+    required = [p for p in positional if p.default is p.empty]
+    if len(required) > 5 or len(positional) < 4:
+        raise InputError(f"register_strategy '{name}': assign must take (poses, targets, costs, claimed"
+                         f"[, context]); it takes {len(positional)} arguments besides self")
+    return len(positional) >= 5
+
+
 def register_strategy(name: str, cls: type, help: str = "", joint: bool = True) -> None:
     """Registers a coordination strategy written in Python under `name`.
 
     `cls` is a class (or any callable) that makes one strategy object per run. Its method
-        assign(positions, targets, costs, claimed) -> sequence of ints
-    gets the robots to assign now as an (R, 2) array of positions (m), the frontier targets as a
+        assign(poses, targets, costs, claimed[, context]) -> sequence of ints
+    gets the robots to assign now as an (R, 3) array of poses (x, y in metres, heading in radians
+    in (-pi, pi], counter-clockwise from +x, as the robot believes it), the frontier targets as a
     (T, 4) array (goal x, goal y, frontier cells in the piece, frontier region index), the wave
     costs (R, T) in metres (inf: unreachable) and the goals other robots already drive to (K, 2);
-    it returns, per robot, a target index or -1 for none. With `joint`, every robot that can talk
-    is reassigned together; otherwise only the robot that needs a target. Scenarios and sweeps then
-    use `name` like a built-in strategy.
+    it returns, per robot, a target index or -1 for none. When assign takes a fifth argument it
+    also gets an AssignmentContext: each robot's team index and the team size, the sensor range,
+    the strategy options (beta, directional_weight), and, computed when called, the wave costs
+    between the targets (target_costs(), T x T) and the unknown area behind each target
+    (target_gains(), square metres) - what the built-in C++ strategies use. The context is valid
+    only during the call. With `joint`, every robot that can talk is reassigned together;
+    otherwise only the robot that needs a target. Scenarios and sweeps then use `name` like a
+    built-in strategy.
     """
-    _fleetmap._register_strategy(name, cls, help, bool(joint))
+    if not hasattr(cls, "assign"):
+        raise InputError(f"register_strategy '{name}': the class has no assign method")
+    _fleetmap._register_strategy(name, cls, help, bool(joint), _takes_context(name, cls))

@@ -76,10 +76,40 @@ class ExplorationResult:
     def robot_maps(self) -> list[Map]: ...
     def save(self, folder: PathLike) -> list[str]: ...
 
+class AssignmentContext:
+    """A strategy's optional fifth assign argument; valid only while assign runs."""
+    @property
+    def team_indices(self) -> npt.NDArray[np.int32]:
+        """(R,) each robot's place in the team, 0..team_size-1 (the rows of poses and costs)."""
+    @property
+    def team_size(self) -> int: ...
+    @property
+    def sensor_range(self) -> float:
+        """The range sensor's reach, metres."""
+    @property
+    def beta(self) -> float:
+        """Weight of travel cost against utility (scenario exploration.beta)."""
+    @property
+    def directional_weight(self) -> float: ...
+    def target_costs(self) -> npt.NDArray[np.float64]:
+        """(T, T) wave costs between the targets' goals, metres (inf: not connected)."""
+    def target_gains(self) -> npt.NDArray[np.float64]:
+        """(T,) never-observed area each target would reveal, square metres."""
+
 class Strategy(Protocol):
-    """What register_strategy expects of the objects its class makes."""
-    def assign(self, positions: npt.NDArray[np.float64], targets: npt.NDArray[np.float64],
+    """What register_strategy expects of the objects its class makes. `poses` (R, 3): x, y in
+    metres and heading in radians, (-pi, pi]; `targets` (T, 4): goal x, goal y, frontier cells,
+    region; `costs` (R, T) wave metres, inf when unreachable; `claimed` (K, 2) goals teammates drive
+    to. Returns a target index or -1 per robot. An assign that takes a fifth parameter also gets
+    an AssignmentContext."""
+    def assign(self, poses: npt.NDArray[np.float64], targets: npt.NDArray[np.float64],
                costs: npt.NDArray[np.float64], claimed: npt.NDArray[np.float64]) -> Sequence[int]: ...
+
+class StrategyWithContext(Protocol):
+    """A Strategy whose assign takes the AssignmentContext too."""
+    def assign(self, poses: npt.NDArray[np.float64], targets: npt.NDArray[np.float64],
+               costs: npt.NDArray[np.float64], claimed: npt.NDArray[np.float64],
+               context: AssignmentContext) -> Sequence[int]: ...
 
 def explore(scenario: Union[None, Mapping[str, Any], PathLike] = None, **keys: Any) -> ExplorationResult: ...
 def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, **keys: Any) -> list[dict[str, Any]]: ...

@@ -12,9 +12,9 @@ class CheapestFree:
 
     calls = 0
 
-    def assign(self, positions, targets, costs, claimed):
+    def assign(self, poses, targets, costs, claimed):
         CheapestFree.calls += 1
-        assert positions.shape == (costs.shape[0], 2) and targets.shape == (costs.shape[1], 4)
+        assert poses.shape == (costs.shape[0], 3) and targets.shape == (costs.shape[1], 4)
         assert claimed.ndim == 2 and claimed.shape[1] == 2
         out, taken = [], set()
         for r in range(costs.shape[0]):
@@ -27,12 +27,29 @@ class CheapestFree:
 
 
 class WrongLength:
-    def assign(self, positions, targets, costs, claimed):
-        return [0] * (len(positions) + 1)
+    def assign(self, poses, targets, costs, claimed):
+        return [0] * (len(poses) + 1)
+
+
+class Recorder:
+    """Takes the first reachable target; keeps what every call got (poses and the context)."""
+
+    calls = []
+    kept_context = None
+
+    def assign(self, poses, targets, costs, claimed, context):
+        gains = context.target_gains()
+        between = context.target_costs()
+        Recorder.calls.append((poses.copy(), context.team_indices.copy(), context.team_size, context.sensor_range,
+                               context.beta, targets.shape[0], between, gains))
+        Recorder.kept_context = context
+        return [next((t for t in range(costs.shape[1]) if math.isfinite(costs[r, t])), -1)
+                for r in range(costs.shape[0])]
 
 
 fleetmap.register_strategy("py-cheapest", CheapestFree, help="cheapest free target (a Python test's own)")
 fleetmap.register_strategy("py-wrong", WrongLength)
+fleetmap.register_strategy("py-recorder", Recorder)
 
 
 class PythonStrategyTest(unittest.TestCase):
@@ -55,6 +72,43 @@ class PythonStrategyTest(unittest.TestCase):
         # The sweep's run is the run explore() makes of the same scenario.
         alone = fleetmap.explore(map="empty", robots=2, steps=30, seed=1, strategy="py-cheapest")
         self.assertAlmostEqual(rows[0]["coverage"], alone.metrics["coverage"], places=5)
+
+    def test_it_gets_headings_and_the_context(self):
+        starts = [[1.0, 1.0, 40.0], [8.5, 8.5, -115.0]]  # x, y in metres, heading in degrees
+        run = fleetmap.explore(map="office", robots={"starts": starts}, steps=40, seed=1, strategy="py-recorder",
+                               sensors={"range": {"max_range": 3.5}}, exploration={"beta": 0.7})
+        self.assertGreater(len(Recorder.calls), 1)
+        first_poses, first_indices = Recorder.calls[0][0], Recorder.calls[0][1]
+        # The first round gets the start poses, headings included (in radians).
+        for row, robot in zip(first_poses, first_indices):
+            np.testing.assert_allclose(row, [starts[robot][0], starts[robot][1], math.radians(starts[robot][2])],
+                                       atol=1e-9)
+        turned = False
+        for poses, indices, team_size, sensor_range, beta, targets, between, gains in Recorder.calls:
+            self.assertEqual((team_size, sensor_range, beta), (2, 3.5, 0.7))
+            self.assertTrue(set(indices.tolist()) <= {0, 1})
+            # Every pose a robot was given is one it held (ideal localization: the estimates are the truth).
+            for row, robot in zip(poses, indices):
+                track = run.estimates[robot]
+                self.assertTrue(np.any(np.all(np.abs(track - row) < 1e-9, axis=1)), (robot, row))
+                self.assertTrue(-math.pi < row[2] <= math.pi)
+                turned = turned or abs(row[2] - math.radians(starts[robot][2])) > 0.1
+            self.assertEqual(between.shape, (targets, targets))
+            self.assertTrue(np.all(np.diag(between) == 0.0))
+            self.assertEqual(gains.shape, (targets,))
+            self.assertTrue(np.all(gains >= 0.0))
+        self.assertTrue(turned)
+        with self.assertRaisesRegex(RuntimeError, "only while assign runs"):
+            Recorder.kept_context.target_costs()
+
+    def test_assign_must_take_the_four_arrays(self):
+        class TooFew:
+            def assign(self, poses, targets):
+                return []
+
+        with self.assertRaisesRegex(ValueError, "py-too-few.*poses, targets, costs, claimed"):
+            fleetmap.register_strategy("py-too-few", TooFew)
+        self.assertNotIn("py-too-few", fleetmap.strategy_names())
 
     def test_a_bad_answer_is_reported(self):
         with self.assertRaisesRegex(RuntimeError, "py-wrong.*3 targets for 2 robots"):

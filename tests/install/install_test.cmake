@@ -14,7 +14,8 @@ endfunction()
 set(prefix ${WORK_DIR}/prefix)
 file(REMOVE_RECURSE ${prefix})  # the consumer's own build stays, so that ccache and ninja reuse it
 run("cmake --install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
-foreach(expected include/fleetmap/core/transform2.h include/fleetmap/sim/simulation.h lib/cmake/fleetmap/fleetmapConfig.cmake)
+foreach(expected include/fleetmap/core/transform2.h include/fleetmap/sim/simulation.h include/fleetmap/sim/run_files.h
+                 lib/cmake/fleetmap/fleetmapConfig.cmake)
   if(NOT EXISTS ${prefix}/${expected})
     message(FATAL_ERROR "install test: ${expected} is not installed")
   endif()
@@ -37,7 +38,10 @@ endif()
 run("configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/consumer-build -G ${GENERATOR}
     -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_PREFIX_PATH=${prefix} ${launcher})
 run("build the consumer" ${CMAKE_COMMAND} --build ${WORK_DIR}/consumer-build)
-run("run the consumer" ${WORK_DIR}/consumer-build/consumer)
+file(REMOVE_RECURSE ${WORK_DIR}/run)
+# The built-in maps from the prefix (fleetmap_MAPS_DIR), as a program finds them without the source tree.
+run("run the consumer" ${CMAKE_COMMAND} -E env FLEETMAP_MAPS_DIR=${prefix}/share/fleetmap/maps
+    ${WORK_DIR}/consumer-build/consumer ${WORK_DIR}/run)
 
 # The Python package from the prefix: it imports from there and finds the installed maps.
 if(PYTHON)

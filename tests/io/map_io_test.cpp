@@ -50,6 +50,62 @@ TEST(MapIo, PngToGridToPgmYamlToGridIsIdentical) {
   EXPECT_EQ(from_yaml.geometry(), original.geometry());
 }
 
+// map_image: map_saver's grey values, the top cell row as the image's first row.
+TEST(MapImage, PixelsAreMapSaverValuesTopRowFirst) {
+  OccupancyGrid g(GridGeometry(0.1, 3, 2, core::Pose2(1.0, -2.0, 0.0)));
+  g.set_state({0, 0}, CellState::Occupied);  // bottom left
+  g.set_state({1, 0}, CellState::Free);
+  g.set_state({2, 1}, CellState::Free);      // top right
+  g.set_state({0, 1}, CellState::Occupied);  // top left
+  const MapImage image = map_image(g);
+  ASSERT_EQ(image.width, 3);
+  ASSERT_EQ(image.height, 2);
+  EXPECT_EQ(image.pixels, (std::vector<std::uint8_t>{0, 205, 254,     // top row: cell row 1
+                                                     0, 254, 205}));  // bottom row: cell row 0
+}
+
+// An image of map_saver's values becomes a grid with map_server's rules and gives the same image
+// back, directly and through files (save, load): 0 occupied, 254 free, 205 unknown.
+TEST(MapImage, RoundTripKeepsMapServerValues) {
+  std::mt19937 rng(7);
+  const std::uint8_t values[3] = {0, 254, 205};
+  std::uniform_int_distribution<int> pick(0, 2);
+  MapImage image{29, 17, {}};
+  for (int i = 0; i < image.width * image.height; ++i) image.pixels.push_back(values[pick(rng)]);
+  MapYaml meta;
+  meta.resolution = 0.025;
+  meta.origin = core::Pose2(-1.5, 2.0, 0.0);
+  const OccupancyGrid grid = grid_from_map_image(image, meta);
+  EXPECT_EQ(grid.width(), image.width);
+  EXPECT_EQ(grid.height(), image.height);
+  EXPECT_DOUBLE_EQ(grid.resolution(), 0.025);
+  // Image row r is cell row height - 1 - r.
+  for (int r = 0; r < image.height; ++r) {
+    for (int c = 0; c < image.width; ++c) {
+      const std::uint8_t v = image.pixels[std::size_t(r * image.width + c)];
+      const CellState expected = v == 0 ? CellState::Occupied : v == 254 ? CellState::Free : CellState::Unknown;
+      ASSERT_EQ(grid.state({c, image.height - 1 - r}), expected) << "pixel " << c << ", " << r;
+    }
+  }
+  EXPECT_EQ(map_image(grid).pixels, image.pixels);
+
+  TempDir dir;
+  save_map_yaml(grid, dir / "m.yaml");
+  const OccupancyGrid loaded = load_map(dir / "m.yaml");
+  EXPECT_DOUBLE_EQ(loaded.resolution(), 0.025);
+  EXPECT_DOUBLE_EQ(loaded.geometry().origin().x, -1.5);
+  EXPECT_EQ(map_image(loaded).pixels, image.pixels);
+}
+
+TEST(MapImageBadInput, WrongPixelCountOrEmptyImageIsRefused) {
+  const MapYaml meta;
+  expect_input_error([&] { grid_from_map_image(MapImage{3, 2, std::vector<std::uint8_t>(5, 254)}, meta); },
+                     {"map image", "got 5 for 3 x 2"});
+  expect_input_error([&] { grid_from_map_image(MapImage{}, meta); }, {"map image", "got 0 for 0 x 0"});
+  expect_input_error([&] { grid_from_map_image(MapImage{-2, -3, std::vector<std::uint8_t>(6, 0)}, meta); },
+                     {"map image", "-2 x -3"});
+}
+
 TEST(MapIo, YamlMatchesMapSaverFormat) {
   MapYaml y;
   y.image = "map.pgm";

@@ -95,5 +95,55 @@ exploration: {strategy: first-come, path_planner: grid-astar-again}
   EXPECT_EQ(counters.front().second, r.steps);
 }
 
+// Records the poses every assignment round gets.
+class PoseRecorder final : public exploration::CoordinationStrategy {
+ public:
+  std::string name() const override { return "pose-recorder"; }
+  bool joint() const override { return true; }
+  std::vector<int> assign(const exploration::AssignmentInput& input) const override {
+    std::vector<int> out(input.robots.size(), -1);
+    for (std::size_t r = 0; r < input.robots.size(); ++r) {
+      const auto& robot = input.robots[r];
+      seen_.push_back({robot.team_index, core::Pose2(robot.position_m.x(), robot.position_m.y(), robot.heading_rad)});
+      for (std::size_t t = 0; t < input.targets.size(); ++t)
+        if (std::isfinite(robot.cost_m[t]) && out[r] < 0) out[r] = int(t);
+    }
+    return out;
+  }
+  static inline std::vector<std::pair<int, core::Pose2>> seen_;
+};
+
+// A strategy sees each robot's pose with its heading: the start poses first, then poses the robots
+// held during the run (ideal localization: the estimates are the truth).
+TEST(Plugins, AStrategyGetsTheRobotsHeadings) {
+  exploration::register_strategy("pose-recorder", "records the poses it gets (a test's own)",
+                                 [](const exploration::StrategyOptions&) { return std::make_unique<PoseRecorder>(); });
+  Scenario s;
+  s.map = "room";
+  s.robot_count = 2;
+  s.steps = 30;
+  s.placement = Placement::List;
+  s.starts = {{2.0, 2.0, 0.7}, {6.0, 4.0, -2.0}};
+  s.exploration.strategy = "pose-recorder";
+  const RunResult r = Simulation(s, testing::walled_room(80, 60)).run();
+  const auto& seen = PoseRecorder::seen_;
+  ASSERT_GE(seen.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const auto& [robot, pose] = seen[k];
+    ASSERT_TRUE(robot == 0 || robot == 1);
+    EXPECT_NEAR(pose.theta, s.starts[std::size_t(robot)].theta, 1e-9) << "robot " << robot;
+  }
+  bool turned = false;
+  for (const auto& [robot, pose] : seen) {
+    const auto& track = r.robots[std::size_t(robot)].estimate;
+    const bool held = std::any_of(track.begin(), track.end(), [&](const core::Pose2& p) {
+      return (p.position() - pose.position()).norm() < 1e-9 && std::abs(p.theta - pose.theta) < 1e-9;
+    });
+    EXPECT_TRUE(held) << "robot " << robot << " never was at " << pose.x << ", " << pose.y << ", " << pose.theta;
+    turned = turned || std::abs(pose.theta - s.starts[std::size_t(robot)].theta) > 0.1;
+  }
+  EXPECT_TRUE(turned);
+}
+
 }  // namespace
 }  // namespace fleetmap::sim

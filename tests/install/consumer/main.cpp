@@ -1,12 +1,19 @@
-// Registers a coordination strategy of its own and explores a built-in map with it, through the
-// installed headers and libraries only. Exit status 0 when the strategy ran and mapped the room.
+// Registers a coordination strategy of its own, explores a built-in map with it and writes the
+// run's files into the folder given as its argument, through the installed headers and libraries
+// only. Exit status 0 when the strategy ran and mapped the room, and the files are there: the
+// merged map read back has the run's cells.
 #include <fleetmap/core/transform2.h>
 #include <fleetmap/exploration/strategy.h>
+#include <fleetmap/io/map_io.h>
 #include <fleetmap/maps/builtin_maps.h>
+#include <fleetmap/sim/run_files.h>
 #include <fleetmap/sim/scenario.h>
 #include <fleetmap/sim/simulation.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -40,7 +47,39 @@ class CheapestFreeTarget final : public exploration::CoordinationStrategy {
 
 }  // namespace
 
-int main() {
+// The run's files: every name run_output_files promises, each non-empty; metrics.json names the
+// map; map.yaml reads back as the merged map.
+bool check_run_files(const sim::RunResult& result, const std::filesystem::path& dir) {
+  const auto written = sim::write_run_outputs(result, "empty", dir);
+  for (const std::string& name : sim::run_output_files(result.scenario)) {
+    const auto path = dir / name;
+    if (!std::filesystem::exists(path) || std::filesystem::file_size(path) == 0 ||
+        std::find(written.begin(), written.end(), path) == written.end()) {
+      std::cerr << "consumer: " << path << " was not written\n";
+      return false;
+    }
+  }
+  std::ifstream metrics(dir / "metrics.json");
+  const std::string text((std::istreambuf_iterator<char>(metrics)), std::istreambuf_iterator<char>());
+  if (text.find("\"map\": \"empty\"") == std::string::npos) {
+    std::cerr << "consumer: metrics.json does not name the map\n";
+    return false;
+  }
+  const mapping::OccupancyGrid back = io::load_map(dir / "map.yaml");
+  if (back.width() != result.merged.width() || back.height() != result.merged.height()) {
+    std::cerr << "consumer: map.yaml is " << back.width() << " x " << back.height() << ", the run's map "
+              << result.merged.width() << " x " << result.merged.height() << "\n";
+    return false;
+  }
+  std::cout << written.size() << " files written to " << dir << "\n";
+  return true;
+}
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::cerr << "usage: consumer OUTPUT_FOLDER\n";
+    return 2;
+  }
   // A core type straight from the installed headers.
   const core::Transform2 t = core::Pose2{1.0, 2.0, 0.5}.as_transform();
   if ((t.inverse() * t).translation().norm() > 1e-12) return 1;
@@ -56,5 +95,6 @@ int main() {
   const sim::RunResult result = simulation.run();
   std::cout << "strategy cheapest-free: " << g_calls << " assignment rounds, coverage " << result.coverage.back()
             << " after " << result.steps << " steps\n";
-  return g_calls > 0 && result.coverage.back() > result.coverage.front() ? 0 : 1;
+  if (g_calls == 0 || result.coverage.back() <= result.coverage.front()) return 1;
+  return check_run_files(result, argv[1]) ? 0 : 1;
 }
