@@ -77,7 +77,7 @@ struct ConfidenceOptions {
   // without contradiction and reaches this share of the answer's score, the distinctiveness is 0.
   // Off because at 0.1 it refused 24 of 219 right merges of house windows on the benchmark of
   // robot-built maps, and did not catch the simulator's wrong merge it was made for.
-  double min_turned_share = 0.0;
+  double min_turned_share = 0.5;
 };
 
 // The confidences a threshold may be (the scenario's merging.min_confidence, merge --min-confidence).
