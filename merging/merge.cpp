@@ -236,8 +236,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       best_q.matched > 0 ? std::max(0.0, std::log(chance_rms / std::max(best_q.residual_rms, 0.05))) : 0.0;
   result.evidence = best_q.constraint * fit_weight;
   // The same for any placement: how many wall cells' worth pin it, each weighted by how much better
-  // than chance it fits. Alternatives are compared with the answer by this measure, not by their
-  // wall counts: a rough fit of one long corner lays many walls near walls but pins little.
+  // than chance it fits. A turned placement of one room is compared with the answer by this measure
+  // (below), not by wall counts: in a symmetric room the answer may lay more of one map on the other
+  // and still be the wrong one of two equally tight fits.
   const auto evidence_of = [&](const AlignmentQuality& q) {
     return q.matched > 0 ? q.constraint * std::max(0.0, std::log(chance_rms / std::max(q.residual_rms, 0.05))) : 0.0;
   };
@@ -260,13 +261,12 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       if (same_answer(t, answer, at, co)) continue;
       const double n = q.matched + q.contradicted;
       const double z = (q.contradicted - rate * n) / std::sqrt(rate * n + 1.0);
-      const double e = evidence_of(q);
-      const double plausible = e * clamp01((4.0 - z) / 2.0);
+      const double plausible = q.score * clamp01((4.0 - z) / 2.0);
       if (plausible > second) second = plausible, alternative = t;
       const double dtheta = std::abs(core::normalize_angle(t.rotation() - answer.rotation()));
-      if (z <= 2.0 && dtheta > std::numbers::pi / 4.0 && own > 0.0) turned = std::max(turned, e / own);
+      if (z <= 2.0 && dtheta > std::numbers::pi / 4.0 && own > 0.0) turned = std::max(turned, evidence_of(q) / own);
     }
-    return std::pair(own > 0.0 ? clamp01(1.0 - second / own) : 0.0, alternative);
+    return std::pair(best.score > 0.0 ? clamp01(1.0 - second / best.score) : 0.0, alternative);
   };
   Placements others;
   for (std::size_t i = 1; i < scored.size(); ++i) others.emplace_back(scored[i].first, scored[i].second->fit.b_to_a);
