@@ -289,7 +289,9 @@ TEST(ExploreCommand, MergeAttemptsKeepsTheMapsThatReproduceEachAttempt) {
   const auto j = nlohmann::json::parse(slurp(dir / "m.json"));
   const auto& t = j["transforms"][0];
   EXPECT_EQ(t["merged"].get<bool>(), cells[4] == "1");
-  if (t.contains("confidence")) EXPECT_NEAR(t["confidence"].get<double>(), std::stod(cells[5]), 1e-3);
+  if (t.contains("confidence")) {
+    EXPECT_NEAR(t["confidence"].get<double>(), std::stod(cells[5]), 1e-3);
+  }
   // The folder is the run's own: not --out itself.
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map office --steps 1 --out run --merge-attempts run", dir), "--merge-attempts");
 }
