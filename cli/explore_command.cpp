@@ -46,6 +46,7 @@ struct ExploreFlags {
   bool animate = false;
   bool html = false;
   std::string video;  // a file name inside --out; --animate is run.mp4
+  std::string merge_attempts;  // debug: a folder for the two maps of every merge attempt
   bool quiet = false;
   long long max_cells = 64'000'000;
 };
@@ -202,6 +203,15 @@ int run_explore(const ExploreFlags& f) {
     files.push_back(video_name);
   }
   io::OutputFolder folder(out, "explore", files, inputs, "--out " + out.string());
+  // Debug: the two maps of every merge attempt, as the aligner saw them (a folder of its own: how
+  // many attempts a run makes is known only at its end).
+  std::optional<io::OutputFolder> attempts_folder;
+  if (!f.merge_attempts.empty()) {
+    if (fs::weakly_canonical(f.merge_attempts) == fs::weakly_canonical(out))
+      throw InputError("--merge-attempts " + f.merge_attempts + ": give a folder other than --out");
+    attempts_folder.emplace(f.merge_attempts, "explore --merge-attempts", std::vector<std::string>{"attempts.csv"},
+                            inputs, "--merge-attempts " + f.merge_attempts);
+  }
 
   io::MapLoadOptions load;
   load.max_cells = f.max_cells;
@@ -213,12 +223,33 @@ int run_explore(const ExploreFlags& f) {
 
   // Placing the robots is where a scenario meets its map: errors name the scenario, or the map.
   std::optional<sim::Simulation> made;
+  sim::SimulationSetup setup;
+  std::vector<std::string> attempt_files;
+  std::string attempts_csv = "step,receiver,sender,method,merged,confidence,rotation_error_deg,position_error_m,receiver_map,sender_map,reason\n";
+  if (attempts_folder) {
+    setup.on_merge_attempt = [&](const sim::MergeRecord& m, const mapping::OccupancyGrid& receiver,
+                                 const mapping::OccupancyGrid& sender) {
+      const std::string stem = fmt::format("step{:05d}_robot{}_robot{}", m.step, m.receiver + 1, m.sender + 1);
+      const std::string rname = stem + "_receiver", sname = stem + "_sender";
+      for (const auto& [name, map] : {std::pair{rname, &receiver}, std::pair{sname, &sender}}) {
+        io::save_map_yaml(*map, attempts_folder->dir() / (name + ".yaml"));
+        attempt_files.push_back(name + ".yaml");
+        attempt_files.push_back(name + ".pgm");
+      }
+      std::string reason = m.reason;
+      std::replace(reason.begin(), reason.end(), '"', '\'');
+      attempts_csv += fmt::format("{},{},{},{},{},{:.4f},{:.3f},{:.4f},{}.yaml,{}.yaml,\"{}\"\n", m.step, m.receiver + 1,
+                                  m.sender + 1, m.method, int(m.merged), m.confidence, m.rotation_error_deg,
+                                  m.position_error_m, rname, sname, reason);
+    };
+  }
   try {
-    made.emplace(s, std::move(truth));
+    made.emplace(s, std::move(truth), std::move(setup));
   } catch (const InputError& e) {
     throw InputError((f.scenario.empty() ? s.map : f.scenario) + ": " + e.what());
   }
   folder.claim();
+  if (attempts_folder) attempts_folder->claim();
   sim::Simulation& simulation = *made;
   ProgressBar bar(!f.quiet);
   std::unique_ptr<sim::RunVideo> video;
@@ -254,6 +285,11 @@ int run_explore(const ExploreFlags& f) {
     if (!video->fallback_note().empty()) fmt::print(stderr, "fleetmap: {}: {}\n", video_name, video->fallback_note());
   }
   folder.finish(io::OutputFolder::names(written));
+  if (attempts_folder) {
+    io::write_file_atomic(attempts_folder->dir() / "attempts.csv", attempts_csv);
+    attempt_files.push_back("attempts.csv");
+    attempts_folder->finish(attempt_files);
+  }
   // A plan that failed: the run's outputs are written; the plan's problem gets one line.
   const auto plan_exit = [&]() {
     if (!plan || plan->success()) return 0;
@@ -350,6 +386,9 @@ Command add_explore_command(CLI::App& root) {
                 "fleetmap replay-compare puts two runs' pages side by side");
   app->add_option("--video", f->video,
                   "Write the video under this name in --out: NAME.mp4 (H.264) or NAME.webm (VP9); implies --animate");
+  app->add_option("--merge-attempts", f->merge_attempts,
+                  "Debug: write the two maps of every merge attempt (map_server YAML, each in its robot's own frame, "
+                  "named by step and robots) and attempts.csv to this folder; try one with `fleetmap merge`");
   app->add_flag("--quiet,-q", f->quiet, "Print only the merged map's path; no progress bar");
   app->add_option("--max-cells", f->max_cells, "Refuse maps with more cells than this")
       ->capture_default_str()

@@ -205,11 +205,27 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   std::vector<std::pair<AlignmentQuality, const Candidate*>> scored;
   for (const auto& c : active) scored.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, options.quality), &c);
   std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first.score > y.first.score; });
+  // The answer: the best-scoring survivor whose cells agree with the other map (the wave-algorithm
+  // paper's acceptance index, Birk & Carpin 2006, at least ConfidenceOptions::zero_acceptance). The
+  // wall score does not see free cells of one map on filled obstacles or thick walls of the other; a
+  // placement that lays many of them would be refused anyway, and a smaller placement that agrees
+  // is then the better answer.
+  std::vector<double> omega(scored.size(), -1.0);
+  std::size_t pick = 0;
+  for (std::size_t i = 0; i < scored.size(); ++i) {
+    omega[i] = acceptance_index(a.grid(), b.grid(), scored[i].second->fit.b_to_a).omega();
+    if (omega[i] >= options.confidence.zero_acceptance) {
+      pick = i;
+      break;
+    }
+  }
+  if (omega[pick] < options.confidence.zero_acceptance) pick = 0;
+  std::rotate(scored.begin(), scored.begin() + std::ptrdiff_t(pick), scored.begin() + std::ptrdiff_t(pick) + 1);
   const auto& [best_q, best] = scored.front();
   result.transform = best->fit.b_to_a;
   result.method = best->hypothesis.method;
   result.quality = best_q;
-  result.acceptance = acceptance_index(a.grid(), b.grid(), result.transform).omega();
+  result.acceptance = omega[pick];
 
   const auto& co = options.confidence;
   const double agree_factor = clamp01((best_q.agreement - co.zero_agreement) / (co.full_agreement - co.zero_agreement));
@@ -219,6 +235,13 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   const double fit_weight =
       best_q.matched > 0 ? std::max(0.0, std::log(chance_rms / std::max(best_q.residual_rms, 0.05))) : 0.0;
   result.evidence = best_q.constraint * fit_weight;
+  // The same for any placement: how many wall cells' worth pin it, each weighted by how much better
+  // than chance it fits. A turned placement of one room is compared with the answer by this measure
+  // (below), not by wall counts: in a symmetric room the answer may lay more of one map on the other
+  // and still be the wrong one of two equally tight fits.
+  const auto evidence_of = [&](const AlignmentQuality& q) {
+    return q.matched > 0 ? q.constraint * std::max(0.0, std::log(chance_rms / std::max(q.residual_rms, 0.05))) : 0.0;
+  };
   const auto support = [&](double evidence) { return 1.0 - std::exp2(-evidence / co.half_evidence); };
 
   // The best plausible different answer among `others` (placements of `from` in a), relative to
@@ -231,6 +254,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   const auto distinctiveness = [&](const Placements& others,
                                    const AlignmentQuality& best, const core::Transform2& answer) {
     const Eigen::Vector2d at = answer.inverse().apply(best.overlap_centre);
+    const double own = evidence_of(best);
     double second = 0.0;
     std::optional<core::Transform2> alternative;
     for (const auto& [q, t] : others) {
@@ -240,7 +264,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       const double plausible = q.score * clamp01((4.0 - z) / 2.0);
       if (plausible > second) second = plausible, alternative = t;
       const double dtheta = std::abs(core::normalize_angle(t.rotation() - answer.rotation()));
-      if (z <= 2.0 && dtheta > std::numbers::pi / 4.0 && best.score > 0.0) turned = std::max(turned, q.score / best.score);
+      if (z <= 2.0 && dtheta > std::numbers::pi / 4.0 && own > 0.0) turned = std::max(turned, evidence_of(q) / own);
     }
     return std::pair(best.score > 0.0 ? clamp01(1.0 - second / best.score) : 0.0, alternative);
   };

@@ -47,6 +47,8 @@ namespace fleetmap::merging {
 // - distinctiveness: 1 - S2 / S1, with S1 the best candidate's score and S2 the best score of a
 //   plausible different answer (rotation off by more than distinct_rotation_deg, or displacement at
 //   the overlap centre above distinct_distance cells). Repeated or symmetric places give ~0.
+//   (Comparing evidence instead of scores raised right answers' confidences but merged two wrong
+//   answers on the benchmark: large contradiction-free fits of similar houses.)
 //   A different answer is plausible when its contradictions are what the best answer's own rate
 //   (at least min_contradiction_rate) predicts: with z = (c - rate n) / sqrt(rate n + 1) over its n
 //   tested walls, it counts fully for z <= 2 and not at all for z >= 4.
@@ -55,9 +57,11 @@ namespace fleetmap::merging {
 //   (4 x 4 blocks of wall, counted in both maps: a door jamb seen by both is two): two maps whose
 //   common walls are one corner of a bare room fit any other corner as well, and nothing in
 //   either map can tell (seen on a real plan: two corners of a large hall, turned a quarter).
-// - one rectangular room (opt-in, ConfidenceOptions::min_turned_share): its sides are four lines,
-//   and the room turned a half turn fits them too; when the probes find that turned placement free
-//   of contradictions, the distinctiveness is 0, however much less of the maps it lays on each other.
+// - one rectangular room (ConfidenceOptions::min_turned_share): its sides are four lines, and the
+//   room turned a half turn fits them too; when the answer's common walls are such four lines and
+//   the probes find a turned placement free of contradictions with at least that share of the
+//   answer's evidence, the distinctiveness is 0: which of the two lays more of one map on the other
+//   says nothing in a symmetric room.
 // half_evidence: the evidence (times distinctiveness) at which the last factor is 0.5, set on the
 // development benchmark of robot-built maps (bench/merging_real_bench.cpp) so that the default
 // min_confidence accepts no wrong answer there; bench/README.md shows the reliability table.
@@ -72,12 +76,12 @@ struct ConfidenceOptions {
   double distinct_distance = 4.0;
   double distinct_rotation_deg = 2.0;
   double min_contradiction_rate = 0.005;
-  // One rectangular room (0: off, the default): when the matched walls lie on four lines (at most
-  // zero_beyond_corner blocks off them) and a placement turned by a quarter turn or more fits
-  // without contradiction and reaches this share of the answer's score, the distinctiveness is 0.
-  // Off because at 0.1 it refused 24 of 219 right merges of house windows on the benchmark of
-  // robot-built maps, and did not catch the simulator's wrong merge it was made for.
-  double min_turned_share = 0.0;
+  // One rectangular room (0: off): when the matched walls lie on four lines (at most
+  // zero_beyond_corner blocks off them) and a placement turned by 45 degrees or more fits without
+  // contradiction with at least this share of the answer's evidence ("nearly as well", as a
+  // distinctiveness below 0.5 reads), the distinctiveness is 0. Seen in the simulator: two robots'
+  // maps of a bare rectangular hall merged turned a half turn, 33 m off, at confidence 0.80.
+  double min_turned_share = 0.5;
 };
 
 // The confidences a threshold may be (the scenario's merging.min_confidence, merge --min-confidence).

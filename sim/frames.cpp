@@ -53,6 +53,7 @@ void Simulation::try_merge(int i, int j) {
   record.confidence = m.confidence;
   if (!m.merged) {
     record.reason = m.reason;
+    if (setup_.on_merge_attempt) setup_.on_merge_attempt(record, r.map, s.map);
     merges_.push_back(record);
     return;
   }
@@ -63,6 +64,7 @@ void Simulation::try_merge(int i, int j) {
   record.merged = true;
   record.rotation_error_deg = core::rad2deg(std::abs(core::normalize_angle(t->rotation() - truth.rotation())));
   record.position_error_m = (t->apply(at) - truth.apply(at)).norm();
+  if (setup_.on_merge_attempt) setup_.on_merge_attempt(record, r.map, s.map);
   merges_.push_back(record);
   events_.push_back({step_, "merge", receiver, sender,
                      fmt::format("{} merge, confidence {:.2f}: rotation error {:.2f} deg, position error {:.3f} m",

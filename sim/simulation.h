@@ -138,12 +138,19 @@ struct RobotSetup {
 // (D'Alfonso et al.'s polynomials), which then replaces the frame alignment and the grid exchange.
 using MeetingHandler = std::function<void(Simulation&, int a, int b)>;
 
+// One attempt to align two robots' frames (merging modes that search, e.g. overlap), with the two
+// maps exactly as the aligner saw them, each in its robot's own map frame: for debugging a wrong or
+// refused merge outside the run (`fleetmap explore --merge-attempts DIR` writes them as map files).
+using MergeAttemptHandler = std::function<void(const MergeRecord&, const mapping::OccupancyGrid& receiver_map,
+                                               const mapping::OccupancyGrid& sender_map)>;
+
 struct SimulationSetup {
   std::vector<RobotSetup> robots;  // by robot index; robots beyond the list get the defaults
   // Coverage of the observable space, measured every step. Experiments that measure their own
   // outputs switch it off (it needs the observable space of the whole map).
   bool measure_coverage = true;
   MeetingHandler on_meeting;
+  MergeAttemptHandler on_merge_attempt;
 };
 
 class Simulation {

@@ -264,6 +264,38 @@ TEST(ExploreCommand, RobotsInTheirOwnFramesMergeAtRendezvous) {
   EXPECT_NE(help.out.find("overlap"), std::string::npos);
 }
 
+// Debugging a merge: --merge-attempts keeps the two maps of every attempt, and `fleetmap merge` on
+// them gives the attempt's own answer again.
+TEST(ExploreCommand, MergeAttemptsKeepsTheMapsThatReproduceEachAttempt) {
+  TempDir dir;
+  const auto r = run_fleetmap("explore --map office --robots 2 --merging overlap --steps 60 --seed 3 --out run "
+                              "--merge-attempts att --quiet", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string csv = slurp(dir / "att" / "attempts.csv");
+  std::vector<std::string> rows;
+  for (std::size_t p = 0, q; (q = csv.find('\n', p)) != std::string::npos; p = q + 1) rows.push_back(csv.substr(p, q - p));
+  ASSERT_GE(rows.size(), 2u) << csv;
+  EXPECT_EQ(rows[0].rfind("step,receiver,sender,method,merged,confidence,", 0), 0u) << rows[0];
+  // The last attempt: its maps, named in the row, merged again as a user would.
+  std::vector<std::string> cells;
+  for (std::size_t p = 0, q = 0; cells.size() < 10; p = q + 1) {
+    q = rows.back().find(',', p);
+    cells.push_back(rows.back().substr(p, q - p));
+  }
+  ASSERT_TRUE(std::filesystem::exists(dir / "att" / cells[8])) << cells[8];
+  ASSERT_TRUE(std::filesystem::exists(dir / "att" / cells[9])) << cells[9];
+  const auto again = run_fleetmap("merge att/" + cells[8] + " att/" + cells[9] + " --seed 3 --out m.png --json m.json", dir);
+  ASSERT_NE(again.exit_code, 2) << again.err;
+  const auto j = nlohmann::json::parse(slurp(dir / "m.json"));
+  const auto& t = j["transforms"][0];
+  EXPECT_EQ(t["merged"].get<bool>(), cells[4] == "1");
+  if (t.contains("confidence")) {
+    EXPECT_NEAR(t["confidence"].get<double>(), std::stod(cells[5]), 1e-3);
+  }
+  // The folder is the run's own: not --out itself.
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map office --steps 1 --out run --merge-attempts run", dir), "--merge-attempts");
+}
+
 }  // namespace
 }  // namespace fleetmap::cli
 
