@@ -157,6 +157,17 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
     return core::Pose2::from_transform(frame_of(i).inverse() * p.as_transform());
   };
 
+  // The simulator's order: readings at the start and after every step's moves, the filter updated
+  // when a robot saw landmarks, the camera read every step.
+  std::vector<std::vector<sim::Detection>> seen(static_cast<std::size_t>(n));
+  const auto sense = [&] {
+    for (int i = 0; i < n; ++i) {
+      const auto readings = sim::read_landmarks(world, truth[std::size_t(i)], sensor, sensor_rng[std::size_t(i)]);
+      if (!readings.empty()) filters[std::size_t(i)].update(readings);
+      seen[std::size_t(i)] = sim::detect_robots(world, i, truth, camera, camera_rng[std::size_t(i)]);
+    }
+  };
+  sense();
   std::size_t next_meeting = 0;
   for (int k = 1; k <= c.steps; ++k) {
     for (int i = 0; i < n; ++i) {
@@ -165,11 +176,10 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
                                                  motion_rng[std::size_t(i)]);
       truth[std::size_t(i)] = mv.pose;
       odometry[std::size_t(i)] = localization::integrate_motion(odometry[std::size_t(i)], mv.odometry);
-      auto& filter = filters[std::size_t(i)];
-      filter.predict(mv.odometry);
-      filter.update(sim::read_landmarks(world, mv.pose, sensor, sensor_rng[std::size_t(i)]));
+      filters[std::size_t(i)].predict(mv.odometry);
       out.truth_paths[std::size_t(i)].push_back(core::Pose2::from_transform(leader_from_world * mv.pose.as_transform()));
     }
+    sense();
     if (next_meeting >= c.rendezvous.size() || c.rendezvous[next_meeting] != k) continue;
     ++next_meeting;
 
@@ -177,8 +187,6 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
     const auto maps_of = [&](int i, localization::ParticleMap which) {
       return landmark_map(filters[std::size_t(i)].map(which), w, o.signature_noise, base.fork(500 + std::uint64_t(i)));
     };
-    std::vector<std::vector<sim::Detection>> seen(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) seen[std::size_t(i)] = sim::detect_robots(world, i, truth, camera, camera_rng[std::size_t(i)]);
     const auto find = [&](int a, int b) -> const sim::Detection* {
       for (const auto& d : seen[std::size_t(a)]) {
         if (d.other == b) return &d;
