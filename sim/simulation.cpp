@@ -398,6 +398,7 @@ void Simulation::step() {
     }
     robot.truth = truths[std::size_t(i)] = mv.pose;
     auto& t = robot.track;
+    t.odometry.push_back(mv.odometry);
     t.distance_m += mv.distance_m;
     streak = mv.blocked ? streak + 1 : (streak >= 2 ? 0 : streak);
     if (streak > 3) streak = 0;  // the escape did not help either: follow the path again

@@ -34,6 +34,7 @@ struct RobotTrack {
   std::vector<core::Pose2> truth;     // one pose per step, from step 0
   std::vector<core::Pose2> estimate;
   std::vector<Eigen::Matrix3d> covariance;
+  std::vector<localization::Odometry> odometry;  // what its encoders reported, one per step from step 1
   double distance_m = 0.0;
   int blocked_moves = 0;
   double localization_s = 0.0;  // the localizer's time: predict and every update
