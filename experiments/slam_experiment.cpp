@@ -357,23 +357,29 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
   return result;
 }
 
-using SlamMethod = std::function<SlamRunResult(const SlamSetup&, int, bool, int)>;
-
-// The SLAM methods by name: one row per name of slam_method_names().
-const std::vector<std::pair<std::string, SlamMethod>>& slam_methods() {
-  static const std::vector<std::pair<std::string, SlamMethod>> kMethods = {
-      {"polynomial", run_polynomial_slam},
-  };
-  return kMethods;
-}
-
 }  // namespace
 
+core::Registry<SlamMethod>& slam_method_registry() {
+  static core::Registry<SlamMethod> registry("SLAM method");
+  static const bool built_in = [] {
+    registry.add("polynomial",
+                 "D'Alfonso et al.'s polynomial EKF-SLAM, one filter per robot, polynomials exchanged at a rendezvous "
+                 "(§3.2)",
+                 run_polynomial_slam);
+    return true;
+  }();
+  (void)built_in;
+  return registry;
+}
+
+void register_slam_method(std::string name, std::string help, SlamMethod method) {
+  slam_method_registry().add(std::move(name), std::move(help), std::move(method));
+}
+
+std::vector<std::string> slam_method_names() { return slam_method_registry().names(); }
+
 SlamRunResult run_slam(const SlamSetup& setup, int run, bool exchange, int only) {
-  for (const auto& [name, method] : slam_methods()) {
-    if (name == setup.scenario.method) return method(setup, run, exchange, only);
-  }
-  throw InputError("method: no SLAM method is named '" + setup.scenario.method + "'");
+  return slam_method_registry().get(setup.scenario.method).make(setup, run, exchange, only);
 }
 
 }  // namespace fleetmap::experiments
