@@ -124,8 +124,8 @@ class Leader {
     RobotLandmarkMap global = maps_of(s, 0, localization::ParticleMap::Combined);
     std::vector<int> source(global.ids.size(), 0);
     for (int j = 1; j < n; ++j) {
-      const sim::Detection* lj = seen(s, 0, j);
-      const sim::Detection* jl = seen(s, j, 0);
+      const sim::Detection* lj = s.detection(0, j);
+      const sim::Detection* jl = s.detection(j, 0);
       if (!lj || !jl) {
         const auto truth = s.true_poses();
         throw InputError(fmt::format("case '{}': robots {} and {} do not see each other at the rendezvous of step {} ({:.1f} m "
@@ -180,12 +180,6 @@ class Leader {
     return landmark_map(filter_of(s, i).map(which), w_, o_.signature_noise, base_.fork(500 + std::uint64_t(i)));
   }
 
-  static const sim::Detection* seen(const sim::Simulation& s, int a, int b) {
-    for (const auto& d : s.detections(a)) {
-      if (d.other == b) return &d;
-    }
-    return nullptr;
-  }
 
   // The global map with follower j's map fused in; fused entries (the leader's, changed by the
   // fusion) are marked -1 in `source`.

@@ -158,8 +158,8 @@ class PolynomialExchange {
   // A rendezvous is the step two robots start seeing each other (a choice: the paper does not say
   // how often robots that keep seeing each other exchange).
   void operator()(sim::Simulation& s, int a, int b) {
-    const sim::Detection* ab = seen(s, a, b);
-    const sim::Detection* ba = seen(s, b, a);
+    const sim::Detection* ab = s.detection(a, b);
+    const sim::Detection* ba = s.detection(b, a);
     if (!enabled_ || ab == nullptr || ba == nullptr) return;
     struct Outgoing {
       int from, to;
@@ -188,7 +188,7 @@ class PolynomialExchange {
       outgoing.push_back({l, j, std::move(m)});
     }
     for (const auto& o : outgoing) {
-      const sim::Detection* seen_jl = seen(s, o.to, o.from);
+      const sim::Detection* seen_jl = s.detection(o.to, o.from);
       merging::ExchangeOptions options;
       options.segment_tolerance = sc_.segment_tolerance_m;
       options.range_noise = sc_.camera.range_noise_m;
@@ -209,13 +209,6 @@ class PolynomialExchange {
   double seconds(int a) const { return seconds_[std::size_t(a)]; }
 
  private:
-  static const sim::Detection* seen(const sim::Simulation& s, int a, int b) {
-    for (const auto& d : s.detections(a)) {
-      if (d.other == b) return &d;
-    }
-    return nullptr;
-  }
-
   const SlamScenario& sc_;
   const std::vector<int>& team_;
   bool enabled_;

@@ -204,6 +204,13 @@ std::vector<core::Pose2> Simulation::estimated_poses() const {
   return out;
 }
 
+const Detection* Simulation::detection(int i, int other) const {
+  for (const Detection& d : robots_[std::size_t(i)].detections) {
+    if (d.other == other) return &d;
+  }
+  return nullptr;
+}
+
 bool Simulation::finished(int i) const {
   const Robot& r = robots_[std::size_t(i)];
   return r.driver ? !r.command.has_value() : explorer_.finished(i);

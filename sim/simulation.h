@@ -174,6 +174,8 @@ class Simulation {
   localization::Localizer& localizer(int i) { return *robots_[std::size_t(i)].localizer; }
   // The robots robot i detected this step.
   const std::vector<Detection>& detections(int i) const { return robots_[std::size_t(i)].detections; }
+  // Robot i's detection of robot `other` this step, or null when i did not see it.
+  const Detection* detection(int i, int other) const;
   std::vector<Eigen::Vector2d> path(int i) const { return explorer_.path(i); }
   // Robot i ran out of reachable frontiers (for now: it resumes when its map grows), or its driver
   // has no command left.
