@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 
+#include "core/format.h"
 #include "core/angle.h"
 #include "core/error.h"
 #include "experiments/slam_experiment.h"
@@ -201,9 +202,7 @@ SlamScenario load_slam_scenario(const std::filesystem::path& path) {
 
 void validate_slam_scenario(const SlamScenario& s) {
   if (const auto names = slam_method_names(); std::find(names.begin(), names.end(), s.method) == names.end()) {
-    std::string valid;
-    for (const auto& n : names) valid += (valid.empty() ? "" : ", ") + n;
-    throw InputError("method: unknown value '" + s.method + "' (valid: " + valid + ")");
+    throw InputError("method: unknown value '" + s.method + "' (valid: " + core::join(names) + ")");
   }
   if (s.runs < 1) throw InputError("runs: need at least one run, got " + std::to_string(s.runs));
   if (s.steps < 1) throw InputError("steps: need at least one step, got " + std::to_string(s.steps));
