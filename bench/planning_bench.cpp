@@ -8,6 +8,7 @@
 // Own flags (before Google Benchmark's): --pairs=N (50), --budgets=0.1,0.5,2, --maps=a,b (all),
 // --planners=a,b (all), --markdown=FILE (also write the summary tables there).
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdio>
@@ -110,15 +111,10 @@ void run_case(benchmark::State& state, const MapCase* c, const std::string& plan
 }
 
 std::string format_cell(const Row& r) {
-  char buf[96];
-  if (r.successes == 0) {
-    std::snprintf(buf, sizeof buf, "0%%");
-  } else {
-    const double ms = 1e3 * r.first_s;
-    std::snprintf(buf, sizeof buf, ms < 10 ? "%.0f%% · %.1f ms · %.3f" : "%.0f%% · %.0f ms · %.3f",
-                  100.0 * r.successes / r.runs, ms, r.ratio);
-  }
-  return buf;
+  if (r.successes == 0) return "0%";
+  const double ms = 1e3 * r.first_s;
+  return ms < 10 ? fmt::format("{:.0f}% · {:.1f} ms · {:.3f}", 100.0 * r.successes / r.runs, ms, r.ratio)
+                 : fmt::format("{:.0f}% · {:.0f} ms · {:.3f}", 100.0 * r.successes / r.runs, ms, r.ratio);
 }
 
 // One table per budget: a row per planner, a column per map; each cell "success · first · ratio".
@@ -128,9 +124,7 @@ std::string markdown(const std::vector<std::string>& maps, const std::vector<std
   for (const Row& r : rows()) by_key[{r.map, r.planner, r.budget}] = r;
   std::string s;
   for (const double budget : budgets) {
-    char title[64];
-    std::snprintf(title, sizeof title, "\nBudget %g s:\n\n", budget);
-    s += title;
+    s += fmt::format("\nBudget {:g} s:\n\n", budget);
     s += "| planner |";
     for (const auto& m : maps) {
       s += ' ';
@@ -190,9 +184,8 @@ int main(int argc, char** argv) {
     c->pairs = fp::random_pairs(*c->space, pairs, 1000 + k);
     for (const auto& planner : planners) {
       for (const double budget : budgets) {
-        char name[128];
-        std::snprintf(name, sizeof name, "%s/%s/budget:%gs", maps[k].c_str(), planner.c_str(), budget);
-        benchmark::RegisterBenchmark(name, fp::run_case, c.get(), planner, budget)
+        const std::string name = fmt::format("{}/{}/budget:{:g}s", maps[k], planner, budget);
+        benchmark::RegisterBenchmark(name.c_str(), fp::run_case, c.get(), planner, budget)
             ->Iterations(static_cast<benchmark::IterationCount>(c->pairs.size()))
             ->UseManualTime()
             ->Unit(benchmark::kMillisecond);

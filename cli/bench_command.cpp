@@ -18,6 +18,7 @@
 #include "cli/progress.h"
 #include "cli/sweep_flags.h"
 #include "cli/validators.h"
+#include "core/format.h"
 #include "core/error.h"
 #include "io/file_io.h"
 #include "io/map_io.h"
@@ -369,10 +370,8 @@ Command add_bench_command(CLI::App& root) {
                   "Scenario file every run starts from (its map, strategy, robots and seed are replaced) "
                   "[default: the scenario defaults of `fleetmap explore`]");
   app->add_option("--steps", s.steps, "Step limit of each run [default: 2000]")->check(in_range(sim::limits::kSteps));
-  std::string localizers;
-  for (const auto& name : localization::localizer_names()) localizers += (localizers.empty() ? "" : ", ") + name;
   app->add_option("--localization", s.localization,
-                  "How robots know their pose: " + localizers + " (see `fleetmap explore --help`) [default: ideal]");
+                  "How robots know their pose: " + core::join(localization::localizer_names()) + " (see `fleetmap explore --help`) [default: ideal]");
   app->add_option("--merging", s.merging,
                   "How robots bring teammates' maps into their frame: known, rendezvous or overlap (see `fleetmap "
                   "explore --help`) [default: known]");

@@ -182,37 +182,37 @@ planning::PlanResult plan_on(const sim::RunResult& result, const PlanRequest& re
   return plan;
 }
 
-int run_explore(const ExploreFlags& f) {
-  sim::Scenario s = scenario_from(f);
-  const std::optional<PlanRequest> request = plan_request(f);
+// Where a run's outputs go, the files it will write and the inputs they must not overwrite.
+struct ExploreOutputs {
+  std::string label;  // the map's name
+  fs::path out;
+  std::string video_name;  // "" for none
+  std::vector<std::string> files;
+  std::vector<fs::path> inputs;
+};
 
-  // Every output is checked before anything is read or run; nothing is written on bad input.
-  const std::string label = maps::is_builtin_map(s.map) ? s.map : fs::path(s.map).stem().string();
-  const fs::path out = f.out.empty() ? fs::path("out") / label : fs::path(f.out);
-  std::vector<fs::path> inputs = maps::map_source_files(s.map);
-  if (!f.scenario.empty()) inputs.push_back(f.scenario);
-  std::vector<std::string> files = sim::run_output_files(s);
-  if (request) files.push_back("path.json");
-  const std::string video_name = !f.video.empty() ? f.video : f.animate ? "run.mp4" : "";
-  if (!video_name.empty()) {
+ExploreOutputs explore_outputs(const ExploreFlags& f, const sim::Scenario& s, bool plan) {
+  ExploreOutputs o;
+  o.label = maps::is_builtin_map(s.map) ? s.map : fs::path(s.map).stem().string();
+  o.out = f.out.empty() ? fs::path("out") / o.label : fs::path(f.out);
+  o.inputs = maps::map_source_files(s.map);
+  if (!f.scenario.empty()) o.inputs.push_back(f.scenario);
+  o.files = sim::run_output_files(s);
+  if (plan) o.files.push_back("path.json");
+  o.video_name = !f.video.empty() ? f.video : f.animate ? "run.mp4" : "";
+  if (!o.video_name.empty()) {
     const auto& ext = sim::video_extensions();
-    if (fs::path(video_name).filename() != video_name ||
-        std::find(ext.begin(), ext.end(), fs::path(video_name).extension().string()) == ext.end()) {
-      throw InputError("--video " + video_name + ": give a file name (no folder) ending in .mp4 (H.264) or .webm (VP9)");
+    if (fs::path(o.video_name).filename() != o.video_name ||
+        std::find(ext.begin(), ext.end(), fs::path(o.video_name).extension().string()) == ext.end()) {
+      throw InputError("--video " + o.video_name + ": give a file name (no folder) ending in .mp4 (H.264) or .webm (VP9)");
     }
-    files.push_back(video_name);
+    o.files.push_back(o.video_name);
   }
-  io::OutputFolder folder(out, "explore", files, inputs, "--out " + out.string());
-  // Debug: the two maps of every merge attempt, as the aligner saw them (a folder of its own: how
-  // many attempts a run makes is known only at its end).
-  std::optional<io::OutputFolder> attempts_folder;
-  if (!f.merge_attempts.empty()) {
-    if (fs::weakly_canonical(f.merge_attempts) == fs::weakly_canonical(out))
-      throw InputError("--merge-attempts " + f.merge_attempts + ": give a folder other than --out");
-    attempts_folder.emplace(f.merge_attempts, "explore --merge-attempts", std::vector<std::string>{"attempts.csv"},
-                            inputs, "--merge-attempts " + f.merge_attempts);
-  }
+  return o;
+}
 
+// The true map; one with no free cell is refused.
+mapping::OccupancyGrid load_truth(const ExploreFlags& f, const sim::Scenario& s) {
   io::MapLoadOptions load;
   load.max_cells = f.max_cells;
   load.default_resolution = s.map_resolution_m;
@@ -220,28 +220,87 @@ int run_explore(const ExploreFlags& f) {
   bool any_free = false;
   for (int i = 0; i < truth.width() * truth.height() && !any_free; ++i) any_free = truth.state_at(i) == mapping::CellState::Free;
   if (!any_free) throw InputError(s.map + ": the map has no free cell: nowhere for a robot to start");
+  return truth;
+}
+
+// A plan that failed: the run's outputs are written; the plan's problem gets one line, and the
+// exit code says which (2: a bad point, 1: no path).
+int plan_exit_code(const ExploreFlags& f, const std::optional<planning::PlanResult>& plan) {
+  if (!plan || plan->success()) return 0;
+  using planning::PlanStatus;
+  const bool bad_point = plan->status == PlanStatus::StartOutsideMap || plan->status == PlanStatus::StartInObstacle ||
+                         plan->status == PlanStatus::GoalOutsideMap || plan->status == PlanStatus::GoalInObstacle;
+  const bool at_start = plan->status == PlanStatus::StartOutsideMap || plan->status == PlanStatus::StartInObstacle;
+  fmt::print(stderr, "fleetmap: {}: no path on the merged map: {}\n",
+             bad_point ? (at_start ? "--plan-from " + f.plan_from : "--plan-to " + f.plan_to) : "--plan-from/--plan-to",
+             plan->detail);
+  return bad_point ? 2 : 1;
+}
+
+// Debug (--merge-attempts): the two maps of every merge attempt, as the aligner saw them, and
+// attempts.csv; a folder of its own, since how many attempts a run makes is known only at its end.
+class MergeAttempts {
+ public:
+  MergeAttempts(const fs::path& dir, const fs::path& out, const std::vector<fs::path>& inputs)
+      : folder_(checked(dir, out), "explore --merge-attempts", {"attempts.csv"}, inputs,
+                "--merge-attempts " + dir.string()) {}
+
+  void claim() { folder_.claim(); }
+
+  void add(const sim::MergeRecord& m, const mapping::OccupancyGrid& receiver, const mapping::OccupancyGrid& sender) {
+    const std::string stem = fmt::format("step{:05d}_robot{}_robot{}", m.step, m.receiver + 1, m.sender + 1);
+    const std::string rname = stem + "_receiver", sname = stem + "_sender";
+    for (const auto& [name, map] : {std::pair{rname, &receiver}, std::pair{sname, &sender}}) {
+      io::save_map_yaml(*map, folder_.dir() / (name + ".yaml"));
+      files_.push_back(name + ".yaml");
+      files_.push_back(name + ".pgm");
+    }
+    std::string reason = m.reason;
+    std::replace(reason.begin(), reason.end(), '"', '\'');
+    csv_ += fmt::format("{},{},{},{},{},{:.4f},{:.3f},{:.4f},{}.yaml,{}.yaml,\"{}\"\n", m.step, m.receiver + 1,
+                        m.sender + 1, m.method, int(m.merged), m.confidence, m.rotation_error_deg, m.position_error_m,
+                        rname, sname, reason);
+  }
+
+  void finish() {
+    io::write_file_atomic(folder_.dir() / "attempts.csv", csv_);
+    files_.push_back("attempts.csv");
+    folder_.finish(files_);
+  }
+
+ private:
+  static const fs::path& checked(const fs::path& dir, const fs::path& out) {
+    if (fs::weakly_canonical(dir) == fs::weakly_canonical(out))
+      throw InputError("--merge-attempts " + dir.string() + ": give a folder other than --out");
+    return dir;
+  }
+
+  io::OutputFolder folder_;
+  std::vector<std::string> files_;
+  std::string csv_ =
+      "step,receiver,sender,method,merged,confidence,rotation_error_deg,position_error_m,receiver_map,sender_map,reason\n";
+};
+
+int run_explore(const ExploreFlags& f) {
+  sim::Scenario s = scenario_from(f);
+  const std::optional<PlanRequest> request = plan_request(f);
+
+  // Every output is checked before anything is read or run; nothing is written on bad input.
+  const ExploreOutputs o = explore_outputs(f, s, request.has_value());
+  const std::string& label = o.label;
+  const fs::path& out = o.out;
+  const std::string& video_name = o.video_name;
+  io::OutputFolder folder(out, "explore", o.files, o.inputs, "--out " + out.string());
+  std::optional<MergeAttempts> attempts;
+  if (!f.merge_attempts.empty()) attempts.emplace(f.merge_attempts, out, o.inputs);
+  auto truth = load_truth(f, s);
 
   // Placing the robots is where a scenario meets its map: errors name the scenario, or the map.
   std::optional<sim::Simulation> made;
   sim::SimulationSetup setup;
-  std::vector<std::string> attempt_files;
-  std::string attempts_csv = "step,receiver,sender,method,merged,confidence,rotation_error_deg,position_error_m,receiver_map,sender_map,reason\n";
-  if (attempts_folder) {
+  if (attempts) {
     setup.on_merge_attempt = [&](const sim::MergeRecord& m, const mapping::OccupancyGrid& receiver,
-                                 const mapping::OccupancyGrid& sender) {
-      const std::string stem = fmt::format("step{:05d}_robot{}_robot{}", m.step, m.receiver + 1, m.sender + 1);
-      const std::string rname = stem + "_receiver", sname = stem + "_sender";
-      for (const auto& [name, map] : {std::pair{rname, &receiver}, std::pair{sname, &sender}}) {
-        io::save_map_yaml(*map, attempts_folder->dir() / (name + ".yaml"));
-        attempt_files.push_back(name + ".yaml");
-        attempt_files.push_back(name + ".pgm");
-      }
-      std::string reason = m.reason;
-      std::replace(reason.begin(), reason.end(), '"', '\'');
-      attempts_csv += fmt::format("{},{},{},{},{},{:.4f},{:.3f},{:.4f},{}.yaml,{}.yaml,\"{}\"\n", m.step, m.receiver + 1,
-                                  m.sender + 1, m.method, int(m.merged), m.confidence, m.rotation_error_deg,
-                                  m.position_error_m, rname, sname, reason);
-    };
+                                 const mapping::OccupancyGrid& sender) { attempts->add(m, receiver, sender); };
   }
   try {
     made.emplace(s, std::move(truth), std::move(setup));
@@ -249,7 +308,7 @@ int run_explore(const ExploreFlags& f) {
     throw InputError((f.scenario.empty() ? s.map : f.scenario) + ": " + e.what());
   }
   folder.claim();
-  if (attempts_folder) attempts_folder->claim();
+  if (attempts) attempts->claim();
   sim::Simulation& simulation = *made;
   ProgressBar bar(!f.quiet);
   std::unique_ptr<sim::RunVideo> video;
@@ -285,26 +344,10 @@ int run_explore(const ExploreFlags& f) {
     if (!video->fallback_note().empty()) fmt::print(stderr, "fleetmap: {}: {}\n", video_name, video->fallback_note());
   }
   folder.finish(io::OutputFolder::names(written));
-  if (attempts_folder) {
-    io::write_file_atomic(attempts_folder->dir() / "attempts.csv", attempts_csv);
-    attempt_files.push_back("attempts.csv");
-    attempts_folder->finish(attempt_files);
-  }
-  // A plan that failed: the run's outputs are written; the plan's problem gets one line.
-  const auto plan_exit = [&]() {
-    if (!plan || plan->success()) return 0;
-    using planning::PlanStatus;
-    const bool bad_point = plan->status == PlanStatus::StartOutsideMap || plan->status == PlanStatus::StartInObstacle ||
-                           plan->status == PlanStatus::GoalOutsideMap || plan->status == PlanStatus::GoalInObstacle;
-    const bool at_start = plan->status == PlanStatus::StartOutsideMap || plan->status == PlanStatus::StartInObstacle;
-    fmt::print(stderr, "fleetmap: {}: no path on the merged map: {}\n",
-               bad_point ? (at_start ? "--plan-from " + f.plan_from : "--plan-to " + f.plan_to) : "--plan-from/--plan-to",
-               plan->detail);
-    return bad_point ? 2 : 1;
-  };
+  if (attempts) attempts->finish();
   if (f.quiet) {
     fmt::print("{}\n", (out / "merged.png").string());
-    return plan_exit();
+    return plan_exit_code(f, plan);
   }
   print_summary(result, label);
   if (plan && plan->success()) {
@@ -315,7 +358,7 @@ int run_explore(const ExploreFlags& f) {
   std::string names;
   for (const auto& p : written) names += " " + p.filename().string();
   fmt::print("all outputs in {}/:{}\n", out.string(), names);
-  return plan_exit();
+  return plan_exit_code(f, plan);
 }
 
 }  // namespace

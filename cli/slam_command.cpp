@@ -15,6 +15,7 @@
 #include "cli/landmark_command.h"
 #include "cli/progress.h"
 #include "cli/validators.h"
+#include "core/format.h"
 #include "core/parallel.h"
 #include "io/file_io.h"
 #include "core/error.h"
@@ -40,11 +41,7 @@ struct SlamFlags {
   bool exact_start = false;
 };
 
-std::string method_names() {
-  std::string names;
-  for (const auto& n : experiments::slam_method_names()) names += (names.empty() ? "" : ", ") + n;
-  return names;
-}
+std::string method_names() { return core::join(experiments::slam_method_names()); }
 
 int run_slam(const SlamFlags& f) {
   const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/format.h"
 #include "core/error.h"
 #include "io/file_io.h"
 #include "sim/scenario.h"
@@ -23,9 +24,7 @@ void apply_sweep_flags(sweep::Sweep& sweep, const SweepFlags& f) {
   if (f.merging) {
     const auto names = sim::merging_names();
     if (std::find(names.begin(), names.end(), *f.merging) == names.end()) {
-      std::string valid;
-      for (const auto& n : names) valid += (valid.empty() ? "" : ", ") + n;
-      throw InputError("--merging: unknown mode '" + *f.merging + "' (valid: " + valid + ")");
+      throw InputError("--merging: unknown mode '" + *f.merging + "' (valid: " + core::join(names) + ")");
     }
     sweep.base.merging = *f.merging;
   }

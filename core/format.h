@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "core/grid_geometry.h"
 
@@ -36,6 +38,11 @@ inline std::string fixed(double v, int decimals) {
 inline std::string exact(double v) {
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
   return fmt::format("{}", v);
+}
+
+// "a, b, c": the items with `separator` between them.
+inline std::string join(const std::vector<std::string>& items, std::string_view separator = ", ") {
+  return fmt::format("{}", fmt::join(items, separator));
 }
 
 }  // namespace fleetmap::core

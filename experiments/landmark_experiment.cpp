@@ -1,8 +1,7 @@
 #include "experiments/landmark_experiment.h"
 
-#include <algorithm>
 #include <cmath>
-#include <map>
+#include <memory>
 #include <set>
 
 #include <fmt/format.h>
@@ -12,10 +11,9 @@
 #include "core/parallel.h"
 #include "core/random.h"
 #include "experiments/slam_experiment.h"
-#include "localization/ekf_models.h"
 #include "localization/fastslam2.h"
 #include "merging/rendezvous.h"
-#include "sim/world.h"
+#include "sim/simulation.h"
 
 namespace fleetmap::experiments {
 
@@ -105,153 +103,197 @@ void landmark_rms(const merging::LandmarkMap& map, const std::vector<int>& ids, 
 
 }  // namespace
 
-LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const LandmarkCase& c, int run,
-                                  std::optional<double> range_noise) {
-  const LandmarkWorld w = make_landmark_world(o, c.fields.empty() ? o.fields : c.fields);
-  sim::LandmarkSensorOptions sensor = o.sensor;
-  sim::RobotDetectorOptions camera = o.camera;
-  sim::RobotOptions robot = o.robot;
-  robot.max_speed_mps = o.speed_mps;
-  if (range_noise) sensor.range_noise_m = camera.range_noise_m = *range_noise;
-  const sim::World world(open_ground(w, c), w.landmarks);
-  const core::Random base = core::Random(o.seed).fork(std::uint64_t(run) + 1);
-  const int n = int(c.robots.size());
+namespace {
 
-  localization::FastSlam2Options f;
-  f.particles = o.particles;
-  f.process_noise = Eigen::Vector3d(o.noise.position_m * o.noise.position_m, o.noise.position_m * o.noise.position_m,
-                                    o.noise.heading_rad * o.noise.heading_rad)
-                        .asDiagonal();
-  f.measurement_noise = Eigen::Vector2d(std::max(sensor.range_noise_m, localization::kMinMeasurementStd) *
-                                            std::max(sensor.range_noise_m, localization::kMinMeasurementStd),
-                                        std::max(sensor.bearing_noise_rad, localization::kMinMeasurementStd) *
-                                            std::max(sensor.bearing_noise_rad, localization::kMinMeasurementStd))
-                            .asDiagonal();
+// The filter of robot i: the registered `fastslam2` localizer (both of its maps are measured).
+const localization::FastSlam2& filter_of(const sim::Simulation& s, int i) {
+  return localization::fastslam2_filter(s.localizer(i));
+}
 
-  std::vector<core::Pose2> truth, odometry(static_cast<std::size_t>(n));
-  std::vector<std::vector<localization::Odometry>> commands;
-  std::vector<localization::FastSlam2> filters;
-  std::vector<core::Random> motion_rng, sensor_rng, camera_rng;
-  LandmarkCaseRun out;
-  out.case_name = c.name;
-  out.run = run;
-  out.range_noise = sensor.range_noise_m;
-  out.truth_paths.resize(static_cast<std::size_t>(n));
-  const core::Transform2 leader_from_world = c.robots[0].start.as_transform().inverse();
-  for (int i = 0; i < n; ++i) {
-    const auto& r = c.robots[std::size_t(i)];
-    truth.push_back(r.start);
-    commands.push_back(path_commands(r.start, r.path, o.speed_mps, c.steps, o.period_s, robot.max_turn_rate_rps));
-    // Each robot's map frame is its start: it knows its pose there exactly.
-    filters.emplace_back(core::Pose2(), Eigen::Matrix3d::Zero(), f, base.fork(100 + std::uint64_t(i)).seed());
-    motion_rng.push_back(base.fork(200 + std::uint64_t(i)));
-    sensor_rng.push_back(base.fork(300 + std::uint64_t(i)));
-    camera_rng.push_back(base.fork(400 + std::uint64_t(i)));
-    out.truth_paths[std::size_t(i)].push_back(core::Pose2::from_transform(leader_from_world * r.start.as_transform()));
-  }
-  for (const auto& p : w.landmarks) out.truth_in_leader.push_back(leader_from_world.apply(p));
+// What the leader (robot 0) does at a rendezvous: every follower reports its maps, pose and
+// observation; both alignment methods are measured on both kinds of map, and the leader's global
+// map grows by each follower's map aligned by the method Fig. 3 chooses (§VI, Fig. 9).
+class Leader {
+ public:
+  Leader(const LandmarkExperimentOptions& o, const LandmarkCase& c, const LandmarkWorld& w, const core::Random& base,
+         LandmarkCaseRun& out)
+      : o_(o), c_(c), w_(w), base_(base), out_(out) {}
 
-  // The true start of robot i in robot j's frame, and a pose in the world in robot i's frame.
-  const auto frame_of = [&](int i) { return c.robots[std::size_t(i)].start.as_transform(); };
-  const auto in_own_frame = [&](int i, const core::Pose2& p) {
-    return core::Pose2::from_transform(frame_of(i).inverse() * p.as_transform());
-  };
-
-  std::size_t next_meeting = 0;
-  for (int k = 1; k <= c.steps; ++k) {
-    for (int i = 0; i < n; ++i) {
-      const auto& u = commands[std::size_t(i)][std::size_t(k - 1)];
-      const sim::MoveResult mv = sim::move_robot(world, i, truth, robot, {u.v, u.omega}, o.period_s, o.noise,
-                                                 motion_rng[std::size_t(i)]);
-      truth[std::size_t(i)] = mv.pose;
-      odometry[std::size_t(i)] = localization::integrate_motion(odometry[std::size_t(i)], mv.odometry);
-      auto& filter = filters[std::size_t(i)];
-      filter.predict(mv.odometry);
-      filter.update(sim::read_landmarks(world, mv.pose, sensor, sensor_rng[std::size_t(i)]));
-      out.truth_paths[std::size_t(i)].push_back(core::Pose2::from_transform(leader_from_world * mv.pose.as_transform()));
-    }
-    if (next_meeting >= c.rendezvous.size() || c.rendezvous[next_meeting] != k) continue;
-    ++next_meeting;
-
-    // The rendezvous: every follower reports its maps, pose and observation to the leader.
-    const auto maps_of = [&](int i, localization::ParticleMap which) {
-      return landmark_map(filters[std::size_t(i)].map(which), w, o.signature_noise, base.fork(500 + std::uint64_t(i)));
-    };
-    std::vector<std::vector<sim::Detection>> seen(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) seen[std::size_t(i)] = sim::detect_robots(world, i, truth, camera, camera_rng[std::size_t(i)]);
-    const auto find = [&](int a, int b) -> const sim::Detection* {
-      for (const auto& d : seen[std::size_t(a)]) {
-        if (d.other == b) return &d;
-      }
-      return nullptr;
-    };
-    RobotLandmarkMap global = maps_of(0, localization::ParticleMap::Combined);
+  void meet(const sim::Simulation& s) {
+    const int k = s.step_count(), n = int(c_.robots.size());
+    RobotLandmarkMap global = maps_of(s, 0, localization::ParticleMap::Combined);
     std::vector<int> source(global.ids.size(), 0);
     for (int j = 1; j < n; ++j) {
-      const sim::Detection* lj = find(0, j);
-      const sim::Detection* jl = find(j, 0);
+      const sim::Detection* lj = s.detection(0, j);
+      const sim::Detection* jl = s.detection(j, 0);
       if (!lj || !jl) {
+        const auto truth = s.true_poses();
         throw InputError(fmt::format("case '{}': robots {} and {} do not see each other at the rendezvous of step {} ({:.1f} m "
                                      "apart, camera range {:g} m): move their paths' ends closer",
-                                     c.name, c.robots[0].name, c.robots[std::size_t(j)].name, k,
-                                     (truth[0].position() - truth[std::size_t(j)].position()).norm(), camera.max_range_m));
+                                     c_.name, c_.robots[0].name, c_.robots[std::size_t(j)].name, k,
+                                     (truth[0].position() - truth[std::size_t(j)].position()).norm(),
+                                     s.scenario().detector.max_range_m));
       }
       FollowerReport rep;
       rep.step = k;
-      rep.leader = c.robots[0].name;
-      rep.follower = c.robots[std::size_t(j)].name;
+      rep.leader = c_.robots[0].name;
+      rep.follower = c_.robots[std::size_t(j)].name;
       rep.truth = frame_of(0).inverse() * frame_of(j);
-      core::Random ransac = base.fork(600 + std::uint64_t(j) + 10 * std::uint64_t(k));
+      core::Random ransac = base_.fork(600 + std::uint64_t(j) + 10 * std::uint64_t(k));
       for (int kind = 0; kind < 2; ++kind) {
         const auto which = kind == 0 ? localization::ParticleMap::MaxWeight : localization::ParticleMap::Combined;
-        const RobotLandmarkMap self = maps_of(0, which), other = maps_of(j, which);
+        const RobotLandmarkMap self = maps_of(s, 0, which), other = maps_of(s, j, which);
         // Each map with the pose that goes with it (the maximum-weight particle's, or the mean).
-        const merging::Rendezvous meeting{filters[0].pose(which), filters[std::size_t(j)].pose(which),
+        const merging::Rendezvous meeting{filter_of(s, 0).pose(which), filter_of(s, j).pose(which),
                                           {lj->range, lj->bearing, jl->range, jl->bearing}};
         const auto evaluate = [&](MethodOutcome& m, const std::optional<core::Transform2>& t) {
           m.transform = t;
           if (!t) return;
           m.error = transform_error(*t, rep.truth);
-          const auto merged = merging::merge_landmark_maps(self.map, other.map, *t, o.alignment);
-          landmark_rms(merged.merged, merged_ids(merged, self, other, *t), out.truth_in_leader, m.landmark_rms_x,
+          const auto merged = merging::merge_landmark_maps(self.map, other.map, *t, o_.alignment);
+          landmark_rms(merged.merged, merged_ids(merged, self, other, *t), out_.truth_in_leader, m.landmark_rms_x,
                        m.landmark_rms_y);
         };
-        const auto da = merging::align_landmarks(self.map, other.map, o.alignment, ransac);
+        const auto da = merging::align_landmarks(self.map, other.map, o_.alignment, ransac);
         evaluate(rep.data_association[kind], da.found ? std::optional(da.transform) : std::nullopt);
         evaluate(rep.observation[kind],
                  merging::rendezvous_transform(meeting.self_pose, meeting.other_pose, meeting.observation));
         if (kind == 1) {
           const std::set<int> mine(self.ids.begin(), self.ids.end());
           for (int id : other.ids) rep.shared += int(mine.count(id));
-          rep.choice = merging::align_landmark_maps(self.map, other.map, meeting, o.alignment, ransac);
+          rep.choice = merging::align_landmark_maps(self.map, other.map, meeting, o_.alignment, ransac);
           rep.overlap = rep.choice.overlapping_landmarks;
-          if (rep.choice.transform) {
-            // The leader's global map grows by this follower's map (§VI, Fig. 9).
-            const RobotLandmarkMap before = global;
-            const auto merged = merging::merge_landmark_maps(global.map, other.map, *rep.choice.transform, o.alignment);
-            const auto ids = merged_ids(merged, before, other, *rep.choice.transform);
-            std::vector<int> src = source;
-            // Fused entries (self's, changed by the fusion) are marked -1.
-            for (std::size_t s = 0; s < before.map.landmarks.size(); ++s) {
-              if (merged.merged.landmarks[s].position != before.map.landmarks[s].position) src[s] = -1;
-            }
-            for (std::size_t s = before.ids.size(); s < ids.size(); ++s) src.push_back(j);
-            global.map = merged.merged;
-            global.ids = ids;
-            source = src;
-          }
+          if (rep.choice.transform) grow(global, source, other, j, *rep.choice.transform);
         }
       }
       rep.global_landmarks = int(global.map.landmarks.size());
-      out.reports.push_back(std::move(rep));
+      out_.reports.push_back(std::move(rep));
     }
-    out.global = global.map;
-    out.global_source = source;
+    out_.global = global.map;
+    out_.global_source = source;
   }
+
+ private:
+  core::Transform2 frame_of(int i) const { return c_.robots[std::size_t(i)].start.as_transform(); }
+
+  RobotLandmarkMap maps_of(const sim::Simulation& s, int i, localization::ParticleMap which) const {
+    return landmark_map(filter_of(s, i).map(which), w_, o_.signature_noise, base_.fork(500 + std::uint64_t(i)));
+  }
+
+
+  // The global map with follower j's map fused in; fused entries (the leader's, changed by the
+  // fusion) are marked -1 in `source`.
+  void grow(RobotLandmarkMap& global, std::vector<int>& source, const RobotLandmarkMap& other, int j,
+            const core::Transform2& t) const {
+    const RobotLandmarkMap before = global;
+    const auto merged = merging::merge_landmark_maps(global.map, other.map, t, o_.alignment);
+    const auto ids = merged_ids(merged, before, other, t);
+    for (std::size_t s = 0; s < before.map.landmarks.size(); ++s) {
+      if (merged.merged.landmarks[s].position != before.map.landmarks[s].position) source[s] = -1;
+    }
+    for (std::size_t s = before.ids.size(); s < ids.size(); ++s) source.push_back(j);
+    global.map = merged.merged;
+    global.ids = ids;
+  }
+
+  const LandmarkExperimentOptions& o_;
+  const LandmarkCase& c_;
+  const LandmarkWorld& w_;
+  const core::Random& base_;
+  LandmarkCaseRun& out_;
+};
+
+}  // namespace
+
+// One run on the simulator: each robot driven by its precomputed commands (sim::CommandScript), in
+// its own frame (its start, known exactly), with the registered `fastslam2` localizer; the observer
+// records the true paths and lets the leader gather the reports at the case's rendezvous steps.
+LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const LandmarkCase& c, int run,
+                                  std::optional<double> range_noise) {
+  const LandmarkWorld w = make_landmark_world(o, c.fields.empty() ? o.fields : c.fields);
+  const core::Random base = core::Random(o.seed).fork(std::uint64_t(run) + 1);
+  const int n = int(c.robots.size());
+
+  sim::Scenario scenario;
+  scenario.seed = base.seed();  // every stream the run uses is given below
+  scenario.steps = c.steps;
+  scenario.period_s = o.period_s;
+  scenario.placement = sim::Placement::List;
+  scenario.robot = o.robot;
+  scenario.robot.max_speed_mps = o.speed_mps;
+  scenario.noise = o.noise;
+  scenario.landmark_sensor = o.sensor;
+  scenario.detector = o.camera;
+  if (range_noise) scenario.landmark_sensor.range_noise_m = scenario.detector.range_noise_m = *range_noise;
+  scenario.landmarks = w.landmarks;
+  // The ground is open: the range sensor (one short beam) never meets anything, so it draws no noise.
+  scenario.range.angles_rad = {0.0};
+  scenario.range.max_range_m = 1.0;
+  scenario.localization = "fastslam2";
+  scenario.localization_options.fastslam_particles = o.particles;
+  scenario.merging = "rendezvous";       // each robot maps in its own frame, its start
+  scenario.communication.range_m = 0.0;  // robots talk when they see each other
+  sim::SimulationSetup how;
+  how.measure_coverage = false;
+  // No frame alignment or grid exchange when robots see each other: the leader gathers the
+  // followers' maps at the case's rendezvous steps (the observer below).
+  how.on_meeting = [](sim::Simulation&, int, int) {};
   for (int i = 0; i < n; ++i) {
-    const core::Pose2 t = in_own_frame(i, truth[std::size_t(i)]);
-    out.final_position_error.push_back((filters[std::size_t(i)].pose().position() - t.position()).norm());
-    out.odometry_position_error.push_back((odometry[std::size_t(i)].position() - t.position()).norm());
+    const auto& r = c.robots[std::size_t(i)];
+    scenario.starts.push_back(r.start);
+    sim::RobotSetup rs;
+    std::vector<sim::Command> commands;
+    for (const auto& u : path_commands(r.start, r.path, o.speed_mps, c.steps, o.period_s, scenario.robot.max_turn_rate_rps))
+      commands.push_back({u.v, u.omega});
+    rs.driver = std::make_shared<sim::CommandScript>(std::move(commands));
+    const std::uint64_t seed = base.fork(100 + std::uint64_t(i)).seed();
+    rs.localizer = [seed](const localization::LocalizerContext& context) {
+      localization::LocalizerContext own = context;
+      own.initial_pose = core::Pose2();  // its map frame is its start: it knows its pose there exactly
+      own.options.initial_xy = own.options.initial_theta = 0.0;
+      own.seed = seed;
+      return localization::make_localizer("fastslam2", own);
+    };
+    rs.motion_rng = std::make_shared<core::Random>(base.fork(200 + std::uint64_t(i)));
+    rs.sensor_rng = std::make_shared<core::Random>(base.fork(300 + std::uint64_t(i)));
+    rs.detector_rng = std::make_shared<core::Random>(base.fork(400 + std::uint64_t(i)));
+    how.robots.push_back(std::move(rs));
+  }
+  scenario.robot_count = n;
+
+  LandmarkCaseRun out;
+  out.case_name = c.name;
+  out.run = run;
+  out.range_noise = scenario.landmark_sensor.range_noise_m;
+  out.truth_paths.resize(static_cast<std::size_t>(n));
+  const core::Transform2 leader_from_world = c.robots[0].start.as_transform().inverse();
+  for (const auto& p : w.landmarks) out.truth_in_leader.push_back(leader_from_world.apply(p));
+  Leader leader(o, c, w, base, out);
+  std::size_t next_meeting = 0;
+  const auto observe = [&](const sim::Simulation& s) {
+    const auto truth = s.true_poses();
+    for (int i = 0; i < n; ++i) {
+      out.truth_paths[std::size_t(i)].push_back(
+          core::Pose2::from_transform(leader_from_world * truth[std::size_t(i)].as_transform()));
+    }
+    if (next_meeting < c.rendezvous.size() && c.rendezvous[next_meeting] == s.step_count()) {
+      ++next_meeting;
+      leader.meet(s);
+    }
+  };
+  sim::Simulation simulation(scenario, open_ground(w, c), std::move(how));
+  simulation.run_to_end({}, observe);
+
+  const auto truth = simulation.true_poses();
+  for (int i = 0; i < n; ++i) {
+    // Errors in the robot's own frame: its filter's pose, and dead reckoning of what its encoders reported.
+    const Eigen::Vector2d t =
+        core::Pose2::from_transform(c.robots[std::size_t(i)].start.as_transform().inverse() * truth[std::size_t(i)].as_transform())
+            .position();
+    core::Pose2 odometry;
+    for (const auto& u : simulation.track(i).odometry) odometry = localization::integrate_motion(odometry, u);
+    out.final_position_error.push_back((filter_of(simulation, i).pose().position() - t).norm());
+    out.odometry_position_error.push_back((odometry.position() - t).norm());
   }
   return out;
 }

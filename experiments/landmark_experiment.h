@@ -16,6 +16,10 @@
 //    (candidate matches by signature, threshold 10), for 2 robots meeting twice and 4 robots
 //    meeting the leader, with the transforms as the paper prints them.
 //
+// A run is a sim::Simulation set up for it: each robot driven by its precomputed commands
+// (sim::CommandScript) in its own frame, with the registered `fastslam2` localizer; an observer
+// lets the leader gather the followers' reports at the case's rendezvous steps.
+//
 // Landmarks carry a signature (the paper's width, height): two numbers drawn once per landmark
 // and read with a little noise, which is what candidate matches compare (th_s).
 #include <Eigen/Core>

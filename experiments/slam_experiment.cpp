@@ -13,7 +13,7 @@
 #include "core/angle.h"
 #include "core/error.h"
 #include "core/random.h"
-#include "localization/polynomial_slam.h"
+#include "localization/polynomial_localizer.h"
 #include "merging/polynomial_exchange.h"
 #include "sim/simulation.h"
 
@@ -121,37 +121,13 @@ SlamSetup prepare_slam(const SlamScenario& scenario) {
 
 namespace {
 
-// D'Alfonso et al.'s filter as the simulator's localizer for this experiment: the scenario's
-// `polynomial:` options, P0 and Q, every distance sensor's reading, and the filter within reach of
-// the rendezvous exchange (§3.2).
-class TeamPolynomialSlam final : public localization::Localizer {
- public:
-  TeamPolynomialSlam(const core::Pose2& start, const Eigen::Matrix3d& p0, const Eigen::Matrix3d& q,
-                     const localization::PolynomialSlamOptions& options)
-      : slam_(start, p0, q, options) {}
-
-  std::string name() const override { return "polynomial"; }
-  void predict(const localization::Odometry& u) override { slam_.predict(u); }
-  void update_scan(const localization::RangeScan& scan, const mapping::OccupancyGrid& /*own_map*/) override {
-    slam_.update(scan.angles, scan.ranges);
-  }
-  void change_frame(const core::Transform2& new_from_old) override { slam_.change_frame(new_from_old); }
-  core::Pose2 pose() const override { return slam_.pose(); }
-  Eigen::Matrix3d covariance() const override { return slam_.pose_covariance(); }
-
-  localization::PolynomialSlam& slam() { return slam_; }
-  const localization::PolynomialSlam& slam() const { return slam_; }
-
- private:
-  localization::PolynomialSlam slam_;
-};
-
+// Each robot's localizer is the `polynomial` one, built with the scenario's options (below).
 const localization::PolynomialSlam& filter_of(const sim::Simulation& s, int robot) {
-  return dynamic_cast<const TeamPolynomialSlam&>(s.localizer(robot)).slam();
+  return dynamic_cast<const localization::PolynomialLocalizer&>(s.localizer(robot)).slam();
 }
 
 localization::PolynomialSlam& filter_of(sim::Simulation& s, int robot) {
-  return dynamic_cast<TeamPolynomialSlam&>(s.localizer(robot)).slam();
+  return dynamic_cast<localization::PolynomialLocalizer&>(s.localizer(robot)).slam();
 }
 
 // The smallest grid at the room's resolution that holds the whole room in the frame of a robot
@@ -182,8 +158,8 @@ class PolynomialExchange {
   // A rendezvous is the step two robots start seeing each other (a choice: the paper does not say
   // how often robots that keep seeing each other exchange).
   void operator()(sim::Simulation& s, int a, int b) {
-    const sim::Detection* ab = seen(s, a, b);
-    const sim::Detection* ba = seen(s, b, a);
+    const sim::Detection* ab = s.detection(a, b);
+    const sim::Detection* ba = s.detection(b, a);
     if (!enabled_ || ab == nullptr || ba == nullptr) return;
     struct Outgoing {
       int from, to;
@@ -212,7 +188,7 @@ class PolynomialExchange {
       outgoing.push_back({l, j, std::move(m)});
     }
     for (const auto& o : outgoing) {
-      const sim::Detection* seen_jl = seen(s, o.to, o.from);
+      const sim::Detection* seen_jl = s.detection(o.to, o.from);
       merging::ExchangeOptions options;
       options.segment_tolerance = sc_.segment_tolerance_m;
       options.range_noise = sc_.camera.range_noise_m;
@@ -233,13 +209,6 @@ class PolynomialExchange {
   double seconds(int a) const { return seconds_[std::size_t(a)]; }
 
  private:
-  static const sim::Detection* seen(const sim::Simulation& s, int a, int b) {
-    for (const auto& d : s.detections(a)) {
-      if (d.other == b) return &d;
-    }
-    return nullptr;
-  }
-
   const SlamScenario& sc_;
   const std::vector<int>& team_;
   bool enabled_;
@@ -302,9 +271,11 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
     std::vector<sim::Command> commands;
     for (const auto& u : setup.commands[std::size_t(r)]) commands.push_back({u.v, u.omega});
     rs.driver = std::make_shared<sim::CommandScript>(std::move(commands));
-    // The simulator's initial pose is x_j,0 in the robot's own frame; the filter starts there or at the draw.
+    // The simulator's initial pose is x_j,0 in the robot's own frame; the filter starts there or at
+    // the draw, with the scenario's `polynomial:` options, P0 and Q, reading every distance sensor.
     rs.localizer = [&, start_estimate](const localization::LocalizerContext& c) {
-      return std::make_unique<TeamPolynomialSlam>(c.initial_pose.compose(start_estimate), p0, q, sc.polynomial);
+      return std::make_unique<localization::PolynomialLocalizer>(c.initial_pose.compose(start_estimate), p0, q,
+                                                                 sc.polynomial);
     };
     // Streams by the robot's index in the scenario, so that a robot alone has its noise in the team.
     rs.motion_rng = std::make_shared<core::Random>(run_rng.fork(100 + std::uint64_t(r)));
@@ -379,23 +350,29 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
   return result;
 }
 
-using SlamMethod = std::function<SlamRunResult(const SlamSetup&, int, bool, int)>;
-
-// The SLAM methods by name: one row per name of slam_method_names().
-const std::vector<std::pair<std::string, SlamMethod>>& slam_methods() {
-  static const std::vector<std::pair<std::string, SlamMethod>> kMethods = {
-      {"polynomial", run_polynomial_slam},
-  };
-  return kMethods;
-}
-
 }  // namespace
 
+core::Registry<SlamMethod>& slam_method_registry() {
+  static core::Registry<SlamMethod> registry("SLAM method");
+  static const bool built_in = [] {
+    registry.add("polynomial",
+                 "D'Alfonso et al.'s polynomial EKF-SLAM, one filter per robot, polynomials exchanged at a rendezvous "
+                 "(§3.2)",
+                 run_polynomial_slam);
+    return true;
+  }();
+  (void)built_in;
+  return registry;
+}
+
+void register_slam_method(std::string name, std::string help, SlamMethod method) {
+  slam_method_registry().add(std::move(name), std::move(help), std::move(method));
+}
+
+std::vector<std::string> slam_method_names() { return slam_method_registry().names(); }
+
 SlamRunResult run_slam(const SlamSetup& setup, int run, bool exchange, int only) {
-  for (const auto& [name, method] : slam_methods()) {
-    if (name == setup.scenario.method) return method(setup, run, exchange, only);
-  }
-  throw InputError("method: no SLAM method is named '" + setup.scenario.method + "'");
+  return slam_method_registry().get(setup.scenario.method).make(setup, run, exchange, only);
 }
 
 }  // namespace fleetmap::experiments

@@ -5,14 +5,17 @@
 // against the truth: mu (the paper's form and the standard NEES), nu, tau, bytes per rendezvous.
 // A run is a sim::Simulation set up for it: each robot driven by its commands (sim::CommandScript),
 // in its own frame, with the filter as its localizer; a meeting handler exchanges the polynomials.
-// `method` picks the SLAM method through a table in slam_experiment.cpp.
+// `method` picks the SLAM method by name from slam_method_registry(): `polynomial`, and any a
+// program registers with register_slam_method.
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "core/registry.h"
 #include "core/transform2.h"
 #include "localization/localizer.h"
 #include "localization/metrics.h"
@@ -84,5 +87,16 @@ struct SlamRunResult {
 // without exchange has the same noise as the same run with it. `only` restricts the team to one
 // robot by index (-1: all), for the single-robot runs of D'Alfonso et al. Fig. 8.
 SlamRunResult run_slam(const SlamSetup& setup, int run, bool exchange, int only = -1);
+
+// A SLAM method: one run of the team as run_slam describes it (the scenario, its prepared room and
+// paths, the run index, exchange on or off, one robot by index or all with -1).
+using SlamMethod = std::function<SlamRunResult(const SlamSetup&, int run, bool exchange, int only)>;
+// Every SLAM method by name: the built-in `polynomial`, then those registered by the program.
+core::Registry<SlamMethod>& slam_method_registry();
+// Adds a method: a scenario's `method:` (and `fleetmap slam`) then reaches it. Throws Error when
+// the name is taken or unusable.
+void register_slam_method(std::string name, std::string help, SlamMethod method);
+// The registered names, in the order --help lists them.
+std::vector<std::string> slam_method_names();
 
 }  // namespace fleetmap::experiments

@@ -4,8 +4,10 @@
 #include <cctype>
 #include <cmath>
 
+#include "core/format.h"
 #include "core/angle.h"
 #include "core/error.h"
+#include "experiments/slam_experiment.h"
 #include "io/file_io.h"
 #include "io/yaml_reader.h"
 #include "sim/scenario.h"
@@ -56,8 +58,6 @@ std::pair<double, double> range_pair(io::YamlMap& m, const std::string& key, std
 }
 
 }  // namespace
-
-std::vector<std::string> slam_method_names() { return {"polynomial"}; }
 
 std::vector<mapping::WallSegment> room_walls(const SlamRoom& room) {
   std::vector<mapping::WallSegment> out;
@@ -201,10 +201,8 @@ SlamScenario load_slam_scenario(const std::filesystem::path& path) {
 }
 
 void validate_slam_scenario(const SlamScenario& s) {
-  if (std::find(slam_method_names().begin(), slam_method_names().end(), s.method) == slam_method_names().end()) {
-    std::string names;
-    for (const auto& n : slam_method_names()) names += (names.empty() ? "" : ", ") + n;
-    throw InputError("method: unknown value '" + s.method + "' (valid: " + names + ")");
+  if (const auto names = slam_method_names(); std::find(names.begin(), names.end(), s.method) == names.end()) {
+    throw InputError("method: unknown value '" + s.method + "' (valid: " + core::join(names) + ")");
   }
   if (s.runs < 1) throw InputError("runs: need at least one run, got " + std::to_string(s.runs));
   if (s.steps < 1) throw InputError("steps: need at least one step, got " + std::to_string(s.steps));

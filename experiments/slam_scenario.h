@@ -67,9 +67,6 @@ struct SlamScenario {
   localization::PolynomialSlamOptions polynomial;
 };
 
-// The SLAM methods `method` may name, in the order --help lists them.
-std::vector<std::string> slam_method_names();
-
 // Parses scenario YAML; `source` names it in errors.
 SlamScenario parse_slam_scenario(const std::string& text, const std::string& source);
 SlamScenario load_slam_scenario(const std::filesystem::path& path);

@@ -1,3 +1,6 @@
+// Over 500 lines on purpose: the two local searches (the longest tour, and the weighted latency)
+// make the same kinds of moves (insertion, relocate, exchange, 2-opt) on different objectives and
+// are kept side by side.
 #include "exploration/tour_planner.h"
 
 #include <algorithm>
@@ -13,8 +16,6 @@ namespace {
 
 constexpr int kStart = -1;  // the robot's own position, before its first target
 
-// The local search's state: the tours, their lengths, and costs with +inf replaced by a cost
-// above any tour without it, so that differences of lengths stay finite.
 // A leg cost no real tour can reach: unreachable legs cost this, so that any tour using one is worse
 // than every tour without.
 double impossible_cost(const TourProblem& p) {
@@ -27,6 +28,8 @@ double impossible_cost(const TourProblem& p) {
   return 1e6 * (largest + 1.0) * double(p.between.rows() + 1);
 }
 
+// The local search's state: the tours, their lengths, and costs with +inf replaced by a cost
+// above any tour without it, so that differences of lengths stay finite.
 class Search {
  public:
   Search(const TourProblem& p, const TourOptions& o) : p_(p), o_(o), n_(int(p.start_cost.rows())), m_(int(p.between.rows())) {

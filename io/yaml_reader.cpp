@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 
+#include "core/format.h"
 #include "core/error.h"
 
 namespace fleetmap::io {
@@ -133,9 +134,7 @@ std::string YamlMap::text(const std::string& key, const std::string& fallback) {
 std::string YamlMap::choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& valid) {
   const std::string v = text(key, fallback);
   if (std::find(valid.begin(), valid.end(), v) != valid.end()) return v;
-  std::string names;
-  for (const auto& s : valid) names += (names.empty() ? "" : ", ") + s;
-  throw InputError(where(key) + ": unknown value '" + v + "' (valid: " + names + ")");
+  throw InputError(where(key) + ": unknown value '" + v + "' (valid: " + core::join(valid) + ")");
 }
 
 std::vector<double> YamlMap::numbers(const std::string& key, std::size_t size) {

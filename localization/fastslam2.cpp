@@ -318,6 +318,7 @@ class FastSlam2Localizer final : public Localizer {
   }
 
   std::string name() const override { return "fastslam2"; }
+  const FastSlam2& filter() const { return filter_; }
   void predict(const Odometry& u) override { filter_.predict(u); }
   void update_landmarks(const std::vector<LandmarkObservation>& observations) override { filter_.update(observations); }
   core::Pose2 pose() const override { return filter_.pose(); }
@@ -340,6 +341,12 @@ class FastSlam2Localizer final : public Localizer {
 
 std::unique_ptr<Localizer> make_fastslam2_localizer(const LocalizerContext& context) {
   return std::make_unique<FastSlam2Localizer>(context);
+}
+
+const FastSlam2& fastslam2_filter(const Localizer& localizer) {
+  const auto* own = dynamic_cast<const FastSlam2Localizer*>(&localizer);
+  if (!own) throw Error("fastslam2_filter: the localizer is '" + localizer.name() + "', not fastslam2");
+  return own->filter();
 }
 
 }  // namespace fleetmap::localization

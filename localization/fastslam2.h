@@ -110,4 +110,8 @@ class FastSlam2 {
   long rejected_ = 0;
 };
 
+// The filter of the registered `fastslam2` localizer, for experiments that measure both of its maps
+// (the map-alignment paper, Table I). Throws Error for another localizer.
+const FastSlam2& fastslam2_filter(const Localizer& localizer);
+
 }  // namespace fleetmap::localization

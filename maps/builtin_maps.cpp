@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/format.h"
 #include "core/error.h"
 #include "core/random.h"
 #include "io/file_io.h"
@@ -414,11 +415,7 @@ std::vector<BuiltinMapInfo> builtin_maps() {
 
 bool is_builtin_map(std::string_view name) { return map_registry().contains(name); }
 
-std::string builtin_map_names() {
-  std::string s;
-  for (const auto& name : map_registry().names()) s += (s.empty() ? "" : ", ") + name;
-  return s;
-}
+std::string builtin_map_names() { return core::join(map_registry().names()); }
 
 GeneratedMap generate_builtin_map(std::string_view name) {
   for (const auto& g : generators()) {

@@ -32,13 +32,8 @@ void Simulation::try_merge(int i, int j) {
   request.sender_map = &s.map;
   request.receiver_pose = r.localizer->pose();
   request.sender_pose = s.localizer->pose();
-  const auto seen = [&](const Robot& a, int b) -> const Detection* {
-    for (const auto& d : a.detections)
-      if (d.other == b) return &d;
-    return nullptr;
-  };
-  const Detection* rs = seen(r, sender);
-  const Detection* sr = seen(s, receiver);
+  const Detection* rs = detection(receiver, sender);
+  const Detection* sr = detection(sender, receiver);
   if (rs != nullptr && sr != nullptr) request.detection = merging::MutualObservation{rs->range, rs->bearing, sr->range, sr->bearing};
   request.receiver_landmarks = r.localizer->landmark_estimates();
   request.sender_landmarks = s.localizer->landmark_estimates();

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include "core/format.h"
 #include "core/angle.h"
 #include "core/error.h"
 #include "io/file_io.h"
@@ -308,9 +309,7 @@ void validate_scenario(const Scenario& s) {
   check("map_resolution", s.map_resolution_m, io::kResolutionRange);
   const auto check_name = [](const std::string& key, const std::string& value, const std::vector<std::string>& valid) {
     if (std::find(valid.begin(), valid.end(), value) != valid.end()) return;
-    std::string names;
-    for (const auto& v : valid) names += (names.empty() ? "" : ", ") + v;
-    throw InputError(key + ": unknown value '" + value + "' (valid: " + names + ")");
+    throw InputError(key + ": unknown value '" + value + "' (valid: " + core::join(valid) + ")");
   };
   check_name("exploration.strategy", s.exploration.strategy, exploration::strategy_names());
   check_name("localization", s.localization, localization::localizer_names());

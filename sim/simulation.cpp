@@ -204,6 +204,13 @@ std::vector<core::Pose2> Simulation::estimated_poses() const {
   return out;
 }
 
+const Detection* Simulation::detection(int i, int other) const {
+  for (const Detection& d : robots_[std::size_t(i)].detections) {
+    if (d.other == other) return &d;
+  }
+  return nullptr;
+}
+
 bool Simulation::finished(int i) const {
   const Robot& r = robots_[std::size_t(i)];
   return r.driver ? !r.command.has_value() : explorer_.finished(i);
@@ -398,6 +405,7 @@ void Simulation::step() {
     }
     robot.truth = truths[std::size_t(i)] = mv.pose;
     auto& t = robot.track;
+    t.odometry.push_back(mv.odometry);
     t.distance_m += mv.distance_m;
     streak = mv.blocked ? streak + 1 : (streak >= 2 ? 0 : streak);
     if (streak > 3) streak = 0;  // the escape did not help either: follow the path again

@@ -34,6 +34,7 @@ struct RobotTrack {
   std::vector<core::Pose2> truth;     // one pose per step, from step 0
   std::vector<core::Pose2> estimate;
   std::vector<Eigen::Matrix3d> covariance;
+  std::vector<localization::Odometry> odometry;  // what its encoders reported, one per step from step 1
   double distance_m = 0.0;
   int blocked_moves = 0;
   double localization_s = 0.0;  // the localizer's time: predict and every update
@@ -180,6 +181,8 @@ class Simulation {
   localization::Localizer& localizer(int i) { return *robots_[std::size_t(i)].localizer; }
   // The robots robot i detected this step.
   const std::vector<Detection>& detections(int i) const { return robots_[std::size_t(i)].detections; }
+  // Robot i's detection of robot `other` this step, or null when i did not see it.
+  const Detection* detection(int i, int other) const;
   std::vector<Eigen::Vector2d> path(int i) const { return explorer_.path(i); }
   // Robot i ran out of reachable frontiers (for now: it resumes when its map grows), or its driver
   // has no command left.

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include "core/format.h"
 #include "core/error.h"
 #include "io/file_io.h"
 #include "io/yaml_reader.h"
@@ -40,11 +41,7 @@ std::vector<std::string> split_list(const std::string& text, const std::string& 
   return out;
 }
 
-std::string join(const std::vector<std::string>& items, const char* sep = ", ") {
-  std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : sep) + s;
-  return out;
-}
+using core::join;
 
 template <typename T>
 void check_unique(const std::vector<T>& items, const std::string& what) {

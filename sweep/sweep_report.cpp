@@ -71,11 +71,7 @@ viz::Color strategy_color(const std::vector<std::string>& strategies, const std:
   return viz::palette_color(int(std::find(strategies.begin(), strategies.end(), s) - strategies.begin()));
 }
 
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
+using core::join;
 
 std::size_t metric_index(const std::string& name) {
   const auto& m = report_metrics();

@@ -140,34 +140,24 @@ cv::Mat colorize(const mapping::OccupancyGrid& grid) {
   return img;
 }
 
-Picture draw_picture(const cv::Mat& base, const core::GridGeometry& geometry, const Overlays& overlays,
-                     const RenderOptions& options) {
-  if (base.empty() || base.type() != CV_8UC3 || base.cols != geometry.width() || base.rows != geometry.height()) {
-    throw Error("decorate: base image must be BGR with one pixel per grid cell");
-  }
-  const CellBox box = picture_cells(base, geometry, overlays, options);
-  const int longest = std::max(box.width(), box.height());
-  double scale = 1.0;
-  if (longest < options.target_size_px) scale = std::min(16, (options.target_size_px + longest - 1) / longest);
-  if (longest > options.max_size_px) scale = double(options.max_size_px) / longest;
+namespace {
 
-  // The cells of the box, one pixel each; cells beyond the grid in the "outside" colour.
+// The cells of the box, one pixel each (cells beyond the grid in the "outside" colour), with the
+// overlays' cell layers blended in at one pixel per cell, before scaling, so they stay crisp.
+cv::Mat box_cells(const cv::Mat& base, const core::GridGeometry& geometry, const CellBox& box, const Overlays& overlays,
+                  std::vector<LegendItem>& legend) {
   cv::Mat map(box.height(), box.width(), CV_8UC3, cv::Scalar(kOutside[0], kOutside[1], kOutside[2]));
-  {
-    const cv::Rect in_grid = cv::Rect(box.x0, box.y0, box.width(), box.height()) & cv::Rect(0, 0, geometry.width(), geometry.height());
-    if (in_grid.area() > 0) {
-      // Grid rows y0..y1 are image rows height-y1..height-y0 of the base, box.y1-y1.. of the map.
-      const cv::Rect src(in_grid.x, geometry.height() - (in_grid.y + in_grid.height), in_grid.width, in_grid.height);
-      const cv::Rect dst(in_grid.x - box.x0, box.y1 - (in_grid.y + in_grid.height), in_grid.width, in_grid.height);
-      base(src).copyTo(map(dst));
-    }
+  const cv::Rect in_grid = cv::Rect(box.x0, box.y0, box.width(), box.height()) & cv::Rect(0, 0, geometry.width(), geometry.height());
+  if (in_grid.area() > 0) {
+    // Grid rows y0..y1 are image rows height-y1..height-y0 of the base, box.y1-y1.. of the map.
+    const cv::Rect src(in_grid.x, geometry.height() - (in_grid.y + in_grid.height), in_grid.width, in_grid.height);
+    const cv::Rect dst(in_grid.x - box.x0, box.y1 - (in_grid.y + in_grid.height), in_grid.width, in_grid.height);
+    base(src).copyTo(map(dst));
   }
   const bool outside = box.x0 < 0 || box.y0 < 0 || box.x1 > geometry.width() || box.y1 > geometry.height();
-
-  // Cells are blended at one pixel per cell, before scaling, so they stay crisp.
-  std::vector<LegendItem> legend = {{LegendItem::Swatch, {205, 205, 205}, "unknown"},
-                                    {LegendItem::Swatch, {255, 255, 255}, "free"},
-                                    {LegendItem::Swatch, {0, 0, 0}, "occupied"}};
+  legend = {{LegendItem::Swatch, {205, 205, 205}, "unknown"},
+            {LegendItem::Swatch, {255, 255, 255}, "free"},
+            {LegendItem::Swatch, {0, 0, 0}, "occupied"}};
   if (outside) legend.push_back({LegendItem::Swatch, {kOutside[2], kOutside[1], kOutside[0]}, "outside the grid"});
   for (const auto& layer : overlays.cells) {
     const cv::Vec3d c(layer.color.b, layer.color.g, layer.color.r);
@@ -178,16 +168,18 @@ Picture draw_picture(const cv::Mat& base, const core::GridGeometry& geometry, co
     }
     if (!layer.label.empty()) legend.push_back({LegendItem::Swatch, layer.color, layer.label});
   }
-  cv::Mat img;
-  if (scale >= 1.0) cv::resize(map, img, {}, scale, scale, cv::INTER_NEAREST);
-  else cv::resize(map, img, {}, scale, scale, cv::INTER_AREA);
+  return map;
+}
 
+// Paths, points and poses on the scaled map `img`; lines and markers grow with the picture, so
+// they stay visible on large maps.
+void draw_shapes(cv::Mat& img, const core::GridGeometry& geometry, const CellBox& box, double scale,
+                 const Overlays& overlays, const RenderOptions& options, std::vector<LegendItem>& legend) {
   // Pixel position of a world point in `img`.
   const auto to_pixel = [&](const Eigen::Vector2d& p) {
     const Eigen::Vector2d g = geometry.world_to_grid(p);
     return cv::Point2d((g.x() - box.x0) * scale, (box.y1 - g.y()) * scale);
   };
-  // Lines and markers grow with the picture, so they stay visible on large maps.
   const int longest_px = std::max(img.cols, img.rows);
   const double grow = std::max(1.0, longest_px / 1600.0);
   const int min_marker = std::max(options.min_marker_px, int(std::lround(longest_px / 160.0)));
@@ -221,45 +213,109 @@ Picture draw_picture(const cv::Mat& base, const core::GridGeometry& geometry, co
     cv::line(img, rounded(c), rounded(tip), pose.start ? bgr(pose.color) : cv::Scalar(0, 0, 0), line, cv::LINE_AA);
     if (!pose.label.empty()) legend.push_back({pose.start ? LegendItem::Ring : LegendItem::Disc, pose.color, pose.label});
   }
+}
+
+constexpr double kTickFont = 0.45;
+
+// Metre ticks along the grid from its origin (world metres when the map is not turned).
+struct Axes {
+  std::vector<double> xticks, yticks;
+  int left = 0, bottom = 0;  // pixels their labels need
+};
+
+Axes axes_for(const cv::Mat& img, const core::GridGeometry& geometry, const CellBox& box) {
+  const auto metres_x = [&](double gx) { return geometry.origin().x + gx * geometry.resolution(); };
+  const auto metres_y = [&](double gy) { return geometry.origin().y + gy * geometry.resolution(); };
+  Axes a;
+  a.xticks = nice_ticks(metres_x(box.x0), metres_x(box.x1), std::max(2, img.cols / 110));
+  a.yticks = nice_ticks(metres_y(box.y0), metres_y(box.y1), std::max(2, img.rows / 90));
+  const double ystep = a.yticks.size() > 1 ? a.yticks[1] - a.yticks[0] : 1.0;
+  int label_w = 0;
+  for (double t : a.yticks) label_w = std::max(label_w, cv::getTextSize(tick_text(t, ystep), kFont, kTickFont, 1, nullptr).width);
+  a.left = label_w + 40;
+  a.bottom = 50;
+  return a;
+}
+
+void draw_axes(cv::Mat& out, const cv::Rect& map_area, const Axes& axes, const core::GridGeometry& geometry,
+               const CellBox& box, double scale) {
+  cv::rectangle(out, cv::Rect(map_area.x - 1, map_area.y - 1, map_area.width + 2, map_area.height + 2), cv::Scalar(0, 0, 0), 1);
+  const auto& xticks = axes.xticks;
+  const auto& yticks = axes.yticks;
+  const double xstep = xticks.size() > 1 ? xticks[1] - xticks[0] : 1.0, ystep = yticks.size() > 1 ? yticks[1] - yticks[0] : 1.0;
+  const int base_y = map_area.y + map_area.height;
+  for (double t : xticks) {
+    const int x = map_area.x + int(std::lround(((t - geometry.origin().x) / geometry.resolution() - box.x0) * scale));
+    if (x < map_area.x - 1 || x > map_area.x + map_area.width) continue;
+    cv::line(out, cv::Point(x, base_y), cv::Point(x, base_y + 5), cv::Scalar(0, 0, 0), 1);
+    const std::string text = tick_text(t, xstep);
+    const int w = cv::getTextSize(text, kFont, kTickFont, 1, nullptr).width;
+    cv::putText(out, text, cv::Point(x - w / 2, base_y + 20), kFont, kTickFont, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+  for (double t : yticks) {
+    const int y = map_area.y + int(std::lround((box.y1 - (t - geometry.origin().y) / geometry.resolution()) * scale));
+    if (y < map_area.y - 1 || y > base_y) continue;
+    cv::line(out, cv::Point(map_area.x - 6, y), cv::Point(map_area.x - 1, y), cv::Scalar(0, 0, 0), 1);
+    const std::string text = tick_text(t, ystep);
+    const int w = cv::getTextSize(text, kFont, kTickFont, 1, nullptr).width;
+    cv::putText(out, text, cv::Point(map_area.x - 9 - w, y + 5), kFont, kTickFont, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+  const std::string x_label = "x (m)";
+  const int xw = cv::getTextSize(x_label, kFont, kFontScale, 1, nullptr).width;
+  cv::putText(out, x_label, cv::Point(map_area.x + (map_area.width - xw) / 2, base_y + 42), kFont, kFontScale,
+              cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  cv::putText(out, "y (m)", cv::Point(4, map_area.y - 10), kFont, kFontScale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+}
+
+// A scale bar of a round length (the text above the bar).
+struct ScaleBar {
+  int px = 0;
+  std::string text;
+  void draw(cv::Mat& target, cv::Point o) const {
+    cv::rectangle(target, cv::Point(o.x, o.y - 6), cv::Point(o.x + px, o.y), cv::Scalar(0, 0, 0), cv::FILLED);
+    cv::putText(target, text, cv::Point(o.x, o.y - 10), kFont, kFontScale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+};
+
+}  // namespace
+
+Picture draw_picture(const cv::Mat& base, const core::GridGeometry& geometry, const Overlays& overlays,
+                     const RenderOptions& options) {
+  if (base.empty() || base.type() != CV_8UC3 || base.cols != geometry.width() || base.rows != geometry.height()) {
+    throw Error("decorate: base image must be BGR with one pixel per grid cell");
+  }
+  const CellBox box = picture_cells(base, geometry, overlays, options);
+  const int longest = std::max(box.width(), box.height());
+  double scale = 1.0;
+  if (longest < options.target_size_px) scale = std::min(16, (options.target_size_px + longest - 1) / longest);
+  if (longest > options.max_size_px) scale = double(options.max_size_px) / longest;
+
+  std::vector<LegendItem> legend;
+  const cv::Mat map = box_cells(base, geometry, box, overlays, legend);
+  cv::Mat img;
+  if (scale >= 1.0) cv::resize(map, img, {}, scale, scale, cv::INTER_NEAREST);
+  else cv::resize(map, img, {}, scale, scale, cv::INTER_AREA);
+  draw_shapes(img, geometry, box, scale, overlays, options, legend);
   legend.insert(legend.end(), overlays.legend.begin(), overlays.legend.end());
 
   const double px_per_m = scale / geometry.resolution();
   const double bar_m = nice_length(std::min(0.25 * img.cols, 180.0) / px_per_m);
-  const int bar_px = int(std::lround(bar_m * px_per_m));
-  const std::string bar_text = format_metres(bar_m);
-  const auto draw_scale_bar = [&](cv::Mat& target, cv::Point o) {
-    cv::rectangle(target, cv::Point(o.x, o.y - 6), cv::Point(o.x + bar_px, o.y), cv::Scalar(0, 0, 0), cv::FILLED);
-    cv::putText(target, bar_text, cv::Point(o.x, o.y - 10), kFont, kFontScale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  };
+  const ScaleBar bar{int(std::lround(bar_m * px_per_m)), format_metres(bar_m)};
   if (!options.legend && options.scale_bar) {
-    const cv::Size ts = cv::getTextSize(bar_text, kFont, kFontScale, 1, nullptr);
+    const cv::Size ts = cv::getTextSize(bar.text, kFont, kFontScale, 1, nullptr);
     const cv::Point o(10, img.rows - 10);
-    cv::rectangle(img, cv::Point(o.x - 5, o.y - ts.height - 18), cv::Point(o.x + std::max(bar_px, ts.width) + 5, o.y + 5),
+    cv::rectangle(img, cv::Point(o.x - 5, o.y - ts.height - 18), cv::Point(o.x + std::max(bar.px, ts.width) + 5, o.y + 5),
                   cv::Scalar(255, 255, 255), cv::FILLED);
-    draw_scale_bar(img, o);
+    bar.draw(img, o);
   }
+  const Axes axes = options.axes ? axes_for(img, geometry, box) : Axes{};
 
-  // Axes: metres along the grid from its origin (world metres when the map is not turned).
-  constexpr double kTickFont = 0.45;
-  const auto metres_x = [&](double gx) { return geometry.origin().x + gx * geometry.resolution(); };
-  const auto metres_y = [&](double gy) { return geometry.origin().y + gy * geometry.resolution(); };
-  std::vector<double> xticks, yticks;
-  int left = 0, bottom = 0;
-  if (options.axes) {
-    xticks = nice_ticks(metres_x(box.x0), metres_x(box.x1), std::max(2, img.cols / 110));
-    yticks = nice_ticks(metres_y(box.y0), metres_y(box.y1), std::max(2, img.rows / 90));
-    const double ystep = yticks.size() > 1 ? yticks[1] - yticks[0] : 1.0;
-    int label_w = 0;
-    for (double t : yticks) label_w = std::max(label_w, cv::getTextSize(tick_text(t, ystep), kFont, kTickFont, 1, nullptr).width);
-    left = label_w + 40;
-    bottom = 50;
-  }
-
+  // The page: title above, axes' labels left and below, the legend panel (with the scale bar) right.
   constexpr int kRow = 22, kPad = 10, kSwatch = 14;
   int panel_w = 0, panel_h = 0;
   const int scale_h = options.scale_bar ? 40 : 0;
   if (options.legend) {
-    panel_w = std::max(160, bar_px + 2 * kPad);
+    panel_w = std::max(160, bar.px + 2 * kPad);
     for (const auto& e : legend) {
       panel_w = std::max(panel_w, cv::getTextSize(e.label, kFont, kFontScale, 1, nullptr).width + 3 * kPad + kSwatch + 10);
     }
@@ -270,43 +326,18 @@ Picture draw_picture(const cv::Mat& base, const core::GridGeometry& geometry, co
   const int title_h = options.title.empty() ? 0 : title_size.height + 24;
   const int top = title_h + (options.axes ? 24 : 0);
   const int right = options.axes ? 12 : 0;
-  const int width = std::max(left + img.cols + right + panel_w, options.title.empty() ? 0 : title_size.width + 2 * kPad);
-  const int height = std::max(top + img.rows + bottom, title_h + panel_h);
+  const int width = std::max(axes.left + img.cols + right + panel_w, options.title.empty() ? 0 : title_size.width + 2 * kPad);
+  const int height = std::max(top + img.rows + axes.bottom, title_h + panel_h);
   cv::Mat out(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const cv::Rect map_area(left, top, img.cols, img.rows);
+  const cv::Rect map_area(axes.left, top, img.cols, img.rows);
   img.copyTo(out(map_area));
   if (!options.title.empty()) {
     cv::putText(out, options.title, cv::Point((width - title_size.width) / 2, title_size.height + 12), kFont, kTitleFont,
                 cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   }
-  if (options.axes) {
-    cv::rectangle(out, cv::Rect(map_area.x - 1, map_area.y - 1, map_area.width + 2, map_area.height + 2), cv::Scalar(0, 0, 0), 1);
-    const double xstep = xticks.size() > 1 ? xticks[1] - xticks[0] : 1.0, ystep = yticks.size() > 1 ? yticks[1] - yticks[0] : 1.0;
-    const int base_y = map_area.y + map_area.height;
-    for (double t : xticks) {
-      const int x = map_area.x + int(std::lround(((t - geometry.origin().x) / geometry.resolution() - box.x0) * scale));
-      if (x < map_area.x - 1 || x > map_area.x + map_area.width) continue;
-      cv::line(out, cv::Point(x, base_y), cv::Point(x, base_y + 5), cv::Scalar(0, 0, 0), 1);
-      const std::string text = tick_text(t, xstep);
-      const int w = cv::getTextSize(text, kFont, kTickFont, 1, nullptr).width;
-      cv::putText(out, text, cv::Point(x - w / 2, base_y + 20), kFont, kTickFont, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-    }
-    for (double t : yticks) {
-      const int y = map_area.y + int(std::lround((box.y1 - (t - geometry.origin().y) / geometry.resolution()) * scale));
-      if (y < map_area.y - 1 || y > base_y) continue;
-      cv::line(out, cv::Point(map_area.x - 6, y), cv::Point(map_area.x - 1, y), cv::Scalar(0, 0, 0), 1);
-      const std::string text = tick_text(t, ystep);
-      const int w = cv::getTextSize(text, kFont, kTickFont, 1, nullptr).width;
-      cv::putText(out, text, cv::Point(map_area.x - 9 - w, y + 5), kFont, kTickFont, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-    }
-    const std::string x_label = "x (m)";
-    const int xw = cv::getTextSize(x_label, kFont, kFontScale, 1, nullptr).width;
-    cv::putText(out, x_label, cv::Point(map_area.x + (map_area.width - xw) / 2, base_y + 42), kFont, kFontScale,
-                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-    cv::putText(out, "y (m)", cv::Point(4, map_area.y - 10), kFont, kFontScale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  }
+  if (options.axes) draw_axes(out, map_area, axes, geometry, box, scale);
   if (options.legend) {
-    const int x0 = left + img.cols + right + kPad;
+    const int x0 = axes.left + img.cols + right + kPad;
     cv::line(out, cv::Point(x0 - kPad, title_h), cv::Point(x0 - kPad, out.rows - 1), cv::Scalar(160, 160, 160), 1);
     int y = title_h + kPad;
     for (const auto& e : legend) {
@@ -314,7 +345,7 @@ Picture draw_picture(const cv::Mat& base, const core::GridGeometry& geometry, co
       cv::putText(out, e.label, cv::Point(x0 + kSwatch + kPad, y + 16), kFont, kFontScale, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
       y += kRow;
     }
-    if (options.scale_bar) draw_scale_bar(out, cv::Point(x0, y + scale_h - 6));
+    if (options.scale_bar) bar.draw(out, cv::Point(x0, y + scale_h - 6));
   }
   return {out, map_area, scale, Eigen::Vector2d(box.x0, box.y0)};
 }

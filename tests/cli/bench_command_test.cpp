@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <boost/math/distributions/students_t.hpp>
+#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include <chrono>
@@ -268,8 +269,7 @@ TEST(BenchCommand, PairedComparisonOfTwoStrategies) {
     if (uncoordinated.count(key)) sum += v - uncoordinated.at(key), ++pairs;
   }
   ASSERT_GE(pairs, 2);
-  char expected[64];
-  std::snprintf(expected, sizeof expected, "| all | all | %d | %.2f |", pairs, sum / pairs);
+  const std::string expected = fmt::format("| all | all | {} | {:.2f} |", pairs, sum / pairs);
   EXPECT_NE(r.out.find(expected), std::string::npos) << expected << "\n" << r.out;
   EXPECT_NE(r.out.find("| room | 2 |"), std::string::npos) << r.out;
   const auto d = b.bench("--compare coordinated uncoordinated out --metric distance_m");

@@ -221,5 +221,46 @@ TEST(SlamExperiment, OutputsTableAndFigures) {
   EXPECT_EQ(files.size(), 8u);
 }
 
+// A program that links the library adds its own SLAM method; a scenario's `method:` then names it
+// (before, the same file is refused naming the valid methods).
+TEST(SlamMethods, AProgramAddsItsOwnMethodAndScenariosReachItByName) {
+  const std::string text = R"(
+method: planned-path
+steps: 40
+room:
+  boundary: [[0, 0], [4, 0], [4, 3], [0, 3]]
+robots:
+  team:
+    - {name: a, start: [1, 1, 0], path: [[3, 1]]}
+)";
+  if (!slam_method_registry().contains("planned-path")) {
+    expect_input_error([&] { parse_slam_scenario(text, "mine.yaml"); }, {"mine.yaml", "method", "planned-path", "polynomial"});
+    // Its estimate is the noise-free path: a baseline a user might compare with.
+    register_slam_method("planned-path", "the noise-free path as the estimate", [](const SlamSetup& setup, int run, bool exchange, int only) {
+      SlamRunResult r;
+      r.run = run;
+      r.exchange = exchange;
+      for (std::size_t i = 0; i < setup.scenario.robots.size(); ++i) {
+        if (only >= 0 && int(i) != only) continue;
+        SlamRobotResult robot;
+        robot.name = setup.scenario.robots[i].name;
+        robot.estimate = setup.planned[i];
+        r.robots.push_back(std::move(robot));
+      }
+      return r;
+    });
+  }
+  EXPECT_THROW(register_slam_method("polynomial", "again", {}), Error);
+  const auto names = slam_method_names();
+  EXPECT_EQ(names.front(), "polynomial");
+  EXPECT_NE(std::find(names.begin(), names.end(), "planned-path"), names.end());
+  const SlamScenario s = parse_slam_scenario(text, "mine.yaml");
+  const SlamRunResult r = run_slam(prepare_slam(s), 4, false);
+  EXPECT_EQ(r.run, 4);
+  ASSERT_EQ(r.robots.size(), 1u);
+  EXPECT_EQ(r.robots[0].estimate.size(), 41u);  // the start and one pose per step
+  EXPECT_NEAR(r.robots[0].estimate.back().x, 3.0, 0.1);
+}
+
 }  // namespace
 }  // namespace fleetmap::experiments

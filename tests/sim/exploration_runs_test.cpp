@@ -1,4 +1,4 @@
-// Issue 4's acceptance check: every strategy explores every built-in 200x200 map with 1, 2, 4 and
+// The exploration acceptance check: every strategy explores every built-in 200x200 map with 1, 2, 4 and
 // 9 robots to at least 99% of the observable space, and the team notices it is done.
 #include <gtest/gtest.h>
 
