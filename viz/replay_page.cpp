@@ -1,5 +1,7 @@
 // The replay page: HTML, styles and a plain script (no libraries) that decode the run's data
-// (replay_json) and draw it on canvases.
+// (replay_json) and draw it on canvases. Over 500 lines on purpose: most of it is the page's one
+// script, whose parts (decoding the delta-encoded maps, drawing, the timeline, the why panel) share
+// its state and must ship as one self-contained file.
 #include <string>
 
 #include "viz/html.h"
