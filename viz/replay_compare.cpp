@@ -63,14 +63,6 @@ json summary(const ComparedReplay& run) {
           {"decisions", decisions}};
 }
 
-constexpr std::string_view kHead = R"HTML(<!DOCTYPE html>
-<html lang="en">
-<head>
-<meta charset="utf-8">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<meta name="generator" content="fleetmap">
-<title>)HTML";
-
 constexpr std::string_view kStyle = R"HTML(</title>
 <style>
 .controls { display: flex; align-items: center; gap: 8px; margin: 6px 0; flex-wrap: wrap; position: sticky; top: 0;
@@ -257,7 +249,7 @@ std::string replay_comparison_html(const std::vector<ComparedReplay>& runs) {
   std::size_t size = 0;
   for (const auto& r : runs) size += r.page.size() + r.page.size() / 8;
   page.reserve(size + 30000);
-  page += kHead;
+  page += page_head();
   page += html_escape(title);
   page += kStyle;
   page += page_style();

@@ -8,6 +8,16 @@
 
 namespace fleetmap::viz {
 
+std::string_view page_head() {
+  return R"HTML(<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<meta name="generator" content="fleetmap">
+<title>)HTML";
+}
+
 std::string html_escape(std::string_view text) {
   std::string out;
   out.reserve(text.size());
@@ -41,14 +51,6 @@ td.text, th.text { text-align: left; }
 }
 
 namespace {
-
-constexpr std::string_view kHead = R"HTML(<!DOCTYPE html>
-<html lang="en">
-<head>
-<meta charset="utf-8">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<meta name="generator" content="fleetmap">
-<title>)HTML";
 
 constexpr std::string_view kStyle = R"HTML(</title>
 <style>
@@ -712,7 +714,7 @@ render();
 std::string replay_page(const std::string& title, const std::string& json) {
   std::string page;
   page.reserve(json.size() + 40000);
-  page += kHead;
+  page += page_head();
   page += html_escape(title);
   page += kStyle;
   page += page_style();

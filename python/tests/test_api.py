@@ -7,15 +7,15 @@ from pathlib import Path
 
 import fleetmap
 
-STUB = Path(fleetmap.__file__).with_suffix(".pyi")
+PYI = Path(fleetmap.__file__).with_suffix(".pyi")
 
 
-def stub_definitions():
-    tree = ast.parse(STUB.read_text())
+def pyi_definitions():
+    tree = ast.parse(PYI.read_text())
     return {node.name: node for node in tree.body if isinstance(node, (ast.FunctionDef, ast.ClassDef))}
 
 
-def stub_parameters(node):
+def pyi_parameters(node):
     args = node.args
     names = [a.arg for a in args.posonlyargs + args.args]
     names += [args.vararg.arg] if args.vararg else []
@@ -40,14 +40,14 @@ class ApiTest(unittest.TestCase):
                              if line.strip() and not line.startswith(member + "(")]
                     self.assertTrue(lines, f"{name}.{member} has no docstring")
 
-    def test_the_stub_declares_every_public_name_with_its_parameters(self):
-        stub = stub_definitions()
+    def test_the_pyi_declares_every_public_name_with_its_parameters(self):
+        declared = pyi_definitions()
         for name in fleetmap.__all__:
-            self.assertIn(name, stub, f"{name} is not in {STUB.name}")
+            self.assertIn(name, declared, f"{name} is not in {PYI.name}")
             obj = getattr(fleetmap, name)
             if inspect.isfunction(obj):  # the Python half: its real signature
-                self.assertEqual(stub_parameters(stub[name]), list(inspect.signature(obj).parameters),
-                                 f"{name}'s parameters differ from {STUB.name}")
+                self.assertEqual(pyi_parameters(declared[name]), list(inspect.signature(obj).parameters),
+                                 f"{name}'s parameters differ from {PYI.name}")
 
 
 if __name__ == "__main__":
