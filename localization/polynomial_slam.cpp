@@ -277,9 +277,10 @@ void PolynomialSlam::update(const std::vector<double>& angles, const std::vector
     // The reading at any state: the same landmark and axis, with this reading's noise.
     const double noise = reading.noise;
     const int first = first_slot(index), size = state.basis.size;
-    const auto at = [&, first, size, noise](const Eigen::VectorXd& x) -> std::optional<ScalarReading> {
+    const double bearing = angles[i];  // a structured binding cannot be captured (clang 14)
+    const auto at = [&, first, size, noise, bearing](const Eigen::VectorXd& x) -> std::optional<ScalarReading> {
       auto m = range_reading(state.reference, state.basis, x.segment(3 + first, size), first,
-                             core::Pose2(x(0), x(1), x(2)), angles[i], y + options_.sigma_max + 1.0,
+                             core::Pose2(x(0), x(1), x(2)), bearing, y + options_.sigma_max + 1.0,
                              options_.domain_margin);
       if (m) m->noise = noise;
       return m;
