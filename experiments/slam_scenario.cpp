@@ -183,6 +183,7 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
     o.shape_noise = p.boolean("shape_noise", o.shape_noise);
     o.lowest_order = p.boolean("lowest_order", o.lowest_order);
     o.shape_in_state = p.boolean("shape_in_state", o.shape_in_state);
+    o.first_estimate_jacobians = p.boolean("first_estimate_jacobians", o.first_estimate_jacobians);
     o.feature_noise = p.number("feature_noise", o.feature_noise, 0.0, 1.0);
     p.finish();
   }

@@ -25,8 +25,12 @@ Eigen::Matrix3d motion_jacobian(const core::Pose2& pose, const Odometry& u) {
 
 void predict_augmented_state(Eigen::VectorXd& mean, Eigen::MatrixXd& covariance, const Odometry& u,
                              const Eigen::Matrix3d& q) {
+  predict_augmented_state(mean, covariance, u, q, motion_jacobian(core::Pose2(mean(0), mean(1), mean(2)), u));
+}
+
+void predict_augmented_state(Eigen::VectorXd& mean, Eigen::MatrixXd& covariance, const Odometry& u,
+                             const Eigen::Matrix3d& q, const Eigen::Matrix3d& f) {
   const core::Pose2 before(mean(0), mean(1), mean(2));
-  const Eigen::Matrix3d f = motion_jacobian(before, u);
   const core::Pose2 after = integrate_motion(before, u);
   mean.head<3>() << after.x, after.y, core::normalize_angle(after.theta);
   const Eigen::Index m = covariance.rows() - 3;

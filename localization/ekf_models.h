@@ -25,6 +25,9 @@ Eigen::Matrix3d motion_jacobian(const core::Pose2& pose, const Odometry& u);
 // the pose block becomes F P F^T + Q and the pose-landmark blocks F P_xl; landmarks stay.
 void predict_augmented_state(Eigen::VectorXd& mean, Eigen::MatrixXd& covariance, const Odometry& u,
                              const Eigen::Matrix3d& q);
+// The same with a given F (e.g. evaluated at first estimates instead of the current pose).
+void predict_augmented_state(Eigen::VectorXd& mean, Eigen::MatrixXd& covariance, const Odometry& u,
+                             const Eigen::Matrix3d& q, const Eigen::Matrix3d& f);
 
 // Q = diag(sxy^2, sxy^2, sth^2): the process noise, additive in the world frame.
 Eigen::Matrix3d process_noise(const LocalizerOptions& options);

@@ -18,6 +18,14 @@ void PolynomialEkf::predict(const Odometry& u, const Eigen::Matrix3d& q) {
   predict_augmented_state(mean_, covariance_, u, q);
 }
 
+void PolynomialEkf::predict(const Odometry& u, const Eigen::Matrix3d& q, const Eigen::Vector2d& previous_predicted) {
+  const core::Pose2 after = integrate_motion(pose(), u);
+  Eigen::Matrix3d f = Eigen::Matrix3d::Identity();
+  f(0, 2) = -(after.y - previous_predicted.y());
+  f(1, 2) = after.x - previous_predicted.x();
+  predict_augmented_state(mean_, covariance_, u, q, f);
+}
+
 namespace {
 
 // P H^T for H = [h_pose, 0, ..., h_slot at slot, ...].

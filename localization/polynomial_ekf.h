@@ -54,6 +54,10 @@ class PolynomialEkf {
 
   // x <- f(x, u) (the exact differential-drive arc); P_rr <- F P_rr F^T + Q, P_rl <- F P_rl.
   void predict(const Odometry& u, const Eigen::Matrix3d& process_noise);
+  // The same with the motion Jacobian's displacement taken as p_k+1|k - `previous_predicted`
+  // (first-estimate Jacobians, Huang, Mourikis & Roumeliotis 2008: the displacement between the
+  // predicted positions, not from the corrected one).
+  void predict(const Odometry& u, const Eigen::Matrix3d& process_noise, const Eigen::Vector2d& previous_predicted);
 
   // P_ss += variance: process noise on a landmark entry.
   void add_noise(int slot, double variance) { covariance_(3 + slot, 3 + slot) += variance; }

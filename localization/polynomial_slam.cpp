@@ -179,13 +179,19 @@ PolynomialSlam::PolynomialSlam(const core::Pose2& initial_pose, const Eigen::Mat
     : options_((validate(options), options)),
       initial_covariance_(initial_covariance),
       process_noise_(process_noise),
-      filter_(initial_pose, initial_covariance) {
+      filter_(initial_pose, initial_covariance),
+      last_predicted_(initial_pose.position()) {
   thresholds_ = slam_thresholds(initial_covariance, initial_covariance, options_);
 }
 
 void PolynomialSlam::predict(const Odometry& u) {
   ++step_;
-  filter_.predict(u, process_noise_);
+  if (options_.first_estimate_jacobians) {
+    filter_.predict(u, process_noise_, last_predicted_);
+  } else {
+    filter_.predict(u, process_noise_);
+  }
+  last_predicted_ = filter_.pose().position();
   if (options_.feature_noise > 0.0) {
     for (int s = 0; s < filter_.slots(); ++s) filter_.add_noise(s, options_.feature_noise);
   }
@@ -278,11 +284,30 @@ void PolynomialSlam::update(const std::vector<double>& angles, const std::vector
     const double noise = reading.noise;
     const int first = first_slot(index), size = state.basis.size;
     const double bearing = angles[i];  // a structured binding cannot be captured (clang 14)
+    // First-estimate Jacobians: at the predicted pose and the landmark's entries when it was made
+    // (the reading's value, and whether the axis meets the curve, stay the current estimate's).
+    // When the axis from the predicted pose misses the first estimate there is no such Jacobian;
+    // the current estimate's would bring the spurious information back, so the reading is not used.
+    std::optional<ScalarReading> first_estimate;
+    if (options_.first_estimate_jacobians) {
+      first_estimate = range_reading(state.reference, state.basis, state.first, first, x, bearing,
+                                     y + options_.sigma_max + 1.0, options_.domain_margin);
+      if (!first_estimate) {
+        ++counters_.rejected_readings;
+        continue;
+      }
+    }
     const auto at = [&, first, size, noise, bearing](const Eigen::VectorXd& x) -> std::optional<ScalarReading> {
       auto m = range_reading(state.reference, state.basis, x.segment(3 + first, size), first,
                              core::Pose2(x(0), x(1), x(2)), bearing, y + options_.sigma_max + 1.0,
                              options_.domain_margin);
-      if (m) m->noise = noise;
+      if (!m) return m;
+      m->noise = noise;
+      if (first_estimate) {
+        m->h_pose = first_estimate->h_pose;
+        m->h_slot = first_estimate->h_slot;
+        m->h_more = first_estimate->h_more;
+      }
       return m;
     };
     const auto outcome = filter_.update(y, at, options_.innovation_gate);
@@ -446,7 +471,7 @@ std::optional<long> PolynomialSlam::add_landmark(const std::vector<SourcePoint>&
   landmark.id = next_id_++;
   landmark.polynomial = fit->polynomial;
   landmark.received_from = received_from;
-  bases_.push_back({fit->polynomial, basis});
+  bases_.push_back({fit->polynomial, basis, g.value});
   // The shape's uncertainty (options.shape_noise): the least of its sources'. Points computed from
   // the pose carry the pose's variance along the curve and in heading, plus the fit's slope variance.
   {
@@ -673,7 +698,7 @@ void PolynomialSlam::change_frame(const core::Transform2& t) {
     value(0) = fit->polynomial.position;
     auto& landmark = map_.landmarks[std::size_t(i)];
     landmark.polynomial = fit->polynomial;
-    bases_[std::size_t(i)] = {fit->polynomial, basis};
+    bases_[std::size_t(i)] = {fit->polynomial, basis, value};
     for (auto& b : landmark.bad_points) {
       b.position = t * b.position;
       b.observer = t * b.observer;
@@ -700,6 +725,7 @@ void PolynomialSlam::change_frame(const core::Transform2& t) {
     col += std::size_t(blocks[i].cols());
   }
   filter_.change_frame(t, all_values, jacobian);
+  last_predicted_ = t * last_predicted_;
   sync_positions();
 }
 

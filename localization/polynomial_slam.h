@@ -69,6 +69,13 @@ struct PolynomialSlamOptions {
   // Process noise on each landmark's entries per step (m^2): the walls do not move, so 0; more
   // lets the filter follow a boundary an m-th order polynomial cannot follow exactly.
   double feature_noise = 0.0;
+  // First-estimate Jacobians (Huang, Mourikis & Roumeliotis 2008): a reading's Jacobians are
+  // evaluated at the step's predicted pose x_k|k-1 and at its landmark's entries as they were when
+  // it entered the state (its first estimate), and the motion's at the predicted positions
+  // (p_k+1|k - p_k|k-1), while its innovation uses the current estimate. Linearised at estimates
+  // that move, the EKF gains information along the unobservable global translation and rotation
+  // and becomes overconfident; with first estimates it keeps those directions unobservable.
+  bool first_estimate_jacobians = false;
 };
 
 // A landmark's state block (options.shape_in_state): `size` entries, c_0 and a_1..a_{size-1} in
@@ -186,6 +193,7 @@ class PolynomialSlam {
   struct LandmarkState {
     mapping::Polynomial reference;  // the fit it was made from
     ShapeBasis basis;
+    Eigen::VectorXd first;          // its entries when it entered the state (first-estimate Jacobians)
   };
 
   PolynomialSlamOptions options_;
@@ -198,6 +206,7 @@ class PolynomialSlam {
   PolynomialSlamCounters counters_;
   long step_ = 0;
   long next_id_ = 0;
+  Eigen::Vector2d last_predicted_;  // p_k|k-1 of the latest prediction (x_0|0 before the first)
 };
 
 }  // namespace fleetmap::localization
