@@ -176,6 +176,7 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
     o.gamma_m = p.number("gamma_m", o.gamma_m, 1e-9, 100.0);
     o.min_overlap = p.number("min_overlap", o.min_overlap, 1e-6, 1.0);
     o.merge_max_angle = deg2rad(p.number("merge_max_angle_deg", rad2deg(o.merge_max_angle), 1e-6, 90.0));
+    o.min_merge_length = p.number("min_merge_length", o.min_merge_length, 0.0, 100.0);
     o.innovation_gate = p.number("innovation_gate", o.innovation_gate, 1e-9, 1e12);
     o.min_incidence_cos = p.number("min_incidence_cos", o.min_incidence_cos, 0.0, 0.999);
     o.domain_margin = p.number("domain_margin", o.domain_margin, -10.0, 10.0);

@@ -66,6 +66,7 @@ void validate(const PolynomialSlamOptions& o) {
   if (!(o.range_noise >= 0.0)) fail("range_noise", "a number >= 0", o.range_noise);
   if (!(o.min_overlap > 0.0 && o.min_overlap <= 1.0)) fail("min_overlap", "a number in (0, 1]", o.min_overlap);
   if (!(o.merge_max_angle > 0.0)) fail("merge_max_angle", "a positive angle", o.merge_max_angle);
+  if (!(o.min_merge_length >= 0.0) || !std::isfinite(o.min_merge_length)) fail("min_merge_length", "a finite number >= 0", o.min_merge_length);
   if (!(o.innovation_gate > 0.0)) fail("innovation_gate", "a positive number", o.innovation_gate);
   if (!(o.min_incidence_cos >= 0.0 && o.min_incidence_cos < 1.0)) fail("min_incidence_cos", "a number in [0, 1)", o.min_incidence_cos);
   if (!std::isfinite(o.domain_margin)) fail("domain_margin", "a finite number", o.domain_margin);
@@ -596,6 +597,7 @@ void PolynomialSlam::merge_new(long id) {
       const double shorter = std::min(p_len, p2.length());
       if (!(ov->length >= options_.min_overlap * shorter)) continue;
       if (mapping::tangent_angle(p, 0.5 * (ov->lo + ov->hi), p2) > options_.merge_max_angle) continue;
+      if (shorter < options_.min_merge_length) continue;
       const double gamma = mapping::rms_residual(p2, mapping::sample_equally(p, ov->lo, ov->hi, options_.order + 1));
       if (gamma < options_.gamma_m && gamma < best_gamma) best = j, best_gamma = gamma;
     }

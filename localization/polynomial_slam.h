@@ -44,6 +44,10 @@ struct PolynomialSlamOptions {
   // Choices where the paper is silent (README "Polynomial SLAM", what differs).
   double min_overlap = 0.3;       // Fig. 3(b)'s "sufficiently large" overlap, as a share of the shorter polynomial
   double merge_max_angle = 0.5235987755982988;  // rad (30 deg): tangents in the overlap may differ at most this
+  // Fig. 3's "sufficiently large" overlap in absolute terms: a polynomial shorter than this (m) is not
+  // merged. A few centimetres of curve (often one spot read again and again) have a shape no reading
+  // supports, and a merge with them pulls the longer one. 0: any length, as the paper.
+  double min_merge_length = 0.0;
   double innovation_gate = 3.84;  // chi2(1) at 95%: a reading farther from h is not used
   double min_incidence_cos = 0.2;  // an axis meeting a curve beyond ~78 deg from its normal is not used
   double domain_margin = 0.0;      // m: an axis may meet a polynomial this far beyond its ends (< 0: not near them)

@@ -62,11 +62,12 @@ TEST(SlamScenario, DefaultsFillAMinimalScenario) {
   EXPECT_FALSE(s.polynomial.first_estimate_jacobians);
   EXPECT_FALSE(s.sampled_start);
   const SlamScenario t = parse_slam_scenario(
-      std::string(kMinimal) + "initial_sigma: {sampled: true}\npolynomial: {shape_in_state: true, first_estimate_jacobians: true, feature_noise: 1.0e-6}\n",
+      std::string(kMinimal) + "initial_sigma: {sampled: true}\npolynomial: {shape_in_state: true, first_estimate_jacobians: true, min_merge_length: 0.2, feature_noise: 1.0e-6}\n",
       "min.yaml");
   EXPECT_TRUE(t.sampled_start);
   EXPECT_TRUE(t.polynomial.shape_in_state);
   EXPECT_TRUE(t.polynomial.first_estimate_jacobians);
+  EXPECT_DOUBLE_EQ(t.polynomial.min_merge_length, 0.2);
   EXPECT_DOUBLE_EQ(t.polynomial.feature_noise, 1e-6);
 }
 

@@ -208,6 +208,26 @@ TEST(PolynomialSlam, ReceivedCurvesMergeWithOverlappingPolynomialsFig3) {
   EXPECT_EQ(slam.filter().slots(), 2);
 }
 
+TEST(PolynomialSlam, AFewCentimetresOfCurveAreNotMergedWithMinMergeLength) {
+  // A 6 cm piece of the wall (one spot read again and again gives such a piece) overlaps the wall's
+  // polynomial and passes Fig. 3's gamma test; merged, its ill-determined shape pulls the wall's.
+  // With min_merge_length 0.1 m it stays a polynomial of its own; without, it is merged.
+  ReceivedCurve piece;
+  piece.polyline = {{0.10, 2.01}, {0.16, 2.01}};
+  piece.variance = 1e-3;
+  piece.from_robot = 1;
+  for (const double min_length : {0.0, 0.1}) {
+    PolynomialSlamOptions o;
+    o.cluster_tolerance = 0.001;
+    o.min_merge_length = min_length;
+    PolynomialSlam slam = facing_a_wall(o);
+    ASSERT_EQ(slam.map().landmarks.size(), 1u);
+    slam.integrate_received({piece});
+    EXPECT_EQ(slam.counters().merges, min_length > 0.0 ? 0 : 1) << "min_merge_length " << min_length;
+    EXPECT_EQ(slam.map().landmarks.size(), min_length > 0.0 ? 2u : 1u) << "min_merge_length " << min_length;
+  }
+}
+
 TEST(PolynomialSlam, GammaTestKeepsParallelWallsApart) {
   PolynomialSlamOptions o;
   o.cluster_tolerance = 0.001;
@@ -468,6 +488,9 @@ TEST(PolynomialSlam, OptionsAreValidated) {
   o = {};
   o.cluster_tolerance = -1.0;
   fleetmap::testing::expect_input_error([&] { PolynomialSlam(core::Pose2(), p0(), p0(), o); }, {"cluster_tolerance"});
+  o = {};
+  o.min_merge_length = -0.1;
+  fleetmap::testing::expect_input_error([&] { validate(o); }, {"min_merge_length"});
 }
 
 }  // namespace
