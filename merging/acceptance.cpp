@@ -38,13 +38,50 @@ Acceptance acceptance_index(const mapping::OccupancyGrid& a, const mapping::Occu
 namespace {
 
 struct Tally {
-  int tested = 0, matched = 0, near = 0, contradicted = 0;
+  int tested = 0, matched = 0, near = 0, contradicted = 0, wall_ends = 0;
   double squared_residuals = 0.0;  // of the matched and the near walls
   std::unordered_set<std::int64_t> blocks;   // 4 x 4 blocks of the source map already counted
   std::vector<Eigen::Vector2d> positions;    // matched walls, in a's frame
   std::vector<Eigen::Matrix2d> structures;   // their local structure, in a's frame
   std::vector<Eigen::Vector2d> structure_positions;  // the matched walls that are not clutter
 };
+
+// Whether the wall cell `w` of `source` ends a straight wall there (a door jamb, the end of a
+// free-standing wall): along the wall, an opening on one side and the wall going on on the other,
+// and `target` shows the same at `p`, where r turns source's directions into target's. Two maps
+// whose common walls are one corner fit any corner of a bare room; a matched opening in a wall
+// pins the corner to one place along its walls.
+bool matched_wall_end(const GridLevel& source, const GridLevel& target, const WallPoint& w, const Eigen::Matrix2f& r,
+                      const Eigen::Vector2f& p) {
+  const Eigen::Matrix2f c = Eigen::Matrix2f::Identity() - w.structure;  // the wall cells' spread (scaled)
+  if (c.trace() < 0.5f) return false;  // an isolated cell: no direction
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2f> eig(c);
+  const auto& ev = eig.eigenvalues();
+  if (ev(1) < 4.0f * ev(0)) return false;  // not a straight piece of wall
+  const Eigen::Vector2f u = eig.eigenvectors().col(1);
+  const auto free_at = [](const GridLevel& g, const Eigen::Vector2f& q) {
+    const int x = nearest_cell(q.x()), y = nearest_cell(q.y());
+    return x >= 0 && y >= 0 && x < g.width() && y < g.height() && g.is_free(x, y);
+  };
+  const auto wall_at = [](const GridLevel& g, const Eigen::Vector2f& q) {
+    const int x = nearest_cell(q.x()), y = nearest_cell(q.y());
+    return x >= 0 && y >= 0 && x < g.width() && y < g.height() && g.distance_at(q.x(), q.y(), 1e4f) <= 1.0f;
+  };
+  // Beyond the end, free on the wall's line and on both sides of it: an opening one sees through
+  // (the edge of what a robot saw, where grazing beams leave free cells on the line of a wall that
+  // goes on unseen, has unknown behind the wall).
+  const auto open_at = [&](const GridLevel& g, const Eigen::Vector2f& q, const Eigen::Vector2f& across) {
+    return free_at(g, q) && free_at(g, q + 3.0f * across) && free_at(g, q - 3.0f * across);
+  };
+  const Eigen::Vector2f n(-u.y(), u.x()), ut = r * u, nt = r * n;
+  for (const float s : {1.0f, -1.0f}) {
+    bool end = wall_at(source, w.position - 3.0f * s * u) && wall_at(target, p - 3.0f * s * ut);
+    for (float k = 2.0f; end && k <= 4.0f; k += 1.0f)
+      end = open_at(source, w.position + k * s * u, n) && open_at(target, p + k * s * ut, nt);
+    if (end) return true;
+  }
+  return false;
+}
 
 // Counts `from`'s wall cells moved into `to` by t.
 void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transform2& t, const core::Transform2& to_a,
@@ -76,6 +113,7 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
       if (!out.blocks.insert(key).second) continue;
       out.positions.push_back(to_a.apply(p.cast<double>()));
       if (!w.clutter) out.structure_positions.push_back(out.positions.back());
+      if (!w.clutter && matched_wall_end(from.level(0), target, w, r, p)) ++out.wall_ends;
       out.structures.push_back(ra * w.structure.cast<double>() * ra.transpose());
     } else if (!w.clutter && d >= options.contradiction_distance && target.is_free(x, y)) {
       ++out.contradicted;
@@ -153,6 +191,7 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   q.agreement = t.matched + t.contradicted > 0 ? double(t.matched) / double(t.matched + t.contradicted) : 0.0;
   const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0);
   q.beyond_corner = left[1];
+  q.wall_ends = t.wall_ends;
   q.beyond_room = left[3];
   if (t.positions.size() < 3) return q;
   Eigen::Vector2d c = Eigen::Vector2d::Zero();

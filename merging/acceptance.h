@@ -57,6 +57,11 @@ struct AlignmentQuality {
   // straight lines that hold the most of them: 0 when all the common walls are one corner (two
   // walls), which fits any other corner of a bare room as well.
   int beyond_corner = 0;
+  // Matched wall ends (4 x 4 blocks of either map): a straight wall that stops with free space
+  // beyond it on its line and on both sides of the line (an opening one sees through: a door jamb,
+  // the end of a free-standing wall; not where the view ends), in both maps at the same place. On
+  // the lines, but it fixes where along them the maps meet.
+  int wall_ends = 0;
   // The same for the four lines that hold the most: 0 when the common walls are the sides of one
   // rectangular room (or fewer lines), which fits itself turned a half turn.
   int beyond_room = 0;

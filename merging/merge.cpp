@@ -83,6 +83,32 @@ cv::Mat common_mask(const PreparedGrid& a, const PreparedGrid& b, const core::Tr
   return mask;
 }
 
+// The acceptance index (Birk & Carpin 2006) of the known cells of `b`'s finest level (a masked
+// part's cells only) placed by b_to_a on a's finest level.
+double level_acceptance(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a) {
+  const GridLevel& la = a.level(0);
+  const GridLevel& lb = b.level(0);
+  const Eigen::Matrix2d r = b_to_a.rotation_matrix();
+  const Eigen::Vector2d t = b_to_a.translation();
+  std::int64_t agree = 0, disagree = 0;
+  for (int y = 0; y < lb.height(); ++y) {
+    const auto* bo = lb.occupied.ptr<std::uint8_t>(y);
+    const auto* bf = lb.free.ptr<std::uint8_t>(y);
+    const Eigen::Vector2d start = r * Eigen::Vector2d(0.0, y) + t, step = r.col(0);
+    for (int x = 0; x < lb.width(); ++x) {
+      if (bo[x] == 0 && bf[x] == 0) continue;
+      const Eigen::Vector2d p = start + double(x) * step;
+      const int ax = nearest_cell(p.x()), ay = nearest_cell(p.y());
+      if (ax < 0 || ay < 0 || ax >= la.width() || ay >= la.height()) continue;
+      const bool a_occupied = la.occupied.at<std::uint8_t>(ay, ax) != 0;
+      if (!a_occupied && la.free.at<std::uint8_t>(ay, ax) == 0) continue;
+      if (a_occupied == (bo[x] != 0)) ++agree;
+      else ++disagree;
+    }
+  }
+  return agree + disagree > 0 ? double(agree) / double(agree + disagree) : 0.0;
+}
+
 // Coarse to fine: every candidate joins at its level; after each level near-duplicates go and only
 // the best few go on.
 std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGrid& b,
@@ -229,8 +255,10 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
 
   const auto& co = options.confidence;
   const double agree_factor = clamp01((best_q.agreement - co.zero_agreement) / (co.full_agreement - co.zero_agreement));
-  const double acceptance_factor =
-      clamp01((result.acceptance - co.zero_acceptance) / (co.full_acceptance - co.zero_acceptance));
+  const auto acceptance_factor_of = [&](double omega) {
+    return clamp01((omega - co.zero_acceptance) / (co.full_acceptance - co.zero_acceptance));
+  };
+  const double acceptance_factor = acceptance_factor_of(result.acceptance);
   const double chance_rms = options.quality.contradiction_distance / std::sqrt(3.0);
   const double fit_weight =
       best_q.matched > 0 ? std::max(0.0, std::log(chance_rms / std::max(best_q.residual_rms, 0.05))) : 0.0;
@@ -251,7 +279,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   // Also the largest share of the best score that a plausible placement turned by a quarter turn or
   // more from the answer reaches (`turned`).
   double turned = 0.0;
-  const auto distinctiveness = [&](const Placements& others,
+  const auto distinctiveness = [&](const PreparedGrid& from, const Placements& others,
                                    const AlignmentQuality& best, const core::Transform2& answer) {
     const Eigen::Vector2d at = answer.inverse().apply(best.overlap_centre);
     const double own = evidence_of(best);
@@ -261,7 +289,11 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       if (same_answer(t, answer, at, co)) continue;
       const double n = q.matched + q.contradicted;
       const double z = (q.contradicted - rate * n) / std::sqrt(rate * n + 1.0);
-      const double plausible = q.score * clamp01((4.0 - z) / 2.0);
+      double plausible = q.score * clamp01((4.0 - z) / 2.0);
+      // A rival is judged as the answer is: one whose cells disagree with a's (free on occupied)
+      // more than the acceptance factor allows could not be merged itself, and says nothing about
+      // the answer (seen on the benchmark: a quarter-turned corner of one room laid on a's walls).
+      if (plausible > second) plausible *= acceptance_factor_of(level_acceptance(a, from, t));
       if (plausible > second) second = plausible, alternative = t;
       const double dtheta = std::abs(core::normalize_angle(t.rotation() - answer.rotation()));
       if (z <= 2.0 && dtheta > std::numbers::pi / 4.0 && own > 0.0) turned = std::max(turned, evidence_of(q) / own);
@@ -270,7 +302,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   };
   Placements others;
   for (std::size_t i = 1; i < scored.size(); ++i) others.emplace_back(scored[i].first, scored[i].second->fit.b_to_a);
-  std::tie(result.distinctiveness, result.alternative) = distinctiveness(others, best_q, result.transform);
+  std::tie(result.distinctiveness, result.alternative) = distinctiveness(b, others, best_q, result.transform);
 
   // Symmetric or repeated places (only when the answer could be merged at all): other placements
   // of b in a, turned by quarter turns from the answer, at every translation. Twice: all of b (a
@@ -278,10 +310,10 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   // the answer lays on a's known cells, which is all the evidence there is: rows of identical
   // rooms, or a symmetric room, fit elsewhere nearly as well, and the rest of b, lying on a's
   // unknown, cannot tell them apart.
-  if (options.probe_symmetries && best_q.beyond_corner > 0 &&
+  if (options.probe_symmetries && best_q.beyond_corner + best_q.wall_ends > 0 &&
       agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence) {
     std::tie(result.distinctiveness, result.alternative) =
-        distinctiveness(other_placements(a, b, result.transform, options, others), best_q, result.transform);
+        distinctiveness(b, other_placements(a, b, result.transform, options, others), best_q, result.transform);
     // b's prepared data, masked and cut (preparing the common part again cost a third of the time
     // of preparing the maps).
     Eigen::Vector2i origin;
@@ -292,7 +324,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       const core::Transform2 answer(result.transform.translation() + result.transform.rotation_matrix() * o,
                                     result.transform.rotation());  // the cut's cells into a's
       const AlignmentQuality own = evaluate_alignment(a, pc, answer, options.quality);
-      const auto [d, alternative] = distinctiveness(other_placements(a, pc, answer, options, {}), own, answer);
+      const auto [d, alternative] = distinctiveness(pc, other_placements(a, pc, answer, options, {}), own, answer);
       if (d < result.distinctiveness) {
         result.distinctiveness = d;
         // Back to b's cells: the cut's cell q is b's cell q + o.
@@ -311,8 +343,10 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       co.min_turned_share > 0.0 && best_q.beyond_room <= co.zero_beyond_corner && turned >= co.min_turned_share;
   if (one_room) result.distinctiveness = 0.0;
   const double support_factor = support(result.evidence * result.distinctiveness);
-  const double corner_factor =
-      clamp01((best_q.beyond_corner - co.zero_beyond_corner) / (co.full_beyond_corner - co.zero_beyond_corner));
+  // Matched wall ends count with the blocks off the corner's two lines: an opening in a wall, seen in
+  // both maps at one place, tells the corner from the room's other corners as a wall beyond does.
+  const double corner_factor = clamp01((best_q.beyond_corner + best_q.wall_ends - co.zero_beyond_corner) /
+                                       (co.full_beyond_corner - co.zero_beyond_corner));
   result.confidence = agree_factor * acceptance_factor * support_factor * corner_factor;
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {

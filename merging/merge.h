@@ -51,12 +51,16 @@ namespace fleetmap::merging {
 //   answers on the benchmark: large contradiction-free fits of similar houses.)
 //   A different answer is plausible when its contradictions are what the best answer's own rate
 //   (at least min_contradiction_rate) predicts: with z = (c - rate n) / sqrt(rate n + 1) over its n
-//   tested walls, it counts fully for z <= 2 and not at all for z >= 4.
+//   tested walls, it counts fully for z <= 2 and not at all for z >= 4; and, as the answer, when
+//   its cells agree with a's (its score times the acceptance factor below at its own omega): a
+//   placement that lays free cells on occupied ones could not be merged and is no rival.
 // - corner factor: the matched walls off the two straight lines that hold most of them
 //   (AlignmentQuality::beyond_corner), 0 up to zero_beyond_corner, 1 from full_beyond_corner on
-//   (4 x 4 blocks of wall, counted in both maps: a door jamb seen by both is two): two maps whose
-//   common walls are one corner of a bare room fit any other corner as well, and nothing in
-//   either map can tell (seen on a real plan: two corners of a large hall, turned a quarter).
+//   (4 x 4 blocks of wall, counted in both maps: a door jamb seen by both is two), plus the
+//   matched wall ends (AlignmentQuality::wall_ends: an opening in a wall that both maps see
+//   through, at the same place in both): two maps whose common walls are one corner of a bare room fit any other
+//   corner as well, and nothing in either map can tell (seen on a real plan: two corners of a
+//   large hall, turned a quarter); an opening in one of the walls pins the corner along them.
 // - one rectangular room (ConfidenceOptions::min_turned_share): its sides are four lines, and the
 //   room turned a half turn fits them too; when the answer's common walls are such four lines and
 //   the probes find a turned placement free of contradictions with at least that share of the

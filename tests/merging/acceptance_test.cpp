@@ -78,5 +78,21 @@ TEST(AlignmentQuality, WallsSeenFromOppositeSidesDoNotMatch) {
   EXPECT_EQ(opposite.matched, 0);
 }
 
+// A wall with a door opening: at the right placement both maps show the opening's two jambs at the
+// same place (wall ends, which tell where along the wall the maps meet); slid along the wall, or
+// without an opening, there are none.
+TEST(AlignmentQuality, CountsDoorJambsSeenByBothMapsAtOnePlace) {
+  std::vector<std::string> rows(30, std::string(60, '.'));
+  rows[15] = std::string(60, '#');
+  const auto plain = grid_from_text(rows);
+  rows[15].replace(28, 6, std::string(6, '.'));
+  const auto door = grid_from_text(rows);
+  const PreparedGrid a(door), b(door), c(plain);
+  const AlignmentQuality right = evaluate_alignment(a, b, core::Transform2::identity());
+  EXPECT_GE(right.wall_ends, 2);  // both jambs, at least once
+  EXPECT_EQ(evaluate_alignment(a, b, core::Transform2(10.0, 0.0, 0.0)).wall_ends, 0);
+  EXPECT_EQ(evaluate_alignment(c, c, core::Transform2::identity()).wall_ends, 0);
+}
+
 }  // namespace
 }  // namespace fleetmap::merging
