@@ -19,7 +19,8 @@ namespace {
 // counts twice); every robot gets an open tour, and the targets are split among the robots so that
 // the weighted sum of the times at which they are reached is as small as the search finds
 // (plan_latency_tours): the team reveals the most area soonest. Each robot drives to its tour's
-// first target.
+// first target; a robot with an empty tour drives ahead to where unknown space will open
+// (drive_ahead).
 //
 // Why not the min-max split (the longest tour as short as possible, plan_tours): measured on the
 // wave-algorithm paper's maps it was slower than Burgard's utility reduction (bench/README.md,
@@ -65,14 +66,43 @@ class Tour final : public CoordinationStrategy {
       for (int t : tours[i]) kept.push_back(input.targets[std::size_t(t)].goal_m);
       if (!tours[i].empty()) out[i] = tours[i].front();
     }
-    if (input.scores) explain(input, problem, weight, tours);
+    const std::vector<int> ahead = drive_ahead(problem, weight, tours);
+    for (std::size_t i = 0; i < n; ++i)
+      if (ahead[i] >= 0) out[i] = ahead[i];
+    if (input.scores) explain(input, problem, weight, tours, ahead);
     return out;
   }
 
  private:
+  // Robots the minimum-latency split leaves free (every target is reached sooner by another robot)
+  // do not wait: each drives ahead to the target with the most unknown area per metre of its way
+  // (weight / (1 + wave cost)), already on another robot's tour, where new frontiers will open
+  // once that robot sees it, as RACER (Zhou et al. 2023) keeps every robot moving toward unknown
+  // space of its own. No two free robots drive ahead to the same target. Measured on the
+  // wave-algorithm paper's maps (bench/README.md, "Tour strategy"): waiting robots made the last
+  // corridors slow. Per robot: the target it drives ahead to, or -1 (its tour is not empty, or it
+  // reaches no target).
+  static std::vector<int> drive_ahead(const TourProblem& problem, const std::vector<double>& weight, const Tours& tours) {
+    const auto n = std::size_t(problem.start_cost.rows()), m = std::size_t(problem.start_cost.cols());
+    std::vector<int> ahead(n, -1);
+    std::vector<char> taken(m, false);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!tours[i].empty()) continue;
+      double best = 0.0;
+      for (std::size_t t = 0; t < m; ++t) {
+        const double cost = problem.start_cost(Eigen::Index(i), Eigen::Index(t));
+        if (!std::isfinite(cost) || taken[t]) continue;
+        const double rate = (weight.empty() ? 1.0 : weight[t]) / (1.0 + cost);
+        if (ahead[i] < 0 || rate > best) best = rate, ahead[i] = int(t);
+      }
+      if (ahead[i] >= 0) taken[std::size_t(ahead[i])] = true;
+    }
+    return ahead;
+  }
+
   // Per candidate: its wave cost, the area behind it, and when the tour it belongs to reaches it.
   static void explain(const AssignmentInput& input, const TourProblem& problem, const std::vector<double>& weight,
-                      const Tours& tours) {
+                      const Tours& tours, const std::vector<int>& ahead) {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     std::vector<double> arrival(input.targets.size(), nan);
     std::vector<int> owner(input.targets.size(), -1);
@@ -92,7 +122,8 @@ class Tour final : public CoordinationStrategy {
                    .lower_is_better = true,
                    .rule = "every robot gets an open tour through the targets; the tours make the area-weighted sum of "
                            "the times targets are reached least (minimum latency, after TARE, Cao et al. 2021, and "
-                           "RACER, Zhou et al. 2023); each robot drives to its tour's first target", .robots = {}},
+                           "RACER, Zhou et al. 2023); each robot drives to its tour's first target, one with an empty tour "
+                           "ahead to the target with the most unknown area per metre of its way", .robots = {}},
                   [&](std::size_t i, std::size_t t) {
                     const double area = weight.empty() ? nan : weight[t] - kBaseWeight;
                     const int o = owner[t];
@@ -103,7 +134,9 @@ class Tour final : public CoordinationStrategy {
                   });
     for (std::size_t i = 0; i < tours.size(); ++i) {
       input.scores->robots[i].note =
-          tours[i].empty() ? std::string("an empty tour: the others reach every target sooner")
+          tours[i].empty() ? (ahead[i] < 0 ? std::string("an empty tour: the others reach every target sooner")
+                                            : std::string("an empty tour: the others reach every target sooner; drives ahead to "
+                                                          "the target with the most unknown area per metre"))
                            : fmt::format("its tour: {} target{}, {:.1f} m, weighted latency {:.0f} m*m2", tours[i].size(),
                                          tours[i].size() == 1 ? "" : "s", tour_length(problem, int(i), tours[i]),
                                          tour_latency(problem, weight, int(i), tours[i]));
