@@ -75,7 +75,8 @@ class CoordinationStrategy {
   virtual bool joint() const = 0;
   // Per robot of the input: the index of its target, or -1 for none. Joint strategies give each
   // target to one robot at most; with more robots than targets the others get -1 and wait (a team
-  // that sends its spare robots after taken targets jams in the last corridor).
+  // that sends its spare robots after taken targets jams in the last corridor). Exception: `tour`
+  // sends a robot with an empty tour ahead to a target on another robot's tour (two at most).
   virtual std::vector<int> assign(const AssignmentInput& input) const = 0;
 };
 
