@@ -84,11 +84,13 @@ struct Args {
   int build_part = -1, build_parts = 0;  // --build-maps K/N: only build the cached maps of plans K, K + N, ... and stop
 };
 
+constexpr const char* kUsage =
+    "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
+    "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
+    "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S] [--build-maps K/N]\n";
+
 [[noreturn]] void usage(const std::string& problem) {
-  std::cerr << "fleetmap_bench_merging_real: " << problem << "\n"
-            << "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
-            << "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
-            << "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S] [--build-maps K/N]\n";
+  std::cerr << "fleetmap_bench_merging_real: " << problem << "\n" << kUsage;
   std::exit(2);
 }
 
@@ -96,6 +98,10 @@ Args parse_args(int argc, char** argv) {
   Args a;
   for (int i = 1; i < argc; ++i) {
     const std::string k = argv[i];
+    if (k == "--help" || k == "-h") {
+      std::cout << "The merging benchmark of robot-built maps (bench/README.md, \"Merging robot-built maps\").\n" << kUsage;
+      std::exit(0);
+    }
     const auto value = [&]() -> std::string {
       if (i + 1 >= argc) usage(k + " needs a value");
       return argv[++i];
