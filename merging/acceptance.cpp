@@ -10,29 +10,51 @@
 
 namespace fleetmap::merging {
 
-Acceptance acceptance_index(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
-                            const core::Transform2& b_to_a) {
+namespace {
+
+// The agr / dis count over b's known cells moved into a; state_a / state_b give a cell's state
+// (0 unknown, 1 free, 2 occupied, as mapping::CellState) for the two ways a map is held (a grid, or a prepared level).
+template <class StateA, class StateB>
+Acceptance count_agreement(int wa, int ha, int wb, int hb, StateA state_a, StateB state_b, const core::Transform2& b_to_a) {
   Acceptance acc;
   const Eigen::Matrix2d r = b_to_a.rotation_matrix();
   const Eigen::Vector2d t = b_to_a.translation();
-  const int wa = a.width(), ha = a.height();
-  for (int y = 0; y < b.height(); ++y) {
-    const int row = y * b.width();
+  for (int y = 0; y < hb; ++y) {
     // The row's cells move along a line: start and step in a's coordinates.
     const Eigen::Vector2d start = r * Eigen::Vector2d(0.0, y) + t, step = r.col(0);
-    for (int x = 0; x < b.width(); ++x) {
-      const mapping::CellState sb = b.state_at(row + x);
-      if (sb == mapping::CellState::Unknown) continue;
+    for (int x = 0; x < wb; ++x) {
+      const int sb = state_b(x, y);
+      if (sb == 0) continue;
       const Eigen::Vector2d p = start + double(x) * step;
       const int ax = nearest_cell(p.x()), ay = nearest_cell(p.y());
       if (ax < 0 || ay < 0 || ax >= wa || ay >= ha) continue;
-      const mapping::CellState sa = a.state_at(ay * wa + ax);
-      if (sa == mapping::CellState::Unknown) continue;
+      const int sa = state_a(ax, ay);
+      if (sa == 0) continue;
       if (sa == sb) ++acc.agree;
       else ++acc.disagree;
     }
   }
   return acc;
+}
+
+int state_of(const GridLevel& g, int x, int y) {
+  return g.occupied.at<std::uint8_t>(y, x) != 0 ? 2 : g.free.at<std::uint8_t>(y, x) != 0 ? 1 : 0;
+}
+
+}  // namespace
+
+Acceptance acceptance_index(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
+                            const core::Transform2& b_to_a) {
+  return count_agreement(
+      a.width(), a.height(), b.width(), b.height(),
+      [&](int x, int y) { return int(a.state_at(y * a.width() + x)); },
+      [&](int x, int y) { return int(b.state_at(y * b.width() + x)); }, b_to_a);
+}
+
+Acceptance acceptance_index(const GridLevel& a, const GridLevel& b, const core::Transform2& b_to_a) {
+  return count_agreement(
+      a.width(), a.height(), b.width(), b.height(), [&](int x, int y) { return state_of(a, x, y); },
+      [&](int x, int y) { return state_of(b, x, y); }, b_to_a);
 }
 
 namespace {

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "merging/acceptance.h"
 #include "merging/prepared_grid.h"
 
 namespace fleetmap::merging {
@@ -77,5 +78,9 @@ inline bool seen_from_same_side(const GridLevel& target, const Eigen::Vector2f& 
 // mask gives a grid without walls.
 PreparedGrid prepared_part(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options,
                            Eigen::Vector2i& origin);
+
+// The acceptance index (merging/acceptance.h) of two prepared levels: b's known cells (a masked
+// part's cells only) placed by b_to_a on a.
+Acceptance acceptance_index(const GridLevel& a, const GridLevel& b, const core::Transform2& b_to_a);
 
 }  // namespace fleetmap::merging

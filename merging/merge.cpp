@@ -83,32 +83,6 @@ cv::Mat common_mask(const PreparedGrid& a, const PreparedGrid& b, const core::Tr
   return mask;
 }
 
-// The acceptance index (Birk & Carpin 2006) of the known cells of `b`'s finest level (a masked
-// part's cells only) placed by b_to_a on a's finest level.
-double level_acceptance(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a) {
-  const GridLevel& la = a.level(0);
-  const GridLevel& lb = b.level(0);
-  const Eigen::Matrix2d r = b_to_a.rotation_matrix();
-  const Eigen::Vector2d t = b_to_a.translation();
-  std::int64_t agree = 0, disagree = 0;
-  for (int y = 0; y < lb.height(); ++y) {
-    const auto* bo = lb.occupied.ptr<std::uint8_t>(y);
-    const auto* bf = lb.free.ptr<std::uint8_t>(y);
-    const Eigen::Vector2d start = r * Eigen::Vector2d(0.0, y) + t, step = r.col(0);
-    for (int x = 0; x < lb.width(); ++x) {
-      if (bo[x] == 0 && bf[x] == 0) continue;
-      const Eigen::Vector2d p = start + double(x) * step;
-      const int ax = nearest_cell(p.x()), ay = nearest_cell(p.y());
-      if (ax < 0 || ay < 0 || ax >= la.width() || ay >= la.height()) continue;
-      const bool a_occupied = la.occupied.at<std::uint8_t>(ay, ax) != 0;
-      if (!a_occupied && la.free.at<std::uint8_t>(ay, ax) == 0) continue;
-      if (a_occupied == (bo[x] != 0)) ++agree;
-      else ++disagree;
-    }
-  }
-  return agree + disagree > 0 ? double(agree) / double(agree + disagree) : 0.0;
-}
-
 // Coarse to fine: every candidate joins at its level; after each level near-duplicates go and only
 // the best few go on.
 std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGrid& b,
@@ -293,7 +267,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       // A rival is judged as the answer is: one whose cells disagree with a's (free on occupied)
       // more than the acceptance factor allows could not be merged itself, and says nothing about
       // the answer (seen on the benchmark: a quarter-turned corner of one room laid on a's walls).
-      if (plausible > second) plausible *= acceptance_factor_of(level_acceptance(a, from, t));
+      if (plausible > second) plausible *= acceptance_factor_of(acceptance_index(a.level(0), from.level(0), t).omega());
       if (plausible > second) second = plausible, alternative = t;
       const double dtheta = std::abs(core::normalize_angle(t.rotation() - answer.rotation()));
       if (z <= 2.0 && dtheta > std::numbers::pi / 4.0 && own > 0.0) turned = std::max(turned, evidence_of(q) / own);
