@@ -17,14 +17,33 @@ cv::Mat find_clutter(const cv::Mat& occupied, int gap, int size) {
   cv::Mat joined;  // a new matrix: dilating into a header of `occupied` would write into it
   if (gap > 0) cv::dilate(occupied, joined, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * gap + 1, 2 * gap + 1}));
   else joined = occupied;
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(joined, labels, stats, centroids, 8, CV_32S);
-  std::vector<std::uint8_t> small(std::size_t(std::max(n, 1)), 0);
+  cv::Mat labels;
+  // Labels only: OpenCV's statistics cost ten times the labelling on a large map; the boxes come
+  // from the occupied cells alone (below).
+  const int n = cv::connectedComponents(joined, labels, 8, CV_32S);
+  // The box of each joined component: its occupied cells' box grown by `gap` (the ellipse reaches
+  // `gap` cells along both axes), clipped to the map as the dilation is.
+  std::vector<cv::Rect> boxes(std::size_t(std::max(n, 1)), cv::Rect());
+  std::vector<int> x0(boxes.size(), occupied.cols), y0(boxes.size(), occupied.rows), x1(boxes.size(), -1),
+      y1(boxes.size(), -1);
+  for (int y = 0; y < occupied.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    const auto* o = occupied.ptr<std::uint8_t>(y);
+    for (int x = 0; x < occupied.cols; ++x) {
+      if (!o[x]) continue;
+      const auto i = std::size_t(l[x]);
+      x0[i] = std::min(x0[i], x), x1[i] = std::max(x1[i], x), y0[i] = std::min(y0[i], y), y1[i] = std::max(y1[i], y);
+    }
+  }
+  std::vector<std::uint8_t> small(boxes.size(), 0);
   bool any = false;
-  for (int i = 1; i < n; ++i) {
+  for (std::size_t i = 1; i < boxes.size(); ++i) {
+    if (x1[i] < 0) continue;
+    const int width = std::min(x1[i] + gap, occupied.cols - 1) - std::max(x0[i] - gap, 0) + 1;
+    const int height = std::min(y1[i] + gap, occupied.rows - 1) - std::max(y0[i] - gap, 0) + 1;
     // The dilation grew the box by `gap` on each side.
-    const int extent = std::max(stats.at<int>(i, cv::CC_STAT_WIDTH), stats.at<int>(i, cv::CC_STAT_HEIGHT)) - 2 * gap;
-    if (extent <= size) small[std::size_t(i)] = 255, any = true;
+    const int extent = std::max(width, height) - 2 * gap;
+    if (extent <= size) small[i] = 255, any = true;
   }
   cv::Mat clutter = cv::Mat::zeros(occupied.size(), CV_8U);
   if (!any) return clutter;
@@ -37,28 +56,47 @@ cv::Mat find_clutter(const cv::Mat& occupied, int gap, int size) {
   return clutter;
 }
 
+// Max pooling of a mask by 2 into `out` ((rows + 1) / 2 x (cols + 1) / 2), one output cell at a time.
+void pool_into(const cv::Mat& m, cv::Mat& out) {
+  const int w = (m.cols + 1) / 2, h = (m.rows + 1) / 2, pairs = m.cols / 2;
+  out.create(h, w, CV_8U);
+  for (int y = 0; y < h; ++y) {
+    const auto* r0 = m.ptr<std::uint8_t>(2 * y);
+    const auto* r1 = 2 * y + 1 < m.rows ? m.ptr<std::uint8_t>(2 * y + 1) : r0;
+    auto* o = out.ptr<std::uint8_t>(y);
+    for (int x = 0; x < pairs; ++x) o[x] = std::uint8_t(r0[2 * x] | r0[2 * x + 1] | r1[2 * x] | r1[2 * x + 1]);
+    if (pairs < w) o[pairs] = std::uint8_t(r0[2 * pairs] | r1[2 * pairs]);
+  }
+}
+
 // Max pooling by 2: occupied if any fine cell is; free if any is free and none is occupied.
 void downsample(const cv::Mat& occ, const cv::Mat& fre, cv::Mat& occ_out, cv::Mat& free_out) {
-  const int w = (occ.cols + 1) / 2, h = (occ.rows + 1) / 2;
-  occ_out = cv::Mat::zeros(h, w, CV_8U);
-  free_out = cv::Mat::zeros(h, w, CV_8U);
-  for (int y = 0; y < occ.rows; ++y) {
-    const auto* o = occ.ptr<std::uint8_t>(y);
-    const auto* f = fre.ptr<std::uint8_t>(y);
-    auto* oo = occ_out.ptr<std::uint8_t>(y / 2);
-    auto* fo = free_out.ptr<std::uint8_t>(y / 2);
-    for (int x = 0; x < occ.cols; ++x) {
-      oo[x / 2] |= o[x];
-      fo[x / 2] |= f[x];
-    }
-  }
+  pool_into(occ, occ_out);
+  pool_into(fre, free_out);
   free_out.setTo(0, occ_out);
 }
 
 // The unit direction toward the free cells within 2 cells of (x, y) (the mean of their directions,
 // each weighted 1 / distance), zero where free space lies on opposite sides or nowhere near.
 Eigen::Vector2f free_direction(const cv::Mat& free, int x, int y) {
-  constexpr int kR = 2;
+  constexpr int kR = 2, kSide = 2 * kR + 1;
+  // Each neighbour's direction / distance^2 and 1 / distance, computed once.
+  struct Offsets {
+    Eigen::Vector2f direction[kSide * kSide];
+    float weight[kSide * kSide];
+  };
+  static const Offsets offsets = [] {
+    Offsets o{};
+    for (int dy = -kR; dy <= kR; ++dy) {
+      for (int dx = -kR; dx <= kR; ++dx) {
+        const float d2 = float(dx * dx + dy * dy);
+        const int i = (dy + kR) * kSide + dx + kR;
+        o.direction[i] = d2 > 0.0f ? Eigen::Vector2f(Eigen::Vector2f(float(dx), float(dy)) / d2) : Eigen::Vector2f::Zero();
+        o.weight[i] = d2 > 0.0f ? 1.0f / std::sqrt(d2) : 0.0f;
+      }
+    }
+    return o;
+  }();
   Eigen::Vector2f sum = Eigen::Vector2f::Zero();
   float weight = 0.0f;
   for (int dy = -kR; dy <= kR; ++dy) {
@@ -68,9 +106,9 @@ Eigen::Vector2f free_direction(const cv::Mat& free, int x, int y) {
     for (int dx = -kR; dx <= kR; ++dx) {
       const int xx = x + dx;
       if (xx < 0 || xx >= free.cols || (dx == 0 && dy == 0) || row[xx] == 0) continue;
-      const float d2 = float(dx * dx + dy * dy);
-      sum += Eigen::Vector2f(float(dx), float(dy)) / d2;
-      weight += 1.0f / std::sqrt(d2);
+      const int i = (dy + kR) * kSide + dx + kR;
+      sum += offsets.direction[i];
+      weight += offsets.weight[i];
     }
   }
   // Free space on one side only gives |sum| near weight; on two opposite sides, near 0.
@@ -90,7 +128,7 @@ void finish_level(GridLevel& level, const PrepareOptions& options) {
     level.wall_distance = cv::Mat(level.walls.size(), CV_32F, cv::Scalar(1e4));
   } else {
     cv::Mat not_wall = level.walls == 0;
-    cv::distanceTransform(not_wall, level.wall_distance, cv::DIST_L2, cv::DIST_MASK_5, CV_32F);
+    cv::distanceTransform(not_wall, level.wall_distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
   }
   // At most `cap` points, chosen by a hash of the cell: spread evenly in space without following
   // the raster order (taking every k-th point of a row scan would leave rows, and the Hough
@@ -173,12 +211,18 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
     }
   }
   if (options.min_obstacle_cells > 1) {
-    cv::Mat labels, stats, centroids;
-    const int n = cv::connectedComponentsWithStats(base.occupied, labels, stats, centroids, 8, CV_32S);
-    std::vector<std::uint8_t> speck(std::size_t(n), 0);
+    // Component sizes counted here: OpenCV's statistics cost ten times the labelling on a large map.
+    cv::Mat labels;
+    const int n = cv::connectedComponents(base.occupied, labels, 8, CV_32S);
+    std::vector<int> area(std::size_t(std::max(n, 1)), 0);
+    for (int y = 0; y < labels.rows; ++y) {
+      const int* l = labels.ptr<int>(y);
+      for (int x = 0; x < labels.cols; ++x) ++area[std::size_t(l[x])];
+    }
+    std::vector<std::uint8_t> speck(area.size(), 0);
     bool any = false;
-    for (int i = 1; i < n; ++i) {
-      if (stats.at<int>(i, cv::CC_STAT_AREA) < options.min_obstacle_cells) speck[std::size_t(i)] = 1, any = true;
+    for (std::size_t i = 1; i < area.size(); ++i) {
+      if (area[i] < options.min_obstacle_cells) speck[i] = 1, any = true;
     }
     if (any) {
       for (int y = 0; y < labels.rows; ++y) {
@@ -202,9 +246,9 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
     const GridLevel& prev = levels_.back();
     downsample(prev.occupied, prev.free, next.occupied, next.free);
     // A coarse cell is clutter when its occupied fine cells all are.
-    cv::Mat pooled_clutter, pooled_structure, unused;
-    downsample(prev.clutter, prev.free, pooled_clutter, unused);
-    downsample(prev.occupied & ~prev.clutter, prev.free, pooled_structure, unused);
+    cv::Mat pooled_clutter, pooled_structure;
+    pool_into(prev.clutter, pooled_clutter);
+    pool_into(prev.occupied & ~prev.clutter, pooled_structure);
     next.clutter = pooled_clutter & ~pooled_structure;
     finish_level(next, options);
     levels_.push_back(std::move(next));
@@ -217,18 +261,19 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
   walls_.reserve(pts.size());
   constexpr int kR = 3;
   for (const auto& p : pts) {
-    double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
-    for (int dy = -kR; dy <= kR; ++dy) {
-      const int y = p.y + dy;
-      if (y < 0 || y >= l0.height()) continue;
-      const auto* row = l0.walls.ptr<std::uint8_t>(y);
-      for (int dx = -kR; dx <= kR; ++dx) {
-        const int x = p.x + dx;
-        if (x < 0 || x >= l0.width() || dx * dx + dy * dy > kR * kR || row[x] == 0) continue;
-        n += 1;
-        sx += dx, sy += dy, sxx += dx * dx, sxy += dx * dy, syy += dy * dy;
+    // Sums of small integers: exact in int, and several times faster than in double.
+    int ni = 0, sxi = 0, syi = 0, sxxi = 0, sxyi = 0, syyi = 0;
+    const int dy0 = std::max(-kR, -p.y), dy1 = std::min(kR, l0.height() - 1 - p.y);
+    const int dx0 = std::max(-kR, -p.x), dx1 = std::min(kR, l0.width() - 1 - p.x);
+    for (int dy = dy0; dy <= dy1; ++dy) {
+      const auto* row = l0.walls.ptr<std::uint8_t>(p.y + dy) + p.x;
+      for (int dx = dx0; dx <= dx1; ++dx) {
+        if (dx * dx + dy * dy > kR * kR || row[dx] == 0) continue;
+        ++ni;
+        sxi += dx, syi += dy, sxxi += dx * dx, sxyi += dx * dy, syyi += dy * dy;
       }
     }
+    const double n = ni, sx = sxi, sy = syi, sxx = sxxi, sxy = sxyi, syy = syyi;
     WallPoint w;
     w.position = Eigen::Vector2f(float(p.x), float(p.y));
     Eigen::Matrix2d c;
@@ -247,12 +292,8 @@ namespace {
 
 // Max pooling of a mask by 2.
 cv::Mat pool_mask(const cv::Mat& m) {
-  cv::Mat out = cv::Mat::zeros((m.rows + 1) / 2, (m.cols + 1) / 2, CV_8U);
-  for (int y = 0; y < m.rows; ++y) {
-    const auto* r = m.ptr<std::uint8_t>(y);
-    auto* o = out.ptr<std::uint8_t>(y / 2);
-    for (int x = 0; x < m.cols; ++x) o[x / 2] |= r[x];
-  }
+  cv::Mat out;
+  pool_into(m, out);
   return out;
 }
 

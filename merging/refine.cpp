@@ -40,12 +40,22 @@ void collect(const GridLevel& from, const GridLevel& to, const core::Transform2&
     res.from_b = from_b;
     out.push_back(res);
   }
+}
+
+// Interior points of `from` (inside filled obstacles) moved by t onto `to`'s clear free space.
+// They count against the fit only, so only at the final transform.
+int interior_outliers(const GridLevel& from, const GridLevel& to, const core::Transform2& t) {
+  const Eigen::Matrix2f r = t.rotation_matrix().cast<float>();
+  const Eigen::Vector2f tr = t.translation().cast<float>();
+  constexpr float kFar = 1e4f;
+  int outliers = 0;
   for (const auto& w : from.interior_points) {
     const Eigen::Vector2f p = r * w + tr;
     const int x = nearest_cell(p.x()), y = nearest_cell(p.y());
     if (x < 0 || y < 0 || x >= to.width() || y >= to.height() || !to.is_free(x, y)) continue;
     if (to.distance_at(p.x(), p.y(), kFar) >= 2.5f) ++outliers;
   }
+  return outliers;
 }
 
 }  // namespace
@@ -98,6 +108,8 @@ LevelFit refine_at_level(const PreparedGrid& a, const PreparedGrid& b, const cor
       it = options.iterations - 1;
     }
   }
+  // The last pass above was at the final t.
+  fit.outliers += interior_outliers(lb, la, t) + interior_outliers(la, lb, t.inverse());
   fit.b_to_a = from_level(t, la.factor);
   fit.score = fit.inliers - options.contradiction_weight * fit.outliers;
   return fit;
