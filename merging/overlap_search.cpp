@@ -40,7 +40,8 @@ cv::Mat padded_dft(const cv::Mat& img, cv::Size size) {
   cv::Mat padded = cv::Mat::zeros(size, CV_32F);
   img.copyTo(padded(cv::Rect(0, 0, img.cols, img.rows)));
   cv::Mat spectrum;
-  cv::dft(padded, spectrum);
+  // Rows past the image are zero: their row transforms are zero and are skipped.
+  cv::dft(padded, spectrum, 0, img.rows);
   return spectrum;
 }
 

@@ -116,8 +116,8 @@ Eigen::Vector2f free_direction(const cv::Mat& free, int x, int y) {
   return weight > 0.0f && n >= 0.5f * weight ? Eigen::Vector2f(sum / n) : Eigen::Vector2f::Zero();
 }
 
-// `level.clutter` must be set (or empty: none).
-void finish_level(GridLevel& level, const PrepareOptions& options) {
+// `level.clutter` must be set (or empty: none). `wall_cells` gets every wall cell, row by row.
+void finish_level(GridLevel& level, const PrepareOptions& options, std::vector<cv::Point>& wall_cells) {
   if (level.clutter.empty()) level.clutter = cv::Mat::zeros(level.occupied.size(), CV_8U);
   // Walls: occupied cells touching free space (8-neighbourhood).
   cv::Mat free_near;
@@ -143,7 +143,8 @@ void finish_level(GridLevel& level, const PrepareOptions& options) {
       if ((h & 0xffffu) < keep) out.emplace_back(float(p.x), float(p.y));
     }
   };
-  std::vector<cv::Point> pts;
+  std::vector<cv::Point>& pts = wall_cells;
+  pts.clear();
   cv::findNonZero(level.walls, pts);
   sample(pts, level.wall_points);
   cv::Mat occupied_near;
@@ -155,12 +156,15 @@ void finish_level(GridLevel& level, const PrepareOptions& options) {
     level.wall_normals.push_back(free_direction(level.free, int(p.x()), int(p.y())));
     level.wall_clutter.push_back(level.clutter.at<std::uint8_t>(int(p.y()), int(p.x())) != 0);
   }
-  cv::Mat interior = level.occupied & ~level.walls & ~level.clutter;
-  pts.clear();
-  cv::findNonZero(interior, pts);
+  // Interior: occupied, not a wall, not clutter; even rows and columns only.
   std::vector<cv::Point> even;
-  for (const auto& p : pts) {
-    if (p.x % 2 == 0 && p.y % 2 == 0) even.push_back(p);
+  for (int y = 0; y < level.occupied.rows; y += 2) {
+    const auto* o = level.occupied.ptr<std::uint8_t>(y);
+    const auto* w = level.walls.ptr<std::uint8_t>(y);
+    const auto* c = level.clutter.ptr<std::uint8_t>(y);
+    for (int x = 0; x < level.occupied.cols; x += 2) {
+      if (o[x] && !w[x] && !c[x]) even.emplace_back(x, y);
+    }
   }
   sample(even, level.interior_points);
 }
@@ -238,7 +242,8 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
   // Gaps of two cells at least: a thin wall turned and resampled on another grid breaks every few cells.
   base.clutter = find_clutter(base.occupied, std::max(2, int(std::lround(options.clutter_gap_m / resolution))),
                               int(std::lround(options.clutter_size_m / resolution)));
-  finish_level(base, options);
+  std::vector<cv::Point> pts;  // level 0's wall cells
+  finish_level(base, options, pts);
   levels_.push_back(std::move(base));
   while (std::max(levels_.back().width(), levels_.back().height()) / 2 >= options.min_level_size) {
     GridLevel next;
@@ -250,14 +255,13 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
     pool_into(prev.clutter, pooled_clutter);
     pool_into(prev.occupied & ~prev.clutter, pooled_structure);
     next.clutter = pooled_clutter & ~pooled_structure;
-    finish_level(next, options);
+    std::vector<cv::Point> unused;
+    finish_level(next, options, unused);
     levels_.push_back(std::move(next));
   }
 
   // Every full-resolution wall cell with the covariance of its wall neighbours (radius 3).
   const GridLevel& l0 = levels_.front();
-  std::vector<cv::Point> pts;
-  cv::findNonZero(l0.walls, pts);
   walls_.reserve(pts.size());
   constexpr int kR = 3;
   for (const auto& p : pts) {

@@ -22,6 +22,9 @@ void collect(const GridLevel& from, const GridLevel& to, const core::Transform2&
              bool from_b, double cutoff, std::vector<Residual>& out, int& inliers, int& outliers) {
   const Eigen::Matrix2f r = t.rotation_matrix().cast<float>();
   const Eigen::Vector2f tr = t.translation().cast<float>();
+  // to_a.apply, with its rotation computed once (not once per point).
+  const Eigen::Matrix2d ra = to_a.rotation_matrix();
+  const Eigen::Vector2d ta = to_a.translation();
   constexpr float kFar = 1e4f;
   for (std::size_t i = 0; i < from.wall_points.size(); ++i) {
     const Eigen::Vector2f p = r * from.wall_points[i] + tr;
@@ -34,7 +37,7 @@ void collect(const GridLevel& from, const GridLevel& to, const core::Transform2&
     if (d > cutoff || !seen_from_same_side(to, p, r * from.wall_normals[i])) continue;
     if (d <= 1.0f) ++inliers;
     Residual res;
-    res.position = to_a.apply(p.cast<double>());
+    res.position = ra * p.cast<double>() + ta;
     res.gradient = Eigen::Vector2d(gx, gy);
     res.r = d;
     res.from_b = from_b;
