@@ -16,12 +16,15 @@ std::vector<double> hough_spectrum(const std::vector<Eigen::Vector2f>& points, i
   for (const auto& p : points) max_r = std::max(max_r, (p - c).norm());
   const int offset = int(std::ceil(max_r)) + 1, rho_bins = 2 * offset + 1;
   std::vector<int> h(static_cast<std::size_t>(rho_bins));
+  // The points relative to their centre, once (not once per angle).
+  std::vector<float> dx(points.size()), dy(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) dx[i] = points[i].x() - c.x(), dy[i] = points[i].y() - c.y();
   for (int j = 0; j < bins; ++j) {
     const double theta = j * std::numbers::pi / bins;
     const float cs = float(std::cos(theta)), sn = float(std::sin(theta));
     std::fill(h.begin(), h.end(), 0);
-    for (const auto& p : points) {
-      const float rho = (p.x() - c.x()) * cs + (p.y() - c.y()) * sn;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const float rho = dx[i] * cs + dy[i] * sn;
       ++h[std::size_t(int(rho + float(offset) + 0.5f))];
     }
     double s = 0.0;
