@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <opencv2/core.hpp>
 
 #include "merging/acceptance.h"
@@ -136,6 +139,48 @@ TEST(PreparedGrid, WallStructureIsTheNormalOnAStraightWall) {
     EXPECT_NEAR(w.structure(1, 1), 1.0f, 1e-5) << w.position.transpose();  // normal is y
     EXPECT_NEAR(w.structure(0, 0), 0.0f, 1e-5);
   }
+}
+
+
+// The distance to the walls is the Euclidean one (not a chamfer approximation: 1.4 for a diagonal
+// step, 2.2 for a knight's move) at every level: refinement and scoring read it as cells.
+TEST(PreparedGrid, WallDistanceIsEuclideanAtEveryLevel) {
+  std::vector<std::string> rows(48, std::string(48, '.'));
+  rows[20].replace(20, 6, "######");  // a short wall
+  rows[30][10] = rows[31][10] = rows[31][11] = '#';  // a small obstacle
+  PrepareOptions o;
+  o.min_level_size = 12;
+  const PreparedGrid p(grid_from_text(rows), o);
+  ASSERT_GE(p.level_count(), 2);
+  for (int k = 0; k < 2; ++k) {
+    const GridLevel& l = p.level(k);
+    std::vector<cv::Point> walls;
+    cv::findNonZero(l.walls, walls);
+    ASSERT_FALSE(walls.empty());
+    for (int y = 0; y < l.height(); ++y) {
+      for (int x = 0; x < l.width(); ++x) {
+        double exact = 1e9;
+        for (const auto& w : walls) exact = std::min(exact, std::hypot(double(x - w.x), double(y - w.y)));
+        EXPECT_NEAR(l.wall_distance.at<float>(y, x), exact, 1e-3) << "level " << k << " at " << x << ", " << y;
+      }
+    }
+  }
+}
+
+// Obstacles touching the map's edge are judged by their own size as elsewhere: a chair in a
+// corner is clutter, a wall along the edge is not; specks at the edge are noise.
+TEST(PreparedGrid, ClutterAndSpecksAtTheMapsEdge) {
+  std::vector<std::string> rows(40, std::string(40, '.'));
+  for (int r = 0; r < 3; ++r) rows[std::size_t(r)].replace(0, 3, "###");  // a chair in the top-left corner
+  rows[39] = std::string(40, '#');                                      // a wall along the bottom edge
+  rows[20][39] = '#';                                                   // a one-cell speck on the right edge
+  const PreparedGrid p(grid_from_text(rows));
+  const GridLevel& l0 = p.level(0);
+  const auto at = [&](const cv::Mat& m, int x, int row) { return m.at<std::uint8_t>(39 - row, x) != 0; };
+  EXPECT_TRUE(at(l0.clutter, 1, 1));
+  EXPECT_FALSE(at(l0.clutter, 20, 39));
+  EXPECT_TRUE(at(l0.occupied, 20, 39));
+  EXPECT_FALSE(at(l0.occupied, 39, 20));  // the speck is left out
 }
 
 }  // namespace
