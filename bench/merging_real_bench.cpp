@@ -454,10 +454,10 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
     const double dd = merging::mean_displacement(*r.alternative, r.transform, p.b);
     o.detail = fmt::format("alternative: {:.1f} deg, {:.1f} cells;", dth, dd);
   }
-  o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};{}",
+  o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};arms={};{}",
                          r.method, r.quality.agreement, r.acceptance, r.quality.constraint, r.distinctiveness,
                          r.quality.matched, r.quality.contradicted, r.quality.tested, r.quality.overlap_radius,
-                         acc.common(), acc.disagree, r.quality.residual_rms, r.quality.beyond_corner, r.quality.wall_ends, r.reason);
+                         acc.common(), acc.disagree, r.quality.residual_rms, r.quality.beyond_corner, r.quality.wall_ends, r.quality.junction_arms, r.reason);
   return o;
 }
 
@@ -476,6 +476,28 @@ Outcome run_peer(const Pair& p) {
   }
   o.detail = fmt::format("matches={};inliers={}", r.matches, r.inliers);
   return o;
+}
+
+// Why a pair the run did not merge right is lost, from the oracle's decision (the truth handed in
+// as a candidate beside all of the search's):
+// - "determinable": the oracle merges the truth: the search missed it (or refined it elsewhere);
+// - "rival-scores-higher": a wrong placement fits the walls better than the truth (the oracle's
+//   answer is wrong): ambiguous on these maps by the wall score;
+// - "rival-fits-as-well", "one-corner", "one-room": the truth is the answer but another placement
+//   fits nearly as well without contradiction, or the common walls are one corner or the sides of
+//   one room: ambiguous;
+// - "little-evidence": the truth is the answer and unrivalled, but too few of its walls pin it
+//   (a corridor, one wall, a bare room): weak rather than ambiguous;
+// - "disagreement": the truth's own cells disagree (walls on free space, drift).
+std::string ambiguity_class(bool merged, bool found, const std::string& reason) {
+  if (merged && found) return "determinable";
+  if (!found) return "rival-scores-higher";
+  if (reason.find("another placement") != std::string::npos) return "rival-fits-as-well";
+  if (reason.find("one corner") != std::string::npos) return "one-corner";
+  if (reason.find("rectangular room") != std::string::npos) return "one-room";
+  if (reason.find("free to slide") != std::string::npos || reason.find("better than chance") != std::string::npos)
+    return "little-evidence";
+  return "disagreement";
 }
 
 // Where the right answer drops out: the spectral rotations' error, the rank of the first right
@@ -518,8 +540,24 @@ std::string diagnose(const Pair& p, const merging::MergeOptions& options) {
   // The right answer's own quality, refined from the truth.
   const auto f = merging::refine_alignment(pa, pb, cut, 2, options.refinement);
   const auto q = merging::evaluate_alignment(pa, pb, f.b_to_a, options.quality);
-  return fmt::format("{:.2f},{},{},{},{},{},{},{:.1f},{},{},{:.2f}", rot_err, spec.size(), r_spec, ref_spec, sweep.size(),
-                     r_sweep, ref_sweep, q.score, q.matched, q.contradicted, q.residual_rms);
+  // The oracle: the same decision with the truth handed in as one more candidate (all of auto's
+  // candidates: spectral, features, sweep). What it does with the truth says whether these maps
+  // determine the answer by fleetmap's own measures (ambiguity_class).
+  std::vector<merging::Hypothesis> all = spec;
+  core::Random random(options.seed);
+  for (auto& h : merging::feature_hypotheses(pa, pb, options.features, random)) all.push_back(h);
+  all.insert(all.end(), sweep.begin(), sweep.end());
+  all.push_back({cut, 1e9, 0, "truth"});
+  const merging::MergeResult o = merging::decide(pa, pb, all, options);
+  const bool o_found = merging::mean_displacement(o.transform, cut, kb.grid()) < kSuccessCells;
+  // The truth alone (its only rivals those the symmetry probes find): would it be merged if the
+  // search had not proposed anything that outscores it?
+  const merging::MergeResult alone = merging::decide(pa, pb, {{cut, 1e9, 0, "truth"}}, options);
+  return fmt::format("{:.2f},{},{},{},{},{},{},{:.1f},{},{},{:.2f},{},{},{:.3f},{:.3f},{:.1f},{},\"{}\",{},{:.3f},{}", rot_err, spec.size(), r_spec,
+                     ref_spec, sweep.size(), r_sweep, ref_sweep, q.score, q.matched, q.contradicted, q.residual_rms,
+                     int(o.merged), int(o_found), o.confidence, o.distinctiveness, o.evidence,
+                     ambiguity_class(o.merged, o_found, o.reason), o.reason, int(alone.merged), alone.confidence,
+                     ambiguity_class(alone.merged, true, alone.reason));
 }
 
 bool success(const Outcome& o) { return o.merged && o.found; }
@@ -687,7 +725,9 @@ int main(int argc, char** argv) {
     if (!args.diagnose.empty()) {
       diag.open(args.diagnose);
       diag << "pair,set,overlap,merged,found,confidence,rot_err_deg,spectral_candidates,first_right,first_refines_right,"
-              "sweep_candidates,sweep_first_right,sweep_first_refines_right,truth_score,truth_matched,truth_contra,truth_rms\n";
+              "sweep_candidates,sweep_first_right,sweep_first_refines_right,truth_score,truth_matched,truth_contra,truth_rms,"
+              "oracle_merged,oracle_found,oracle_confidence,oracle_distinct,oracle_evidence,class,oracle_reason,"
+              "alone_merged,alone_confidence,alone_class\n";
     }
     std::ofstream csv;
     if (!args.csv.empty()) {

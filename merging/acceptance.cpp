@@ -152,7 +152,12 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
 // The points farther than `tolerance` from the straight lines that hold the most points, taken one
 // after another: element l after l + 1 lines. A Hough transform (1 degree, 1 cell) picks each line,
 // a total least squares fit to the points within 2 tolerances of it places it.
-std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double tolerance) {
+struct Line {
+  Eigen::Vector2d normal, on;
+};
+
+std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double tolerance,
+                              std::vector<Line>* fitted = nullptr) {
   constexpr int kAngles = 180;
   std::vector<int> left;
   for (int l = 0; l < lines; ++l) {
@@ -191,10 +196,37 @@ std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, do
       n = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov).eigenvectors().col(0);
       on = c;
     }
+    if (fitted) fitted->push_back({n, on});
     std::erase_if(points, [&](const Eigen::Vector2d& p) { return std::abs(n.dot(p - on)) <= tolerance; });
     left.push_back(int(points.size()));
   }
   return left;
+}
+
+// How many of the four half-lines from where the two lines meet carry at least `min_points`
+// points farther than `margin` from the meeting point (and within `tolerance` of the line): 2 for
+// an L (a room's corner), 3 for a T (a wall meeting another that goes on past it), 4 for a cross;
+// 0 when the lines are nearly parallel (no junction).
+int junction_arms(const std::vector<Eigen::Vector2d>& points, const Line& l1, const Line& l2, double tolerance,
+                  double margin, int min_points) {
+  const double det = l1.normal.x() * l2.normal.y() - l1.normal.y() * l2.normal.x();
+  if (std::abs(det) < std::sin(std::numbers::pi / 6.0)) return 0;  // closer than 30 degrees
+  // Where n1 . x = n1 . on1 and n2 . x = n2 . on2.
+  const double c1 = l1.normal.dot(l1.on), c2 = l2.normal.dot(l2.on);
+  const Eigen::Vector2d meet((c1 * l2.normal.y() - c2 * l1.normal.y()) / det,
+                             (l1.normal.x() * c2 - l2.normal.x() * c1) / det);
+  int arms = 0;
+  for (const Line* l : {&l1, &l2}) {
+    const Eigen::Vector2d u(-l->normal.y(), l->normal.x());
+    int plus = 0, minus = 0;
+    for (const auto& p : points) {
+      if (std::abs(l->normal.dot(p - meet)) > tolerance) continue;
+      const double s = u.dot(p - meet);
+      plus += s > margin, minus += s < -margin;
+    }
+    arms += (plus >= min_points) + (minus >= min_points);
+  }
+  return arms;
 }
 
 }  // namespace
@@ -211,8 +243,10 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   q.contradicted = t.contradicted;
   q.score = t.matched - options.contradiction_weight * t.contradicted;
   q.agreement = t.matched + t.contradicted > 0 ? double(t.matched) / double(t.matched + t.contradicted) : 0.0;
-  const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0);
+  std::vector<Line> lines;
+  const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0, &lines);
   q.beyond_corner = left[1];
+  if (lines.size() >= 2) q.junction_arms = junction_arms(t.structure_positions, lines[0], lines[1], 2.0, 4.0, 3);
   q.wall_ends = t.wall_ends;
   q.beyond_room = left[3];
   if (t.positions.size() < 3) return q;

@@ -62,6 +62,11 @@ struct AlignmentQuality {
   // the end of a free-standing wall; not where the view ends), in both maps at the same place. On
   // the lines, but it fixes where along them the maps meet.
   int wall_ends = 0;
+  // Of the four half-lines from where those two lines meet, how many carry matched walls (3 blocks
+  // or more, beyond 4 cells from the meeting point): 2 for an L (a room's corner, which fits any
+  // other corner), 3 for a T (one wall meeting another that goes on past it), 4 for a cross; 0
+  // when the two lines are within 30 degrees of parallel. A bare room has no T.
+  int junction_arms = 0;
   // The same for the four lines that hold the most: 0 when the common walls are the sides of one
   // rectangular room (or fewer lines), which fits itself turned a half turn.
   int beyond_room = 0;

@@ -284,7 +284,11 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   // the answer lays on a's known cells, which is all the evidence there is: rows of identical
   // rooms, or a symmetric room, fit elsewhere nearly as well, and the rest of b, lying on a's
   // unknown, cannot tell them apart.
-  if (options.probe_symmetries && best_q.beyond_corner + best_q.wall_ends > 0 &&
+  // What tells the common walls from any corner of a bare room: matched walls off the corner's two
+  // lines, matched openings in its walls, and a T or cross junction (a wall going on past the
+  // corner in both maps), which counts as a full set of blocks beyond.
+  const double beyond = best_q.beyond_corner + best_q.wall_ends + (best_q.junction_arms >= 3 ? co.full_beyond_corner : 0.0);
+  if (options.probe_symmetries && beyond > 0 &&
       agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence) {
     std::tie(result.distinctiveness, result.alternative) =
         distinctiveness(b, other_placements(a, b, result.transform, options, others), best_q, result.transform);
@@ -319,8 +323,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   const double support_factor = support(result.evidence * result.distinctiveness);
   // Matched wall ends count with the blocks off the corner's two lines: an opening in a wall, seen in
   // both maps at one place, tells the corner from the room's other corners as a wall beyond does.
-  const double corner_factor = clamp01((best_q.beyond_corner + best_q.wall_ends - co.zero_beyond_corner) /
-                                       (co.full_beyond_corner - co.zero_beyond_corner));
+  const double corner_factor = clamp01((beyond - co.zero_beyond_corner) / (co.full_beyond_corner - co.zero_beyond_corner));
   result.confidence = agree_factor * acceptance_factor * support_factor * corner_factor;
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {

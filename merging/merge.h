@@ -58,9 +58,12 @@ namespace fleetmap::merging {
 //   (AlignmentQuality::beyond_corner), 0 up to zero_beyond_corner, 1 from full_beyond_corner on
 //   (4 x 4 blocks of wall, counted in both maps: a door jamb seen by both is two), plus the
 //   matched wall ends (AlignmentQuality::wall_ends: an opening in a wall that both maps see
-//   through, at the same place in both): two maps whose common walls are one corner of a bare room fit any other
+//   through, at the same place in both), plus a full set for a T or cross junction
+//   (AlignmentQuality::junction_arms >= 3: one of the two walls goes on past where the other meets
+//   it, in both maps): two maps whose common walls are one corner of a bare room fit any other
 //   corner as well, and nothing in either map can tell (seen on a real plan: two corners of a
-//   large hall, turned a quarter); an opening in one of the walls pins the corner along them.
+//   large hall, turned a quarter); an opening in one of the walls pins the corner along them, and
+//   a bare room has no T.
 // - one rectangular room (ConfidenceOptions::min_turned_share): its sides are four lines, and the
 //   room turned a half turn fits them too; when the answer's common walls are such four lines and
 //   the probes find a turned placement free of contradictions with at least that share of the

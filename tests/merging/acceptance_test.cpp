@@ -94,5 +94,20 @@ TEST(AlignmentQuality, CountsDoorJambsSeenByBothMapsAtOnePlace) {
   EXPECT_EQ(evaluate_alignment(c, c, core::Transform2::identity()).wall_ends, 0);
 }
 
+// Where the two lines holding most of the matched walls meet: an L (a room's corner: two walls
+// ending there, unknown beyond) has two arms, a T (a wall going on past the one that meets it) has
+// three. A bare room has no T, so the T tells the place from the room's other corners.
+TEST(AlignmentQuality, CountsTheArmsOfTheJunctionOfTheCommonWalls) {
+  std::vector<std::string> t(40, std::string(60, '.'));
+  for (int y = 0; y < 10; ++y) t[std::size_t(y)] = std::string(60, '?');
+  t[10] = std::string(60, '#');
+  for (int y = 11; y < 40; ++y) t[std::size_t(y)][25] = '#';
+  std::vector<std::string> l = t;
+  for (int y = 10; y < 40; ++y) l[std::size_t(y)].replace(0, 25, std::string(25, '?'));
+  const PreparedGrid pt(grid_from_text(t)), pl(grid_from_text(l));
+  EXPECT_EQ(evaluate_alignment(pt, pt, core::Transform2::identity()).junction_arms, 3);
+  EXPECT_EQ(evaluate_alignment(pl, pl, core::Transform2::identity()).junction_arms, 2);
+}
+
 }  // namespace
 }  // namespace fleetmap::merging

@@ -229,6 +229,18 @@ TEST(AlignMaps, OneCornerWithMatchingDoorOpeningsIsMergedRight) {
   EXPECT_LT(mean_displacement(r.transform, p.truth, p.b), 1.0);
 }
 
+// A benchmark pair sharing three tenths of the known cells (plan 95144b9b8ec8): the common walls
+// lie on two lines, the outer wall and an inner wall meeting it, but the outer wall goes on past
+// the meeting point in both maps: a T, which no corner of a bare room fits (refused before as
+// "one corner", confidence 0).
+TEST(AlignMaps, WallsMeetingInATAreNotOneCorner) {
+  const auto p = robot_map_pair("robot_map_95144b9b8ec8_overlap30", 0.05, 278.749, 388.854, 149.357);
+  const MergeResult r = align_maps(p.a, p.b);
+  ASSERT_TRUE(r.merged) << r.reason;
+  EXPECT_GE(r.quality.junction_arms, 3);
+  EXPECT_LT(mean_displacement(r.transform, p.truth, p.b), 1.0);
+}
+
 // The same bare hall in the simulator (three robots, seed 2, step 265, robots 1 and 3, from
 // `fleetmap explore --merge-attempts`): each robot saw one corner and a long stretch of two walls,
 // up to where its view ended. Grazing beams leave free cells on the line of a wall that goes on
