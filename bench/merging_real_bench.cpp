@@ -67,7 +67,7 @@ struct Args {
   fs::path plans = fs::path(FLEETMAP_SOURCE_DIR) / ".." / "shared" / "datasets" / "houseexpo";
   fs::path cache = fs::path(FLEETMAP_BINARY_DIR) / "merging_real_cache";
   std::string csv;
-  std::string diagnose;      // writes, per pair with a truth, where the right answer drops out of the search
+  std::string diagnose;      // writes, per pair with a truth not merged right, where the right answer drops out and why (ambiguity_class)
   fs::path dump;             // writes each pair's maps here (a_<k>.png, b_<k>.png) when given
   std::vector<int> only;     // run only these pair numbers (as in the CSV)
   int pairs = 40;            // 300 x 300 pairs per overlap
@@ -431,6 +431,7 @@ struct Outcome {
 struct Record {
   const Pair* pair = nullptr;
   Outcome fleetmap, peer;
+  std::string loss_class, alone_class;  // with --diagnose, for pairs not merged right
 };
 
 constexpr double kSuccessCells = 2.0;
@@ -504,7 +505,13 @@ std::string ambiguity_class(bool merged, bool found, const std::string& reason) 
 // candidate (within 3 degrees, and 3 cells of the search level at b's known cells) among the
 // overlap search's candidates, among the sweep's, and whether refining any candidate reaches the
 // truth (within 2 cells).
-std::string diagnose(const Pair& p, const merging::MergeOptions& options) {
+struct Diagnosis {
+  std::string csv;         // the CSV columns after the pair's own
+  std::string loss_class;  // ambiguity_class of the oracle's decision
+  std::string alone_class; // ... of the truth alone
+};
+
+Diagnosis diagnose(const Pair& p, const merging::MergeOptions& options) {
   const merging::KnownPart ka(p.a), kb(p.b);
   const merging::PreparedGrid pa(ka.grid(), options.prepare), pb(kb.grid(), options.prepare);
   const core::Transform2 truth = p.reference.value_or(*p.truth);
@@ -553,11 +560,13 @@ std::string diagnose(const Pair& p, const merging::MergeOptions& options) {
   // The truth alone (its only rivals those the symmetry probes find): would it be merged if the
   // search had not proposed anything that outscores it?
   const merging::MergeResult alone = merging::decide(pa, pb, {{cut, 1e9, 0, "truth"}}, options);
-  return fmt::format("{:.2f},{},{},{},{},{},{},{:.1f},{},{},{:.2f},{},{},{:.3f},{:.3f},{:.1f},{},\"{}\",{},{:.3f},{}", rot_err, spec.size(), r_spec,
+  Diagnosis out{"", ambiguity_class(o.merged, o_found, o.reason), ambiguity_class(alone.merged, true, alone.reason)};
+  out.csv = fmt::format("{:.2f},{},{},{},{},{},{},{:.1f},{},{},{:.2f},{},{},{:.3f},{:.3f},{:.1f},{},\"{}\",{},{:.3f},{}", rot_err, spec.size(), r_spec,
                      ref_spec, sweep.size(), r_sweep, ref_sweep, q.score, q.matched, q.contradicted, q.residual_rms,
                      int(o.merged), int(o_found), o.confidence, o.distinctiveness, o.evidence,
-                     ambiguity_class(o.merged, o_found, o.reason), o.reason, int(alone.merged), alone.confidence,
-                     ambiguity_class(alone.merged, true, alone.reason));
+                     out.loss_class, o.reason, int(alone.merged), alone.confidence,
+                     out.alone_class);
+  return out;
 }
 
 bool success(const Outcome& o) { return o.merged && o.found; }
@@ -749,9 +758,12 @@ int main(int argc, char** argv) {
       r.fleetmap = run_fleetmap(p, options);
       if (args.peer) r.peer = run_peer(p);
       records.push_back(r);
-      if (diag.is_open() && p.truth)
+      if (diag.is_open() && p.truth && !success(r.fleetmap)) {
+        const Diagnosis d = diagnose(p, options);
+        records.back().loss_class = d.loss_class, records.back().alone_class = d.alone_class;
         diag << fmt::format("{},{},{:.2f},{},{},{:.3f},{}\n", i, p.set, p.overlap, int(r.fleetmap.merged),
-                            int(r.fleetmap.found), r.fleetmap.confidence, diagnose(p, options)) << std::flush;
+                            int(r.fleetmap.found), r.fleetmap.confidence, d.csv) << std::flush;
+      }
       if (csv) {
         for (const auto& [name, o] : {std::pair<std::string, const Outcome*>{"fleetmap", &r.fleetmap}, {"peer", &r.peer}}) {
           if (name == "peer" && !args.peer) continue;
@@ -810,6 +822,37 @@ int main(int argc, char** argv) {
                                "| peer (ORB) | {} | {} | {} |\n| fleetmap | {} | {} | {} |\n\n",
                                args.peer ? int(pe.size()) : 0, args.peer ? std::to_string(pf) : "-", ms(median(tp)),
                                fl.size(), ff, ms(median(tf)));
+    }
+    // Why the pairs not merged right were lost (--diagnose): the oracle's decision with the truth
+    // handed in as a candidate (ambiguity_class), and the truth alone.
+    if (diag.is_open()) {
+      const std::vector<std::string> classes = {"determinable", "rival-scores-higher", "rival-fits-as-well", "one-corner",
+                                                "one-room", "little-evidence", "disagreement"};
+      for (const std::string set : {"house300", "house300x2", "campus1000"}) {
+        std::vector<double> fs_;
+        for (const auto& r : records)
+          if (r.pair->set == set && std::find(fs_.begin(), fs_.end(), r.pair->overlap) == fs_.end()) fs_.push_back(r.pair->overlap);
+        if (fs_.empty()) continue;
+        std::sort(fs_.begin(), fs_.end());
+        std::cout << "### Losses of " << set << " (oracle: the truth handed in beside the search's candidates)\n\n| overlap | lost |";
+        for (const auto& c : classes) std::cout << " " << c << " |";
+        std::cout << " truth alone: refused as one corner / little evidence / other |\n|---|---|";
+        for (std::size_t k = 0; k < classes.size() + 1; ++k) std::cout << "---|";
+        std::cout << "\n";
+        for (const double f : fs_) {
+          std::map<std::string, int> n;
+          int lost = 0;
+          for (const auto& r : records) {
+            if (r.pair->set != set || std::abs(r.pair->overlap - f) > 1e-9 || r.loss_class.empty()) continue;
+            ++lost, ++n[r.loss_class];
+            ++n[r.alone_class == "one-corner" ? "alone corner" : r.alone_class == "little-evidence" ? "alone evidence" : "alone other"];
+          }
+          std::cout << fmt::format("| {}% | {} |", overlap_percent(f), lost);
+          for (const auto& c : classes) std::cout << " " << n[c] << " |";
+          std::cout << fmt::format(" {} / {} / {} |\n", n["alone corner"], n["alone evidence"], n["alone other"]);
+        }
+        std::cout << "\n";
+      }
     }
     // Reliability: of the answers with confidence in a bin, the share that is right; and at each
     // threshold, what a user gets.
