@@ -664,6 +664,10 @@ int main(int argc, char** argv) {
     }
     // The same windows, a from one robot's map and b from another robot's map of the plan: both
     // maps are in the plan's frame, so the truth is the windows' transform (up to each map's drift).
+    // Each set of pairs draws from its own stream, so that a set's pairs do not depend on the sets
+    // before it (the two-robot set skips windows by a fit that runs fleetmap's refinement: with one
+    // stream, a change to the refinement would change every later pair).
+    random = core::Random(args.seed + 1);
     std::size_t next_two = 0;
     for (const double f : args.overlaps) {
       crop.overlap = f;
@@ -688,6 +692,7 @@ int main(int argc, char** argv) {
     // Windows of two different plans.
     merging::CropPairOptions single = crop;
     single.overlap = 0.9;
+    random = core::Random(args.seed + 2);
     for (int k = 0; k < args.unrelated; ++k) {
       for (int tries = 0; tries < 100; ++tries) {
         const std::size_t i = std::size_t(random.uniform_int(0, int(maps.size()) - 1));
@@ -709,6 +714,7 @@ int main(int argc, char** argv) {
     merging::CropPairOptions campus_crop = crop;
     campus_crop.width = campus_crop.height = 1000;
     campus_crop.min_known = 0.3;
+    random = core::Random(args.seed + 3);
     for (const double f : args.overlaps) {
       campus_crop.overlap = f;
       for (int k = 0; k < args.campus_pairs; ++k) {
@@ -722,6 +728,7 @@ int main(int argc, char** argv) {
       merging::CropPairOptions big = crop;
       big.width = big.height = 4000;
       big.min_known = 0.3;
+      random = core::Random(args.seed + 4);
       for (int k = 0; k < args.large_pairs; ++k) {
         big.overlap = k % 2 ? 0.2 : 0.5;
         merging::CropPair c = merging::make_crop_pair(fine, big, random);
