@@ -490,15 +490,18 @@ Outcome run_peer(const Pair& p) {
 // - "little-evidence": the truth is the answer and unrivalled, but too few of its walls pin it
 //   (a corridor, one wall, a bare room): weak rather than ambiguous;
 // - "disagreement": the truth's own cells disagree (walls on free space, drift).
-std::string ambiguity_class(bool merged, bool found, const std::string& reason) {
+std::string ambiguity_class(bool merged, bool found, merging::Refusal refusal) {
+  using merging::Refusal;
   if (merged && found) return "determinable";
   if (!found) return "rival-scores-higher";
-  if (reason.find("another placement") != std::string::npos) return "rival-fits-as-well";
-  if (reason.find("one corner") != std::string::npos) return "one-corner";
-  if (reason.find("rectangular room") != std::string::npos) return "one-room";
-  if (reason.find("free to slide") != std::string::npos || reason.find("better than chance") != std::string::npos)
-    return "little-evidence";
-  return "disagreement";
+  switch (refusal) {
+    case Refusal::AnotherPlacement: return "rival-fits-as-well";
+    case Refusal::OneCorner: return "one-corner";
+    case Refusal::OneRoom: return "one-room";
+    case Refusal::FreeToSlide:
+    case Refusal::LittleFit: return "little-evidence";
+    default: return "disagreement";
+  }
 }
 
 // Where the right answer drops out: the spectral rotations' error, the rank of the first right
@@ -560,7 +563,7 @@ Diagnosis diagnose(const Pair& p, const merging::MergeOptions& options) {
   // The truth alone (its only rivals those the symmetry probes find): would it be merged if the
   // search had not proposed anything that outscores it?
   const merging::MergeResult alone = merging::decide(pa, pb, {{cut, 1e9, 0, "truth"}}, options);
-  Diagnosis out{"", ambiguity_class(o.merged, o_found, o.reason), ambiguity_class(alone.merged, true, alone.reason)};
+  Diagnosis out{"", ambiguity_class(o.merged, o_found, o.refusal), ambiguity_class(alone.merged, true, alone.refusal)};
   out.csv = fmt::format("{:.2f},{},{},{},{},{},{},{:.1f},{},{},{:.2f},{},{},{:.3f},{:.3f},{:.1f},{},\"{}\",{},{:.3f},{}", rot_err, spec.size(), r_spec,
                      ref_spec, sweep.size(), r_sweep, ref_sweep, q.score, q.matched, q.contradicted, q.residual_rms,
                      int(o.merged), int(o_found), o.confidence, o.distinctiveness, o.evidence,

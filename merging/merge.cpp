@@ -198,6 +198,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   result.candidates = int(candidates.size());
   if (candidates.empty()) {
     result.reason = "no reliable overlap: no candidate transform";
+    result.refusal = Refusal::NoCandidate;
     return result;
   }
   std::vector<Candidate> active = refine_candidates(a, b, candidates, options);
@@ -328,14 +329,20 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {
     // The weakest factor says why, in words.
-    std::string why;
-    if (agree_factor < 0.5) why = "the walls of one map cross the other's free space";
-    else if (acceptance_factor < 0.5) why = "the maps disagree on the cells they share (free in one, occupied in the other)";
-    else if (corner_factor < 0.5) why = "the common walls are one corner (two straight walls), which fits any other corner of a bare room as well";
-    else if (one_room) why = "the common walls are the sides of one rectangular room, which fits itself turned as well";
-    else if (result.distinctiveness < 0.5) why = "another placement fits nearly as well (repeated or symmetric places)";
-    else if (best_q.constraint < co.half_evidence) why = "the common walls leave the placement free to slide or turn (a bare room, a corridor, one wall)";
-    else why = "too little of the common walls fits better than chance";
+    const auto [refusal, why] = [&]() -> std::pair<Refusal, const char*> {
+      if (agree_factor < 0.5) return {Refusal::WallsCross, "the walls of one map cross the other's free space"};
+      if (acceptance_factor < 0.5)
+        return {Refusal::CellsDisagree, "the maps disagree on the cells they share (free in one, occupied in the other)"};
+      if (corner_factor < 0.5)
+        return {Refusal::OneCorner, "the common walls are one corner (two straight walls), which fits any other corner of a bare room as well"};
+      if (one_room) return {Refusal::OneRoom, "the common walls are the sides of one rectangular room, which fits itself turned as well"};
+      if (result.distinctiveness < 0.5)
+        return {Refusal::AnotherPlacement, "another placement fits nearly as well (repeated or symmetric places)"};
+      if (best_q.constraint < co.half_evidence)
+        return {Refusal::FreeToSlide, "the common walls leave the placement free to slide or turn (a bare room, a corridor, one wall)"};
+      return {Refusal::LittleFit, "too little of the common walls fits better than chance"};
+    }();
+    result.refusal = refusal;
     result.reason = fmt::format(
         "no reliable overlap: {}; confidence {:.2f} < {:.2f} (wall agreement {:.2f}, acceptance {:.2f}, evidence {:.1f} "
         "from constraint {:.1f} at {:.2f} cells, distinctiveness {:.2f})",
@@ -351,6 +358,7 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
     MergeResult r;
     r.reason = std::string("no reliable overlap: ") + (a.walls().empty() ? "the first" : "the second") +
                " map has no walls (occupied cells next to free ones) to align";
+    r.refusal = Refusal::NoCandidate;
     return r;
   }
   core::Random random(options.seed);

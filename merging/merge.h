@@ -116,6 +116,20 @@ struct MergeOptions {
   PrepareOptions prepare;
 };
 
+// Why an answer was not merged: the weakest factor of the confidence (ConfidenceOptions), in the
+// order `decide` names them; MergeResult::reason says the same in words.
+enum class Refusal {
+  None,               // merged
+  NoCandidate,        // no method proposed a transform, or a map has no walls
+  WallsCross,         // the walls of one map cross the other's free space (wall agreement)
+  CellsDisagree,      // free in one, occupied in the other (acceptance)
+  OneCorner,          // the common walls are one corner of a bare room
+  OneRoom,            // the common walls are the sides of one rectangular room
+  AnotherPlacement,   // another placement fits nearly as well (distinctiveness)
+  FreeToSlide,        // the common walls leave the placement free to slide or turn (constraint)
+  LittleFit,          // too little of the common walls fits better than chance
+};
+
 struct MergeResult {
   bool merged = false;            // confidence >= min_confidence
   core::Transform2 transform;     // b's cells into a's cells; the best candidate even when not merged
@@ -128,6 +142,7 @@ struct MergeResult {
   std::optional<core::Transform2> alternative;
   std::string method;             // the method whose candidate won; empty when there was none
   std::string reason;             // why not merged; empty when merged
+  Refusal refusal = Refusal::None; // the same, as a value
   int candidates = 0;             // candidates the methods proposed
 };
 

@@ -189,6 +189,7 @@ TEST(AlignMaps, OneRectangularRoomTurnedAHalfTurnIsRefused) {
   const MergeResult r = align_maps(a, b);
   EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
   EXPECT_NE(r.reason.find("rectangular room"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.refusal, Refusal::OneRoom);
 }
 
 // Windows of the development benchmark (bench/merging_real_bench.cpp): a robot explored a
@@ -214,6 +215,7 @@ TEST(AlignMaps, RobotMapsSharingAFifthAreMergedRight) {
   ASSERT_GT(p.a.count(mapping::CellState::Occupied), 1000);
   const MergeResult r = align_maps(p.a, p.b);
   ASSERT_TRUE(r.merged) << r.reason;
+  EXPECT_EQ(r.refusal, Refusal::None);
   EXPECT_LT(mean_displacement(r.transform, p.truth, p.b), 1.0);
 }
 
@@ -253,6 +255,7 @@ TEST(AlignMaps, WallsEndingWhereTheViewEndsDoNotLiftOneCorner) {
   const MergeResult r = align_maps(a, b);
   EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
   EXPECT_NE(r.reason.find("one corner"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.refusal, Refusal::OneCorner);
 }
 
 // Two fifths in common, but the search's best answer is a rough fit of similar rooms elsewhere,
