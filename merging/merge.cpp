@@ -329,6 +329,8 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   result.merged = result.confidence >= options.min_confidence;
   if (!result.merged) {
     // The weakest factor says why, in words.
+    // A named copy: a lambda may not capture a structured binding (clang 14).
+    const double constraint = best_q.constraint;
     const auto [refusal, why] = [&]() -> std::pair<Refusal, const char*> {
       if (agree_factor < 0.5) return {Refusal::WallsCross, "the walls of one map cross the other's free space"};
       if (acceptance_factor < 0.5)
@@ -338,7 +340,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       if (one_room) return {Refusal::OneRoom, "the common walls are the sides of one rectangular room, which fits itself turned as well"};
       if (result.distinctiveness < 0.5)
         return {Refusal::AnotherPlacement, "another placement fits nearly as well (repeated or symmetric places)"};
-      if (best_q.constraint < co.half_evidence)
+      if (constraint < co.half_evidence)
         return {Refusal::FreeToSlide, "the common walls leave the placement free to slide or turn (a bare room, a corridor, one wall)"};
       return {Refusal::LittleFit, "too little of the common walls fits better than chance"};
     }();
