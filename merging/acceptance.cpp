@@ -159,7 +159,8 @@ struct Line {
 std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double tolerance,
                               std::vector<Line>* fitted = nullptr) {
   constexpr int kAngles = 180;
-  std::vector<int> left;
+  std::vector<int> left, bins, counts;
+  std::vector<double> xs, ys;
   for (int l = 0; l < lines; ++l) {
     if (points.size() < 2) {
       left.push_back(int(points.size()));
@@ -169,21 +170,48 @@ std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, do
     for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     const Eigen::Vector2d mid = 0.5 * (lo + hi);
     const int rho_bins = 2 * int(std::ceil((hi - lo).norm() / 2.0)) + 3, offset = rho_bins / 2;
-    std::vector<int> votes(std::size_t(kAngles * rho_bins), 0);
-    int best = 0, best_votes = -1;
-    for (int k = 0; k < kAngles; ++k) {
+    // The winner is the bin that first reaches the most votes, counting angle by angle and point by
+    // point: the first angle whose row holds the most votes, and in it the bin that gets there first.
+    xs.resize(points.size()), ys.resize(points.size()), bins.resize(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) xs[i] = points[i].x(), ys[i] = points[i].y();
+    const auto bins_at = [&](int k) {
       const double th = std::numbers::pi * k / kAngles;
-      const Eigen::Vector2d n(std::cos(th), std::sin(th));
-      for (const auto& p : points) {
-        // Offset first, so that rounding is truncation of a positive number (std::lround is a call).
-        const int r = int(n.dot(p - mid) + offset + 0.5);
-        const std::size_t i = std::size_t(k * rho_bins + std::clamp(r, 0, rho_bins - 1));
-        if (++votes[i] > best_votes) best_votes = votes[i], best = int(i);
+      const double nx = std::cos(th), ny = std::sin(th), mx = mid.x(), my = mid.y(), off = offset;
+      // n . (p - mid), offset first, so that rounding is truncation of a positive number (std::lround
+      // is a call); coordinates in arrays of their own, so that the compiler computes several at once.
+      for (std::size_t i = 0; i < xs.size(); ++i)
+        bins[i] = std::clamp(int(nx * (xs[i] - mx) + ny * (ys[i] - my) + off + 0.5), 0, rho_bins - 1);
+    };
+    const std::size_t rho = std::size_t(rho_bins), n_points = points.size();
+    int best_angle = 0, best_votes = -1;
+    for (int k = 0; k < kAngles; ++k) {
+      bins_at(k);
+      // Four histograms taking turns: increments of one bin (points along a wall) would otherwise
+      // wait for each other.
+      counts.assign(4 * rho, 0);
+      int* h = counts.data();
+      std::size_t i = 0;
+      for (; i + 4 <= n_points; i += 4) {
+        ++h[std::size_t(bins[i])], ++h[rho + std::size_t(bins[i + 1])];
+        ++h[2 * rho + std::size_t(bins[i + 2])], ++h[3 * rho + std::size_t(bins[i + 3])];
+      }
+      for (; i < n_points; ++i) ++h[std::size_t(bins[i])];
+      int most = 0;
+      for (std::size_t j = 0; j < rho; ++j) most = std::max(most, h[j] + h[rho + j] + h[2 * rho + j] + h[3 * rho + j]);
+      if (most > best_votes) best_votes = most, best_angle = k;
+    }
+    bins_at(best_angle);
+    counts.assign(rho, 0);
+    int best_bin = 0;
+    for (const int b : bins) {
+      if (++counts[std::size_t(b)] == best_votes) {
+        best_bin = b;
+        break;
       }
     }
-    const double th = std::numbers::pi * (best / rho_bins) / kAngles;
+    const double th = std::numbers::pi * best_angle / kAngles;
     Eigen::Vector2d n(std::cos(th), std::sin(th));
-    Eigen::Vector2d on = mid + double(best % rho_bins - offset) * n;
+    Eigen::Vector2d on = mid + double(best_bin - offset) * n;
     // Refit to the points near the voted line, then drop the points on it.
     Eigen::Vector2d c = Eigen::Vector2d::Zero();
     std::vector<const Eigen::Vector2d*> near;

@@ -349,9 +349,9 @@ PreparedGrid PreparedGridParts::cut(const PreparedGrid& source, const cv::Mat& m
   PreparedGrid part(source.grid_);
   const GridLevel& s0 = source.level(0);
   cv::Mat m0 = mask & (s0.occupied | s0.free);
-  std::vector<cv::Point> nonzero;
-  cv::findNonZero(m0, nonzero);
-  cv::Rect box = nonzero.empty() ? cv::Rect(0, 0, 1, 1) : cv::boundingRect(nonzero);
+  // The box of the mask's cells, without listing them.
+  cv::Rect box = cv::boundingRect(m0);
+  if (box.area() == 0) box = cv::Rect(0, 0, 1, 1);
   const int coarsest = source.level(source.level_count() - 1).factor;
   const int x0 = box.x / coarsest * coarsest, y0 = box.y / coarsest * coarsest;
   box = cv::Rect(x0, y0, box.x + box.width - x0, box.y + box.height - y0);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+
 #include "core/error.h"
 
 #include "core/angle.h"
@@ -57,6 +59,21 @@ TEST(CropPair, DisjointCropsShareNoCell) {
   }
   o.width = o.height = 190;
   EXPECT_THROW(make_crop_pair(source, o, random), Error);
+}
+
+TEST(CropGrid, IsTheUnturnedResampling) {
+  const auto source = testing::source_map("office");
+  // Inside, across each edge, and wholly outside.
+  for (const auto& [x0, y0, w, h] : {std::array{10, 20, 50, 40}, std::array{-15, -7, 60, 30},
+                                     std::array{source.width() - 20, source.height() - 5, 45, 25},
+                                     std::array{source.width() + 3, 0, 10, 10}}) {
+    const auto crop = crop_grid(source, x0, y0, w, h);
+    const auto resampled = resample_grid(source, core::Transform2(x0, y0, 0.0), w, h);
+    ASSERT_EQ(crop.width(), w);
+    ASSERT_EQ(crop.height(), h);
+    EXPECT_EQ(crop.log_odds_data(), resampled.log_odds_data()) << x0 << ", " << y0;
+    EXPECT_EQ(crop.observed_count(), resampled.observed_count());
+  }
 }
 
 TEST(SyntheticWorld, ViewsOfOnePlaceAgree) {
