@@ -80,6 +80,7 @@ struct Args {
   double min_confidence = merging::MergeOptions{}.min_confidence;
   bool peer = true;
   double clutter = 1.0;      // scales the clutter rates (0: none)
+  double furniture = 0.0;    // one piece of furniture per this many m² of floor (0: the bare plans)
   std::uint64_t seed = 1;
   int build_part = -1, build_parts = 0;  // --build-maps K/N: only build the cached maps of plans K, K + N, ... and stop
 };
@@ -87,7 +88,7 @@ struct Args {
 constexpr const char* kUsage =
     "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
     "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
-    "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--seed S] [--build-maps K/N]\n";
+    "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
 
 [[noreturn]] void usage(const std::string& problem) {
   std::cerr << "fleetmap_bench_merging_real: " << problem << "\n" << kUsage;
@@ -135,6 +136,10 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--min-confidence") a.min_confidence = number(value());
     else if (k == "--no-peer") a.peer = false;
     else if (k == "--clutter") a.clutter = number(value());
+    else if (k == "--furniture") {
+      a.furniture = number(value());
+      if (a.furniture < 0.0) usage("--furniture: '" + std::to_string(a.furniture) + "' is negative (0: bare plans)");
+    }
     else if (k == "--seed") a.seed = std::uint64_t(number(value()));
     else if (k == "--build-maps") {
       const std::string v = value();
@@ -207,6 +212,183 @@ mapping::OccupancyGrid refine_grid(const mapping::OccupancyGrid& g, int factor) 
   return out;
 }
 
+// --- furniture ------------------------------------------------------------------------------
+
+// Furniture as a laser 20-30 cm above the floor sees it, so that both robots' maps of a plan show
+// what real laser maps of rooms show beyond the walls (HouseExpo's plans are bare walls): cabinets,
+// shelves, beds, sofas, counters as solid boxes, mostly with their back to a wall; tables and chairs
+// as their four legs; bins, pots and round tables' bases as discs. About one piece per
+// `m2_per_piece` square metres of free floor, drawn from the plan's index (the same in both robots'
+// maps). A piece is kept only if the floor where a robot of radius 0.25 m fits falls into no more
+// regions than before and loses no more than the piece's own surroundings: no doorway or corridor
+// is closed or narrowed below 0.5 m.
+class Furnisher {
+ public:
+  Furnisher(mapping::OccupancyGrid& truth, std::uint64_t seed) : g_(truth), random_(seed), res_(truth.resolution()) {
+    occupied_ = cv::Mat(g_.height(), g_.width(), CV_8U, cv::Scalar(0));
+    for (int y = 0; y < g_.height(); ++y)
+      for (int x = 0; x < g_.width(); ++x)
+        if (g_.state({x, y}) != mapping::CellState::Free) occupied_.at<std::uint8_t>(y, x) = 255;
+    reach_ = reach(occupied_);
+  }
+
+  // Places the pieces; returns how many were kept.
+  int furnish(double m2_per_piece) {
+    const double free_m2 = double(cv::countNonZero(occupied_ == 0)) * res_ * res_;
+    const int wanted = int(std::lround(free_m2 / m2_per_piece));
+    int kept = 0;
+    for (int attempt = 0; attempt < 30 * wanted && kept < wanted; ++attempt) {
+      const cv::Point2d c = random_free_point();
+      cv::Mat piece(occupied_.size(), CV_8U, cv::Scalar(0));
+      double reach_m = 0.0;  // the piece's extent, for what a robot may lose around it
+      const double kind = random_.uniform();
+      if (kind < 0.45) {
+        if (!box_at_wall(piece, c, reach_m)) continue;
+      } else if (kind < 0.55) {
+        reach_m = box(piece, c, random_.uniform(0.5, 2.0), random_.uniform(0.4, 1.0), axis_or_any_angle(0.8));
+      } else if (kind < 0.72) {
+        reach_m = table_with_chairs(piece, c);
+      } else if (kind < 0.85) {
+        reach_m = legs(piece, c, 0.42, 0.42, random_.uniform(0.0, std::numbers::pi));
+      } else {
+        const double r = random_.uniform(0.08, 0.25);
+        cv::circle(piece, cv::Point(int(std::lround(c.x)), int(std::lround(c.y))), std::max(0, int(std::lround(r / res_))), 255, cv::FILLED);
+        reach_m = 2.0 * r;
+      }
+      if (!try_place(piece, reach_m)) continue;
+      ++kept;
+    }
+    for (int y = 0; y < g_.height(); ++y)
+      for (int x = 0; x < g_.width(); ++x)
+        if (occupied_.at<std::uint8_t>(y, x) && g_.state({x, y}) == mapping::CellState::Free) g_.set_state({x, y}, mapping::CellState::Occupied);
+    return kept;
+  }
+
+ private:
+  static constexpr double kRobotRadius = 0.25;
+
+  // Where a robot of kRobotRadius fits: its area in cells, and its regions of 0.25 m² or more.
+  struct Reach {
+    int area = 0;
+    int regions = 0;
+  };
+  Reach reach(const cv::Mat& occupied) const {
+    cv::Mat clearance, fits, labels, stats, centroids;
+    cv::distanceTransform(occupied == 0, clearance, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    fits = clearance > kRobotRadius / res_;
+    const int n = cv::connectedComponentsWithStats(fits, labels, stats, centroids, 8, CV_32S);
+    Reach r;
+    for (int i = 1; i < n; ++i) {
+      const int area = stats.at<int>(i, cv::CC_STAT_AREA);
+      r.area += area;
+      r.regions += double(area) * res_ * res_ >= 0.25;
+    }
+    return r;
+  }
+
+  cv::Point2d random_free_point() {
+    for (;;) {
+      const int x = random_.uniform_int(0, g_.width() - 1), y = random_.uniform_int(0, g_.height() - 1);
+      if (!occupied_.at<std::uint8_t>(y, x)) return {x + random_.uniform(-0.5, 0.5), y + random_.uniform(-0.5, 0.5)};
+    }
+  }
+
+  // Rooms are mostly square to the plan: a piece is turned by a multiple of 90 degrees with
+  // probability `p_axis`, otherwise by any angle.
+  double axis_or_any_angle(double p_axis) {
+    return random_.bernoulli(p_axis) ? 0.5 * std::numbers::pi * random_.uniform_int(0, 3) : random_.uniform(0.0, std::numbers::pi);
+  }
+
+  // A solid box of w x d metres centred at c (cells), turned by `angle`; returns its extent (m).
+  double box(cv::Mat& piece, const cv::Point2d& c, double w, double d, double angle) const {
+    const cv::RotatedRect r(cv::Point2f(float(c.x), float(c.y)), cv::Size2f(float(w / res_), float(d / res_)), float(core::rad2deg(angle)));
+    cv::Point2f p[4];
+    r.points(p);
+    std::vector<cv::Point> poly;
+    for (const auto& q : p) poly.emplace_back(int(std::lround(q.x)), int(std::lround(q.y)));
+    cv::fillConvexPoly(piece, poly, 255);
+    return std::max(w, d);
+  }
+
+  // A box with its back to the nearest wall along one of the four axis directions within 1 m of c.
+  bool box_at_wall(cv::Mat& piece, const cv::Point2d& c, double& reach_m) {
+    const int dx[] = {1, -1, 0, 0}, dy[] = {0, 0, 1, -1};
+    int best_dir = -1, best_steps = int(1.0 / res_) + 1;
+    for (int k = 0; k < 4; ++k) {
+      for (int s = 1; s < best_steps; ++s) {
+        const int x = int(std::lround(c.x)) + s * dx[k], y = int(std::lround(c.y)) + s * dy[k];
+        if (x < 0 || y < 0 || x >= occupied_.cols || y >= occupied_.rows) break;
+        if (occupied_.at<std::uint8_t>(y, x)) {
+          best_dir = k, best_steps = s;
+          break;
+        }
+      }
+    }
+    if (best_dir < 0) return false;
+    const double w = random_.uniform(0.4, 2.0), d = random_.uniform(0.3, 0.9);
+    // The box's centre: half its depth out from the wall face, along the way back to c.
+    const double face = best_steps - 1.0;  // the back's cells end next to the wall's
+    const cv::Point2d from(std::lround(c.x), std::lround(c.y));
+    const cv::Point2d centre(from.x + dx[best_dir] * (face - 0.5 * d / res_), from.y + dy[best_dir] * (face - 0.5 * d / res_));
+    const double angle = dx[best_dir] != 0 ? 0.5 * std::numbers::pi : 0.0;  // width along the wall
+    reach_m = box(piece, centre, w, d, angle);
+    return true;
+  }
+
+  // Four legs (0.05 m) at the corners of a w x d rectangle centred at c; returns its extent (m).
+  double legs(cv::Mat& piece, const cv::Point2d& c, double w, double d, double angle) const {
+    const int side = std::max(1, int(std::lround(0.05 / res_)));
+    const double ca = std::cos(angle), sa = std::sin(angle);
+    for (const double u : {-0.5, 0.5})
+      for (const double v : {-0.5, 0.5}) {
+        const double px = c.x + (u * w * ca - v * d * sa) / res_, py = c.y + (u * w * sa + v * d * ca) / res_;
+        const int x0 = int(std::lround(px - 0.5 * (side - 1))), y0 = int(std::lround(py - 0.5 * (side - 1)));
+        cv::rectangle(piece, cv::Rect(x0, y0, side, side), 255, cv::FILLED);
+      }
+    return std::hypot(w, d);
+  }
+
+  // A table's legs and up to four chairs' legs around it.
+  double table_with_chairs(cv::Mat& piece, const cv::Point2d& c) {
+    const double w = random_.uniform(0.6, 1.8), d = random_.uniform(0.6, 1.0), angle = axis_or_any_angle(0.8);
+    legs(piece, c, w, d, angle);
+    const double ca = std::cos(angle), sa = std::sin(angle);
+    const int chairs = random_.uniform_int(0, 4);
+    for (int k = 0; k < chairs; ++k) {
+      // Beside one of the four sides, 0.35 m out, turned a little.
+      const int side = random_.uniform_int(0, 3);
+      const double u = side < 2 ? (side == 0 ? -1.0 : 1.0) * (0.5 * w + 0.35) : random_.uniform(-0.3, 0.3) * w;
+      const double v = side >= 2 ? (side == 2 ? -1.0 : 1.0) * (0.5 * d + 0.35) : random_.uniform(-0.3, 0.3) * d;
+      const cv::Point2d chair(c.x + (u * ca - v * sa) / res_, c.y + (u * sa + v * ca) / res_);
+      legs(piece, chair, 0.42, 0.42, angle + random_.uniform(-0.3, 0.3));
+    }
+    return std::hypot(w, d) + 1.2;
+  }
+
+  // Keeps the piece if it lies on free floor (inside the plan) and closes no way: the floor where a
+  // robot fits is in no more regions than before and smaller by at most the piece's surroundings.
+  bool try_place(const cv::Mat& piece, double reach_m) {
+    if (cv::countNonZero(piece) == 0 || cv::countNonZero(piece & occupied_) > 0) return false;
+    // Pieces must not touch the plan's border or unknown space.
+    if (cv::countNonZero(piece.row(0)) || cv::countNonZero(piece.row(piece.rows - 1)) || cv::countNonZero(piece.col(0)) ||
+        cv::countNonZero(piece.col(piece.cols - 1)))
+      return false;
+    cv::Mat after = occupied_ | piece;
+    const Reach r = reach(after);
+    const double around = (reach_m + 2.0 * kRobotRadius) / res_;
+    if (r.regions > reach_.regions || double(reach_.area - r.area) > 1.3 * around * around) return false;
+    occupied_ = after;
+    reach_ = r;
+    return true;
+  }
+
+  mapping::OccupancyGrid& g_;
+  core::Random random_;
+  double res_;
+  cv::Mat occupied_;  // 255: wall, unknown, or furniture placed so far
+  Reach reach_;
+};
+
 // A start in the largest free region of the plan, at least 0.4 m from walls (a random start may
 // fall in a closet-sized pocket between walls), drawn with `random`.
 core::Pose2 start_in_largest_room(const mapping::OccupancyGrid& truth, core::Random& random) {
@@ -243,9 +425,11 @@ constexpr const char* kCacheVersion = "v2";
 
 // `robot` 0 and 1: two robots exploring the same plan alone, from different starts with different
 // noise (the second map of a plan, for pairs of two robots' maps).
-PlanMap build_plan_map(const fs::path& plan_yaml, int index, int robot, const fs::path& cache) {
+// `m2_per_piece` > 0: the plan furnished first (Furnisher), the same furniture for both robots.
+PlanMap build_plan_map(const fs::path& plan_yaml, int index, int robot, const fs::path& cache, double m2_per_piece) {
   PlanMap p{plan_yaml.stem().string(), {}, mapping::OccupancyGrid(core::GridGeometry(0.05, 1, 1)), 0.0, 0.0};
-  const fs::path stem = cache / fmt::format("{}-{}{}", p.id, kCacheVersion, robot == 0 ? "" : "-r2");
+  const std::string furnished = m2_per_piece > 0.0 ? fmt::format("-f{:g}", m2_per_piece) : "";
+  const fs::path stem = cache / fmt::format("{}-{}{}{}", p.id, kCacheVersion, furnished, robot == 0 ? "" : "-r2");
   mapping::OccupancyGrid truth = io::load_map(plan_yaml);
   p.recipe = recipe_for(index, truth.count(mapping::CellState::Free));
   if (fs::exists(stem.string() + ".yaml") && fs::exists(stem.string() + ".txt")) {
@@ -255,6 +439,7 @@ PlanMap build_plan_map(const fs::path& plan_yaml, int index, int robot, const fs
     return p;
   }
   if (p.recipe.resolution < truth.resolution() - 1e-9) truth = refine_grid(truth, int(std::lround(truth.resolution() / p.recipe.resolution)));
+  if (m2_per_piece > 0.0) Furnisher(truth, 11000 + std::uint64_t(index)).furnish(m2_per_piece);
   // The explorer stops at once when sparse far beams leave no frontier it can use (seen with
   // 180 beams on 0.025 m cells): such a plan is explored again with twice the beams.
   core::Random start_random(9000 + std::uint64_t(index) + 1000 * std::uint64_t(robot));
@@ -628,15 +813,15 @@ int main(int argc, char** argv) {
       // Only fill the cache (run N of these at once, K = 0 .. N-1, to use N cores).
       for (std::size_t i = std::size_t(args.build_part); i < plans.size(); i += std::size_t(args.build_parts)) {
         std::cerr << fmt::format("maps: {}/{} {}\n", i + 1, plans.size(), plans[i].stem().string());
-        build_plan_map(plans[i], int(i), 0, args.cache);
-        if (args.two_robots > 0) build_plan_map(plans[i], int(i), 1, args.cache);
+        build_plan_map(plans[i], int(i), 0, args.cache, args.furniture);
+        if (args.two_robots > 0) build_plan_map(plans[i], int(i), 1, args.cache, args.furniture);
       }
       return 0;
     }
     for (std::size_t i = 0; i < plans.size(); ++i) {
       std::cerr << fmt::format("\rmaps: {}/{} {}      ", i + 1, plans.size(), plans[i].stem().string()) << std::flush;
-      maps.push_back(build_plan_map(plans[i], int(i), 0, args.cache));
-      if (args.two_robots > 0) second.push_back(build_plan_map(plans[i], int(i), 1, args.cache));
+      maps.push_back(build_plan_map(plans[i], int(i), 0, args.cache, args.furniture));
+      if (args.two_robots > 0) second.push_back(build_plan_map(plans[i], int(i), 1, args.cache, args.furniture));
     }
     std::cerr << "\n";
 
@@ -789,7 +974,9 @@ int main(int argc, char** argv) {
     std::cerr << "\n";
 
     // Tables.
-    std::cout << "Maps: " << maps.size() << " robot-built HouseExpo maps (cache " << args.cache.string() << ")\n\n";
+    std::cout << "Maps: " << maps.size() << " robot-built HouseExpo maps"
+              << (args.furniture > 0.0 ? fmt::format(", furnished (a piece per {:g} m² of floor)", args.furniture) : std::string(", bare plans"))
+              << " (cache " << args.cache.string() << ")\n\n";
     const auto select = [&](const std::string& set, std::optional<double> f, bool peer) {
       std::vector<const Outcome*> out;
       for (const auto& r : records) {
