@@ -369,7 +369,7 @@ class Furnisher {
   // robot fits is in no more regions than before and smaller by at most the piece's surroundings.
   bool try_place(const cv::Mat& piece, double reach_m) {
     if (cv::countNonZero(piece) == 0 || cv::countNonZero(piece & occupied_) > 0) return false;
-    // Pieces must not touch the plan's border or unknown space.
+    // Nor touch the map's border (walls and unknown space are in occupied_).
     if (cv::countNonZero(piece.row(0)) || cv::countNonZero(piece.row(piece.rows - 1)) || cv::countNonZero(piece.col(0)) ||
         cv::countNonZero(piece.col(piece.cols - 1)))
       return false;
