@@ -7,8 +7,10 @@
 // ../shared/datasets/houseexpo) with visible odometry noise, a noisy laser of 180 to 720 beams
 // (ray fans at range) and `scan-matching` or `rbpf` localization, so its map has the thin broken
 // walls, speckle and drift of a real one; the maps are cached in --cache. Plans too small to fill
-// a 300-cell window at 0.05 m are explored at 0.025 m. The built-in `campus` (1200 x 1200 at
-// 0.1 m) gives the 1000 x 1000 windows, and campus at 0.025 m the 4000 x 4000 ones.
+// a 300-cell window at 0.05 m are explored at 0.025 m. With --furniture the plans are furnished
+// first (Furnisher: boxes at walls, table and chair legs, discs), as real rooms are. The built-in
+// `campus` (1200 x 1200 at 0.1 m) gives the 1000 x 1000 windows, and campus at 0.025 m the
+// 4000 x 4000 ones.
 //
 // The pairs (the protocol of the ROS comparison): window `a` is axis-aligned; window `b`, of the
 // same size, is turned by a uniform random angle and shifted until the stated share of the known
