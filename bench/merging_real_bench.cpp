@@ -139,8 +139,9 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--no-peer") a.peer = false;
     else if (k == "--clutter") a.clutter = number(value());
     else if (k == "--furniture") {
-      a.furniture = number(value());
-      if (a.furniture < 0.0) usage("--furniture: '" + std::to_string(a.furniture) + "' is negative (0: bare plans)");
+      const std::string v = value();
+      a.furniture = number(v);
+      if (a.furniture < 0.0) usage("--furniture: '" + v + "' is negative (0: bare plans)");
     }
     else if (k == "--seed") a.seed = std::uint64_t(number(value()));
     else if (k == "--build-maps") {
