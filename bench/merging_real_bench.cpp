@@ -217,6 +217,15 @@ mapping::OccupancyGrid refine_grid(const mapping::OccupancyGrid& g, int factor) 
 
 // --- furniture ------------------------------------------------------------------------------
 
+// 255 where the grid is free, 0 elsewhere (rows as the grid's rows).
+cv::Mat free_mask(const mapping::OccupancyGrid& g) {
+  cv::Mat free(g.height(), g.width(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < g.height(); ++y)
+    for (int x = 0; x < g.width(); ++x)
+      if (g.state({x, y}) == mapping::CellState::Free) free.at<std::uint8_t>(y, x) = 255;
+  return free;
+}
+
 // Furniture as a laser 20-30 cm above the floor sees it, so that both robots' maps of a plan show
 // what real laser maps of rooms show beyond the walls (HouseExpo's plans are bare walls): cabinets,
 // shelves, beds, sofas, counters as solid boxes, mostly with their back to a wall; tables and chairs
@@ -227,13 +236,8 @@ mapping::OccupancyGrid refine_grid(const mapping::OccupancyGrid& g, int factor) 
 // is closed or narrowed below 0.5 m.
 class Furnisher {
  public:
-  Furnisher(mapping::OccupancyGrid& truth, std::uint64_t seed) : g_(truth), random_(seed), res_(truth.resolution()) {
-    occupied_ = cv::Mat(g_.height(), g_.width(), CV_8U, cv::Scalar(0));
-    for (int y = 0; y < g_.height(); ++y)
-      for (int x = 0; x < g_.width(); ++x)
-        if (g_.state({x, y}) != mapping::CellState::Free) occupied_.at<std::uint8_t>(y, x) = 255;
-    reach_ = reach(occupied_);
-  }
+  Furnisher(mapping::OccupancyGrid& truth, std::uint64_t seed)
+      : g_(truth), random_(seed), res_(truth.resolution()), occupied_(free_mask(truth) == 0), reach_(reach(occupied_)) {}
 
   // Places the pieces; returns how many were kept.
   int furnish(double m2_per_piece) {
@@ -395,10 +399,7 @@ class Furnisher {
 // A start in the largest free region of the plan, at least 0.4 m from walls (a random start may
 // fall in a closet-sized pocket between walls), drawn with `random`.
 core::Pose2 start_in_largest_room(const mapping::OccupancyGrid& truth, core::Random& random) {
-  cv::Mat free(truth.height(), truth.width(), CV_8U, cv::Scalar(0));
-  for (int y = 0; y < truth.height(); ++y)
-    for (int x = 0; x < truth.width(); ++x)
-      if (truth.state({x, y}) == mapping::CellState::Free) free.at<std::uint8_t>(y, x) = 255;
+  const cv::Mat free = free_mask(truth);
   cv::Mat labels, stats, centroids, clearance;
   const int n = cv::connectedComponentsWithStats(free, labels, stats, centroids, 4, CV_32S);
   int best = 1;
