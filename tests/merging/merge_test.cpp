@@ -192,6 +192,28 @@ TEST(AlignMaps, OneRectangularRoomTurnedAHalfTurnIsRefused) {
   EXPECT_EQ(r.refusal, Refusal::OneRoom);
 }
 
+// Two robots' maps from the simulator (HouseExpo plan 95144b9b8ec8; three robots, ideal
+// localization, seed 2, communication range 8 m; robots 1 and 2 at step 80, written by
+// `fleetmap explore --merge-attempts`). Both saw the room they started in and a room beyond it on
+// opposite sides; robot 1's beams grazed a thin wall and saw through it, so at the search level the
+// right fit had 26 walls on robot 1's free space against 254 fitting, and was dropped there below
+// placements that overlap nothing: the run merged the room turned a half turn onto itself (11 m
+// off, confidence 0.77). Now the right placement is the answer; the room turned a half turn still
+// fits nearly as well, so it is refused, not merged wrong. The truth is a shift by whole cells
+// (the robots started 0.6 m apart, facing the same way).
+TEST(AlignMaps, AThinWallSeenThroughDoesNotHideTheRightFit) {
+  const auto a = load_houseexpo_map("house_95144b9b8ec8_step80_robot_1.png", 0.05);
+  const auto b = load_houseexpo_map("house_95144b9b8ec8_step80_robot_2.png", 0.05);
+  ASSERT_GT(a.count(mapping::CellState::Occupied), 1000);
+  const core::Transform2 truth(-9.0, 3.0, 0.0);
+  const MergeResult r = align_maps(a, b);
+  EXPECT_LT(mean_displacement(r.transform, truth, b), 1.0) << r.transform << " " << r.reason;
+  ASSERT_TRUE(r.alternative.has_value());
+  EXPECT_GT(mean_displacement(*r.alternative, truth, b), 50.0) << "the half-turned room";
+  EXPECT_FALSE(r.merged);
+  EXPECT_EQ(r.refusal, Refusal::AnotherPlacement) << r.reason;
+}
+
 // Windows of the development benchmark (bench/merging_real_bench.cpp): a robot explored a
 // HouseExpo plan (Li et al. 2019) with a noisy laser and scan matching (at 0.025 m for the
 // smaller plans, else 0.05 m); `a` is a
