@@ -176,6 +176,19 @@ TEST(AlignMaps, TwoCornersOfABareHallAreRefused) {
   EXPECT_NE(r.reason.find("corner"), std::string::npos) << r.reason;
 }
 
+// The two maps of a simulator's merge attempt (0.05 m, from `fleetmap explore --merge-attempts`),
+// receiver first: refused as one rectangular room, saying so.
+void expect_refused_as_one_room(const std::string& receiver, const std::string& sender) {
+  SCOPED_TRACE(receiver + " and " + sender);
+  const auto a = load_houseexpo_map(receiver, 0.05);
+  const auto b = load_houseexpo_map(sender, 0.05);
+  ASSERT_GT(a.count(mapping::CellState::Occupied), 1000);
+  const MergeResult r = align_maps(a, b);
+  EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
+  EXPECT_NE(r.reason.find("rectangular room"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.refusal, Refusal::OneRoom) << r.reason;
+}
+
 // The two maps of the simulator's wrong merge (HouseExpo plan 84537130db40, a bare rectangular
 // hall; three robots, ideal localization, seed 2; robots 1 and 3 at step 534, written by
 // `fleetmap explore --merge-attempts`; tests/data/houseexpo). Robot 1 saw the hall's right side and parts of its top and bottom,
@@ -183,13 +196,7 @@ TEST(AlignMaps, TwoCornersOfABareHallAreRefused) {
 // robot 1's three (the run merged that, 33 m off, at confidence 0.80), while the right placement shares
 // only one corner. Nothing in either map tells the two apart: refused, saying why.
 TEST(AlignMaps, OneRectangularRoomTurnedAHalfTurnIsRefused) {
-  const auto a = load_houseexpo_map("bare_hall_step534_robot_1.png", 0.05);
-  const auto b = load_houseexpo_map("bare_hall_step534_robot_3.png", 0.05);
-  ASSERT_GT(a.count(mapping::CellState::Occupied), 1000);
-  const MergeResult r = align_maps(a, b);
-  EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
-  EXPECT_NE(r.reason.find("rectangular room"), std::string::npos) << r.reason;
-  EXPECT_EQ(r.refusal, Refusal::OneRoom);
+  expect_refused_as_one_room("bare_hall_step534_robot_1.png", "bare_hall_step534_robot_3.png");
 }
 
 // Two robots' maps from the simulator (HouseExpo plan 95144b9b8ec8; three robots, ideal
@@ -223,12 +230,7 @@ TEST(AlignMaps, AThinWallSeenThroughDoesNotHideTheRightFit) {
 // agree 86%, more contradictions than the answer's rate predicts, so it was no rival. At most
 // twice the answer's rate, it now shows that the room fits itself turned: refused.
 TEST(AlignMaps, OneRoomTurnedIsRefusedWhenTheRightPlacementIsRough) {
-  const auto a = load_houseexpo_map("house_4f6576b767f7_step130_robot_1.png", 0.05);
-  const auto b = load_houseexpo_map("house_4f6576b767f7_step130_robot_2.png", 0.05);
-  ASSERT_GT(a.count(mapping::CellState::Occupied), 1000);
-  const MergeResult r = align_maps(a, b);
-  EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
-  EXPECT_EQ(r.refusal, Refusal::OneRoom) << r.reason;
+  expect_refused_as_one_room("house_4f6576b767f7_step130_robot_1.png", "house_4f6576b767f7_step130_robot_2.png");
 }
 
 // With scan matching the robots' maps drift (HouseExpo plan c4513f5dfd08; the same scenario with
@@ -239,12 +241,7 @@ TEST(AlignMaps, OneRoomTurnedIsRefusedWhenTheRightPlacementIsRough) {
 // leaves 7% of its walls contradicted: no rival by the contradiction count, yet a placement that
 // could be merged and fits more. Refused as one room.
 TEST(AlignMaps, OneRoomTurnedIsRefusedWhenDriftRoughensTheRightPlacement) {
-  const auto a = load_houseexpo_map("house_c4513f5dfd08_scan_matching_step324_robot_2.png", 0.05);
-  const auto b = load_houseexpo_map("house_c4513f5dfd08_scan_matching_step324_robot_3.png", 0.05);
-  ASSERT_GT(a.count(mapping::CellState::Occupied), 1000);
-  const MergeResult r = align_maps(a, b);
-  EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
-  EXPECT_EQ(r.refusal, Refusal::OneRoom) << r.reason;
+  expect_refused_as_one_room("house_c4513f5dfd08_scan_matching_step324_robot_2.png", "house_c4513f5dfd08_scan_matching_step324_robot_3.png");
 }
 
 // Windows of the development benchmark (bench/merging_real_bench.cpp): a robot explored a
