@@ -705,7 +705,8 @@ struct Diagnosis {
 
 Diagnosis diagnose(const Pair& p, const merging::MergeOptions& options) {
   const merging::KnownPart ka(p.a), kb(p.b);
-  const merging::PreparedGrid pa(ka.grid(), options.prepare), pb(kb.grid(), options.prepare);
+  const merging::PrepareOptions prepare = merging::prepare_options(options);
+  const merging::PreparedGrid pa(ka.grid(), prepare), pb(kb.grid(), prepare);
   const core::Transform2 truth = p.reference.value_or(*p.truth);
   const Eigen::Vector2d oa = ka.origin().cast<double>(), ob = kb.origin().cast<double>();
   const core::Transform2 cut(truth.translation() + truth.rotation_matrix() * ob - oa, truth.rotation());

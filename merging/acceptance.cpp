@@ -135,7 +135,7 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
       if (!out.blocks.insert(key).second) continue;
       out.positions.push_back(to_a.apply(p.cast<double>()));
       if (!w.clutter) out.structure_positions.push_back(out.positions.back());
-      if (!w.clutter && matched_wall_end(from.level(0), target, w, r, p)) ++out.wall_ends;
+      if (options.shape && !w.clutter && matched_wall_end(from.level(0), target, w, r, p)) ++out.wall_ends;
       out.structures.push_back(ra * w.structure.cast<double>() * ra.transpose());
     } else if (!w.clutter && d >= options.contradiction_distance && target.is_free(x, y)) {
       ++out.contradicted;
@@ -271,12 +271,14 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   q.contradicted = t.contradicted;
   q.score = t.matched - options.contradiction_weight * t.contradicted;
   q.agreement = t.matched + t.contradicted > 0 ? double(t.matched) / double(t.matched + t.contradicted) : 0.0;
-  std::vector<Line> lines;
-  const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0, &lines);
-  q.beyond_corner = left[1];
-  if (lines.size() >= 2) q.junction_arms = junction_arms(t.structure_positions, lines[0], lines[1], 2.0, 4.0, 3);
-  q.wall_ends = t.wall_ends;
-  q.beyond_room = left[3];
+  if (options.shape) {
+    std::vector<Line> lines;
+    const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0, &lines);
+    q.beyond_corner = left[1];
+    if (lines.size() >= 2) q.junction_arms = junction_arms(t.structure_positions, lines[0], lines[1], 2.0, 4.0, 3);
+    q.wall_ends = t.wall_ends;
+    q.beyond_room = left[3];
+  }
   if (t.positions.size() < 3) return q;
   Eigen::Vector2d c = Eigen::Vector2d::Zero();
   for (const auto& p : t.positions) c += p;

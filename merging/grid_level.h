@@ -24,7 +24,9 @@ struct GridLevel {
   cv::Mat occupied;            // CV_8U mask
   cv::Mat free;                // CV_8U mask
   cv::Mat walls;               // occupied cells with a free 8-neighbour
-  cv::Mat wall_distance;       // CV_32F: distance in cells from each cell centre to the nearest wall cell
+  // CV_32F: distance in cells from each cell centre to the nearest wall cell, at most
+  // PrepareOptions::max_wall_distance (that value where the walls are farther).
+  cv::Mat wall_distance;
   std::vector<Eigen::Vector2f> wall_points;  // centres of the wall cells (subsampled on big maps)
   // For each wall point, the unit direction toward the free space it was seen from (zero where
   // free space lies on several sides): two maps agree on a wall only when they saw it from the

@@ -202,8 +202,10 @@ Placements other_placements(const PreparedGrid& a, const PreparedGrid& b, const 
   for (int k = 0; k < 4; ++k) turns.push_back(answer.rotation() + k * std::numbers::pi / 2.0);
   OverlapSearchOptions probe = options.overlap;
   probe.translation_peaks = 4;
+  QualityOptions fit_only = options.quality;
+  fit_only.shape = false;
   for (const auto& c : refine_candidates(a, b, overlap_hypotheses_at(a, b, turns, probe), options))
-    known.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, options.quality), c.fit.b_to_a);
+    known.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, fit_only), c.fit.b_to_a);
   return known;
 }
 
@@ -220,8 +222,11 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   }
   std::vector<Candidate> active = refine_candidates(a, b, candidates, options);
   // Score the survivors at full resolution; the best one is the answer.
+  // The shape of the common walls counts for the answer only (below).
+  QualityOptions fit_only = options.quality;
+  fit_only.shape = false;
   std::vector<std::pair<AlignmentQuality, const Candidate*>> scored;
-  for (const auto& c : active) scored.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, options.quality), &c);
+  for (const auto& c : active) scored.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, fit_only), &c);
   std::sort(scored.begin(), scored.end(), [](const auto& x, const auto& y) { return x.first.score > y.first.score; });
   // The answer: the best-scoring survivor whose cells agree with the other map (the wave-algorithm
   // paper's acceptance index, Birk & Carpin 2006, at least ConfidenceOptions::zero_acceptance). The
@@ -239,6 +244,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   }
   if (omega[pick] < options.confidence.zero_acceptance) pick = 0;
   std::rotate(scored.begin(), scored.begin() + std::ptrdiff_t(pick), scored.begin() + std::ptrdiff_t(pick) + 1);
+  scored.front().first = evaluate_alignment(a, b, scored.front().second->fit.b_to_a, options.quality);
   const auto& [best_q, best] = scored.front();
   result.transform = best->fit.b_to_a;
   result.method = best->hypothesis.method;
@@ -329,7 +335,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       const Eigen::Vector2d o = origin.cast<double>();
       const core::Transform2 answer(result.transform.translation() + result.transform.rotation_matrix() * o,
                                     result.transform.rotation());  // the cut's cells into a's
-      const AlignmentQuality own = evaluate_alignment(a, pc, answer, options.quality);
+      const AlignmentQuality own = evaluate_alignment(a, pc, answer, fit_only);
       const auto [d, alternative] = distinctiveness(pc, other_placements(a, pc, answer, options, {}), own, answer);
       if (d < result.distinctiveness) {
         result.distinctiveness = d;
@@ -381,8 +387,26 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   return result;
 }
 
+double needed_wall_distance(const MergeOptions& options) {
+  // refine.cpp counts walls 2.5 cells off as outliers, acceptance.cpp cells within 1 of a wall,
+  // the overlap search free cells beyond 1.5.
+  return std::max({options.quality.match_distance, options.quality.contradiction_distance,
+                   options.refinement.inlier_distance, 2.5}) + 1.5;
+}
+
+PrepareOptions prepare_options(const MergeOptions& options) {
+  PrepareOptions p = options.prepare;
+  p.max_wall_distance = std::max(p.max_wall_distance, needed_wall_distance(options));
+  return p;
+}
+
 MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const MergeOptions& options) {
   check_merge_method(options.method);
+  const double needed = needed_wall_distance(options);
+  if (a.max_wall_distance() < needed || b.max_wall_distance() < needed)
+    throw InputError(fmt::format("merge options: the maps were prepared with max_wall_distance {} cells, the "
+                                 "distances compared need {} (prepare them with prepare_options(options))",
+                                 std::min(a.max_wall_distance(), b.max_wall_distance()), needed));
   if (a.walls().empty() || b.walls().empty()) {
     MergeResult r;
     r.reason = std::string("no reliable overlap: ") + (a.walls().empty() ? "the first" : "the second") +
@@ -451,7 +475,8 @@ MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b) {
 MergeResult align_maps(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b, const MergeOptions& options) {
   check_merge_method(options.method);
   const KnownPart ka(a), kb(b);
-  const PreparedGrid pa(ka.grid(), options.prepare), pb(kb.grid(), options.prepare);
+  const PrepareOptions prepare = prepare_options(options);
+  const PreparedGrid pa(ka.grid(), prepare), pb(kb.grid(), prepare);
   return uncut(align_prepared(pa, pb, options), ka, kb);
 }
 

@@ -192,8 +192,16 @@ MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b);
 // not merge. Throws InputError for an unknown method name.
 MergeResult align_maps(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
                        const MergeOptions& options = {});
-// The same on grids prepared once (N-map merging prepares each map once for all its pairs).
+// The same on grids prepared once (N-map merging prepares each map once for all its pairs), with
+// prepare_options(options) or a larger max_wall_distance: throws InputError for a smaller one.
 MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const MergeOptions& options = {});
+
+// The PrepareOptions::max_wall_distance that `options` need: the largest wall distance they compare
+// (match, contradiction, refinement) and 1.5 cells more, since a distance read between cell
+// centres mixes four cells up to 1.42 cells apart in distance.
+double needed_wall_distance(const MergeOptions& options);
+// options.prepare with max_wall_distance raised to needed_wall_distance(options) where it is less.
+PrepareOptions prepare_options(const MergeOptions& options);
 
 // The common pipeline on given candidates: refine, score, decide.
 MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vector<Hypothesis>& candidates,

@@ -21,7 +21,7 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
   std::vector<std::unique_ptr<PreparedGrid>> prepared;
   for (const auto* g : grids) {
     parts.push_back(std::make_unique<KnownPart>(*g));
-    prepared.push_back(std::make_unique<PreparedGrid>(parts.back()->grid(), options.prepare));
+    prepared.push_back(std::make_unique<PreparedGrid>(parts.back()->grid(), prepare_options(options)));
   }
   const int total = n * (n - 1) / 2;
   for (int i = 0; i < n; ++i) {

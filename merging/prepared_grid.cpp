@@ -5,7 +5,10 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
 
 namespace fleetmap::merging {
 
@@ -116,6 +119,36 @@ Eigen::Vector2f free_direction(const cv::Mat& free, int x, int y) {
   return weight > 0.0f && n >= 0.5f * weight ? Eigen::Vector2f(sum / n) : Eigen::Vector2f::Zero();
 }
 
+// The Euclidean distance from each cell to the nearest nonzero cell of `walls`, exact below `cap`
+// and `cap` elsewhere: each wall cell stamps the disc of radius `cap` around it, row by row.
+cv::Mat capped_wall_distance(const cv::Mat& walls, float cap) {
+  cv::Mat d(walls.size(), CV_32F, cv::Scalar(cap));
+  const int r = int(std::ceil(cap));
+  // Row dy of the disc: distances at dx = -half[dy] .. half[dy], from `start[dy]` in `values`.
+  std::vector<int> half(std::size_t(2 * r + 1), -1), start(half.size(), 0);
+  std::vector<float> values;
+  for (int dy = -r; dy <= r; ++dy) {
+    const auto i = std::size_t(dy + r);
+    start[i] = int(values.size());
+    while (half[i] + 1 <= r && float((half[i] + 1) * (half[i] + 1) + dy * dy) < cap * cap) ++half[i];
+    for (int dx = -half[i]; dx <= half[i]; ++dx) values.push_back(std::sqrt(float(dx * dx + dy * dy)));
+  }
+  for (int y = 0; y < walls.rows; ++y) {
+    const auto* w = walls.ptr<std::uint8_t>(y);
+    for (int x = 0; x < walls.cols; ++x) {
+      if (!w[x]) continue;
+      for (int dy = std::max(-r, -y); dy <= std::min(r, walls.rows - 1 - y); ++dy) {
+        const auto i = std::size_t(dy + r);
+        const int x0 = std::max(x - half[i], 0), x1 = std::min(x + half[i], walls.cols - 1);
+        float* row = d.ptr<float>(y + dy);
+        const float* v = values.data() + start[i] + (x0 - (x - half[i]));
+        for (int xx = x0; xx <= x1; ++xx, ++v) row[xx] = std::min(row[xx], *v);
+      }
+    }
+  }
+  return d;
+}
+
 // `level.clutter` must be set (or empty: none). `wall_cells` gets every wall cell, row by row.
 void finish_level(GridLevel& level, const PrepareOptions& options, std::vector<cv::Point>& wall_cells) {
   if (level.clutter.empty()) level.clutter = cv::Mat::zeros(level.occupied.size(), CV_8U);
@@ -123,13 +156,7 @@ void finish_level(GridLevel& level, const PrepareOptions& options, std::vector<c
   cv::Mat free_near;
   cv::dilate(level.free, free_near, cv::Mat::ones(3, 3, CV_8U));
   level.walls = level.occupied & free_near;
-  // Distance to the nearest wall cell; a map without walls is "far" everywhere.
-  if (cv::countNonZero(level.walls) == 0) {
-    level.wall_distance = cv::Mat(level.walls.size(), CV_32F, cv::Scalar(1e4));
-  } else {
-    cv::Mat not_wall = level.walls == 0;
-    cv::distanceTransform(not_wall, level.wall_distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-  }
+  level.wall_distance = capped_wall_distance(level.walls, float(options.max_wall_distance));
   // At most `cap` points, chosen by a hash of the cell: spread evenly in space without following
   // the raster order (taking every k-th point of a row scan would leave rows, and the Hough
   // spectrum would see horizontal lines).
@@ -197,7 +224,10 @@ float GridLevel::distance_gradient_at(float x, float y, float outside, float& gx
   return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
 }
 
-PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOptions& options) : grid_(&grid) {
+PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOptions& options)
+    : grid_(&grid), max_wall_distance_(options.max_wall_distance) {
+  if (!(options.max_wall_distance >= 1.0 && options.max_wall_distance <= 1000.0))
+    throw InputError(fmt::format("merge options: max_wall_distance {} is not 1 to 1000 cells", options.max_wall_distance));
   GridLevel base;
   base.factor = 1;
   base.occupied = cv::Mat::zeros(std::max(grid.height(), 1), std::max(grid.width(), 1), CV_8U);
@@ -347,6 +377,7 @@ PreparedGrid prepared_part(const PreparedGrid& source, const cv::Mat& mask, cons
 PreparedGrid PreparedGridParts::cut(const PreparedGrid& source, const cv::Mat& mask, const PrepareOptions& options,
                                     Eigen::Vector2i& origin) {
   PreparedGrid part(source.grid_);
+  part.max_wall_distance_ = source.max_wall_distance_;
   const GridLevel& s0 = source.level(0);
   cv::Mat m0 = mask & (s0.occupied | s0.free);
   // The box of the mask's cells, without listing them.

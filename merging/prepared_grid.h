@@ -40,6 +40,10 @@ struct PrepareOptions {
   // at most clutter_size_m. Metres, from the grid's resolution.
   double clutter_size_m = 0.5;
   double clutter_gap_m = 0.1;
+  // Distances to walls (GridLevel::wall_distance) are exact up to this many cells of each level and
+  // this value beyond: the merge compares them with a few cells only, and a capped field costs a
+  // third of a full distance transform. MergeOptions need at least needed_wall_distance(options).
+  double max_wall_distance = 6.0;
 };
 
 // Keeps a reference to `grid`, which must outlive it.
@@ -62,6 +66,8 @@ class PreparedGrid {
   // Every wall cell at full resolution, with its local structure (for scoring).
   const std::vector<WallPoint>& walls() const { return walls_; }
   std::int64_t known_cells() const { return known_cells_; }
+  // PrepareOptions::max_wall_distance it was prepared with.
+  double max_wall_distance() const { return max_wall_distance_; }
   const mapping::OccupancyGrid& grid() const { return *grid_; }
 
   // The finest level whose larger side is at most `cells` (the coarsest level if none is).
@@ -76,6 +82,7 @@ class PreparedGrid {
   std::vector<GridLevel> levels_;
   std::vector<WallPoint> walls_;
   std::int64_t known_cells_ = 0;
+  double max_wall_distance_ = 0.0;
   int width_ = 0, height_ = 0;
   std::size_t level_count_ = 0;
 };

@@ -406,6 +406,44 @@ TEST(MergeRegistry, AProgramsOwnMethodIsReachedByNameAndRefinedByTheCommonPipeli
   EXPECT_EQ(none.candidates, 0);
 }
 
+// Distances to walls are kept up to PrepareOptions::max_wall_distance only. Options that compare
+// longer distances get a larger cap from align_maps and multi-map merging, and an error from
+// align_prepared on grids prepared without it (a capped distance would read as "no wall near").
+TEST(AlignMaps, OptionsThatCompareLongerDistancesGetTheWallDistancesTheyNeed) {
+  core::Random world_random(1);
+  SyntheticWorldOptions wo;
+  wo.width = wo.height = 700;
+  const SyntheticWorld world(wo, world_random);
+  CropPairOptions o;
+  o.width = o.height = 200;
+  o.overlap = 0.5;
+  core::Random random(11);
+  const CropPair pair = make_world_pair(world, o, random);
+  MergeOptions options;
+  options.quality.contradiction_distance = 6.0;
+  EXPECT_GT(needed_wall_distance(options), PrepareOptions{}.max_wall_distance);
+  EXPECT_GE(prepare_options(options).max_wall_distance, needed_wall_distance(options));
+
+  const PreparedGrid a(pair.a), b(pair.b);
+  try {
+    align_prepared(a, b, options);
+    ADD_FAILURE() << "grids with distances capped at 6 cells were used to compare 6-cell distances";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("max_wall_distance"), std::string::npos) << e.what();
+  }
+  const MergeResult r = align_maps(pair.a, pair.b, options);
+  ASSERT_TRUE(r.merged) << r.reason;
+  const TransformError e = transform_error(r.transform, pair.b_to_a, pair.overlap_centre_b);
+  EXPECT_LT(e.rotation_deg, kMaxRotationDeg);
+  EXPECT_LT(e.translation_cells, kMaxTranslationCells);
+  const PreparedGrid wide_a(pair.a, prepare_options(options)), wide_b(pair.b, prepare_options(options));
+  EXPECT_EQ(align_prepared(wide_a, wide_b, options).transform.translation(), r.transform.translation());
+
+  PrepareOptions zero;
+  zero.max_wall_distance = 0.0;
+  EXPECT_THROW(PreparedGrid(pair.a, zero), InputError);
+}
+
 TEST(MergeRegistry, RegisteringAutoATakenNameOrNoPassesIsAnError) {
   EXPECT_THROW(register_merge_method("auto", "x", {propose_oracle}), Error);
   EXPECT_THROW(register_merge_method("overlap", "x", {propose_oracle}), Error);
