@@ -127,9 +127,35 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
   const Eigen::Vector2d centre_canvas((d - 1) / 2.0, (d - 1) / 2.0);
   const int radius = std::max(1, options.peak_separation);
 
-  std::vector<Hypothesis> out;
-  cv::Mat turned_band, turned_occupied, turned_clear, product, product2, s;
-  for (double theta : rotations) {
+  // Each rotation's maxima, in the order of `rotations`.
+  std::vector<std::vector<Hypothesis>> found(rotations.size());
+  const auto add_peaks = [&](std::size_t i, const cv::Mat& s, const Eigen::Vector2d& shift) {
+    for (const auto& p : top_peaks(s, options.translation_peaks, radius)) {
+      // A shift index beyond a's extent wraps around to a negative shift.
+      const int tx = p.at.x >= la.width() ? p.at.x - size.width : p.at.x;
+      const int ty = p.at.y >= la.height() ? p.at.y - size.height : p.at.y;
+      const core::Transform2 coarse(shift + Eigen::Vector2d(tx, ty), rotations[i]);
+      found[i].push_back({from_level(coarse, la.factor), p.value, level, "overlap"});
+    }
+  };
+  // b turned by theta + pi is b turned by theta reflected through the canvas centre (D - q for
+  // D = d - 1), and a correlation with a reflection is a convolution:
+  // S_{theta+pi}(t) = sum_q T(D - q) A(q + t) = (A * T)(t + D). Rotations a half turn apart
+  // share b's three transforms (the spectral candidates come in such pairs, and so do the probes'
+  // quarter turns).
+  std::vector<bool> done(rotations.size(), false);
+  cv::Mat turned_band, turned_occupied, turned_clear, f_band, f_occupied, f_clear, product, product2, s, shifted;
+  const auto combine = [&](bool conjugate) {
+    cv::mulSpectrums(g_band, f_band, product, 0, conjugate);
+    cv::mulSpectrums(g_clear, f_occupied, product2, 0, conjugate);
+    product -= w * product2;
+    cv::mulSpectrums(g_occupied, f_clear, product2, 0, conjugate);
+    product -= w * product2;
+    cv::idft(product, s, cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
+  };
+  for (std::size_t i = 0; i < rotations.size(); ++i) {
+    if (done[i]) continue;
+    const double theta = rotations[i];
     const core::Transform2 rot(0.0, 0.0, theta);
     const Eigen::Vector2d shift = centre_canvas - rot.apply(centre_b);
     const Eigen::Matrix2d r = rot.rotation_matrix();
@@ -137,22 +163,32 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
     cv::warpAffine(band_b, turned_band, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
     cv::warpAffine(occupied_b, turned_occupied, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
     cv::warpAffine(clear_b, turned_clear, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+    f_band = padded_dft(turned_band, size);
+    f_occupied = padded_dft(turned_occupied, size);
+    f_clear = padded_dft(turned_clear, size);
     // S(t) = sum_q band_b(q) band_a_near(q + t)
     //        - w sum_q [occupied_b(q) clear_a(q + t) + clear_b(q) occupied_a(q + t)], all t at once.
-    cv::mulSpectrums(g_band, padded_dft(turned_band, size), product, 0, true);
-    cv::mulSpectrums(g_clear, padded_dft(turned_occupied, size), product2, 0, true);
-    product -= w * product2;
-    cv::mulSpectrums(g_occupied, padded_dft(turned_clear, size), product2, 0, true);
-    product -= w * product2;
-    cv::idft(product, s, cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
-    for (const auto& p : top_peaks(s, options.translation_peaks, radius)) {
-      // A shift index beyond a's extent wraps around to a negative shift.
-      const int tx = p.at.x >= la.width() ? p.at.x - size.width : p.at.x;
-      const int ty = p.at.y >= la.height() ? p.at.y - size.height : p.at.y;
-      const core::Transform2 coarse(shift + Eigen::Vector2d(tx, ty), theta);
-      out.push_back({from_level(coarse, la.factor), p.value, level, "overlap"});
+    combine(true);
+    add_peaks(i, s, shift);
+    for (std::size_t j = i + 1; j < rotations.size(); ++j) {
+      if (done[j] || std::abs(core::normalize_angle(rotations[j] - theta - kPi)) > 1e-9) continue;
+      done[j] = true;
+      combine(false);
+      // Index t of S is index t + D of the convolution (cyclic).
+      const int dx = (d - 1) % size.width, dy = (d - 1) % size.height;
+      shifted.create(s.size(), s.type());
+      const int w0 = size.width - dx, h0 = size.height - dy;
+      s(cv::Rect(dx, dy, w0, h0)).copyTo(shifted(cv::Rect(0, 0, w0, h0)));
+      if (dx > 0) s(cv::Rect(0, dy, dx, h0)).copyTo(shifted(cv::Rect(w0, 0, dx, h0)));
+      if (dy > 0) s(cv::Rect(dx, 0, w0, dy)).copyTo(shifted(cv::Rect(0, h0, w0, dy)));
+      if (dx > 0 && dy > 0) s(cv::Rect(0, 0, dx, dy)).copyTo(shifted(cv::Rect(w0, h0, dx, dy)));
+      const core::Transform2 turned(0.0, 0.0, rotations[j]);
+      add_peaks(j, shifted, centre_canvas - turned.apply(centre_b));
+      break;
     }
   }
+  std::vector<Hypothesis> out;
+  for (auto& f : found) out.insert(out.end(), f.begin(), f.end());
   std::sort(out.begin(), out.end(), [](const Hypothesis& x, const Hypothesis& y) { return x.score > y.score; });
   if (int(out.size()) > options.max_hypotheses) out.resize(std::size_t(std::max(0, options.max_hypotheses)));
   return out;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <set>
 
 #include "core/angle.h"
@@ -57,6 +58,40 @@ TEST(OverlapSearch, TheSweepCoversEveryRotation) {
   double previous = *degrees.rbegin() - 360.0, widest = 0.0;
   for (double d : degrees) widest = std::max(widest, d - previous), previous = d;
   EXPECT_LT(widest, 2.0 * o.sweep_step_deg);
+}
+
+// Rotations a half turn apart share b's transforms (the second is a convolution with the first's
+// turned map): searched together they find the translations each finds alone, with the same
+// scores up to the resampling of the turned map (a 32nd of a cell).
+TEST(OverlapSearch, RotationsAHalfTurnApartFindWhatEachFindsAlone) {
+  core::Random random(8);
+  const auto source = testing::source_map("office");
+  const CropPair pair = make_crop_pair(source, testing::half_overlap_crops(source), random);
+  const PreparedGrid a(pair.a), b(pair.b);
+  OverlapSearchOptions o;
+  o.translation_peaks = 3;
+  const double theta = pair.b_to_a.rotation() + 0.3;  // one at the truth's turn + pi (after the 0.3)
+  const std::vector<double> both{theta, core::normalize_angle(theta + std::numbers::pi), pair.b_to_a.rotation()};
+  const auto together = overlap_hypotheses_at(a, b, both, o);
+  std::vector<Hypothesis> alone;
+  for (double r : both) {
+    const auto one = overlap_hypotheses_at(a, b, {r}, o);
+    alone.insert(alone.end(), one.begin(), one.end());
+  }
+  ASSERT_EQ(together.size(), alone.size());
+  double best = 0.0;
+  for (const auto& h : alone) best = std::max(best, h.score);
+  for (const auto& h : alone) {
+    // The same translation at the same rotation, scored within 2% of the best score.
+    bool seen = false;
+    for (const auto& t : together) {
+      seen = seen || (angle_gap_deg(t.b_to_a.rotation(), h.b_to_a.rotation()) < 1e-6 &&
+                      (t.b_to_a.translation() - h.b_to_a.translation()).norm() < 1e-6 &&
+                      std::abs(t.score - h.score) < 0.02 * best);
+    }
+    EXPECT_TRUE(seen) << core::rad2deg(h.b_to_a.rotation()) << " deg at " << h.b_to_a.translation().transpose()
+                      << ", score " << h.score;
+  }
 }
 
 }  // namespace
