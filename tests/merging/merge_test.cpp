@@ -370,14 +370,8 @@ std::vector<Hypothesis> propose_oracle(const PreparedGrid&, const PreparedGrid&,
   return {Hypothesis{spoiled, 1.0, 0, "oracle"}};
 }
 
-TEST(MergeRegistry, AProgramsOwnMethodIsReachedByNameAndRefinedByTheCommonPipeline) {
-  if (!merge_method_registry().contains("oracle")) {
-    register_merge_method("oracle", "the true transform, a cell and a degree off (a test's own)", {propose_oracle});
-  }
-  const auto names = merge_method_names();
-  EXPECT_NE(std::find(names.begin(), names.end(), "oracle"), names.end());
-  EXPECT_NE(merge_method_help().find("  oracle: the true transform"), std::string::npos);
-
+// Two 200 x 200 views, half overlapping, of a 700 x 700 synthetic furnished world (seeded).
+CropPair furnished_half_overlap_pair() {
   core::Random world_random(1);
   SyntheticWorldOptions wo;
   wo.width = wo.height = 700;
@@ -386,7 +380,18 @@ TEST(MergeRegistry, AProgramsOwnMethodIsReachedByNameAndRefinedByTheCommonPipeli
   o.width = o.height = 200;
   o.overlap = 0.5;
   core::Random random(11);
-  const CropPair pair = make_world_pair(world, o, random);
+  return make_world_pair(world, o, random);
+}
+
+TEST(MergeRegistry, AProgramsOwnMethodIsReachedByNameAndRefinedByTheCommonPipeline) {
+  if (!merge_method_registry().contains("oracle")) {
+    register_merge_method("oracle", "the true transform, a cell and a degree off (a test's own)", {propose_oracle});
+  }
+  const auto names = merge_method_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "oracle"), names.end());
+  EXPECT_NE(merge_method_help().find("  oracle: the true transform"), std::string::npos);
+
+  const CropPair pair = furnished_half_overlap_pair();
   const PreparedGrid a(pair.a), b(pair.b);
   MergeOptions options;
   options.method = "oracle";
@@ -410,15 +415,7 @@ TEST(MergeRegistry, AProgramsOwnMethodIsReachedByNameAndRefinedByTheCommonPipeli
 // longer distances get a larger cap from align_maps and multi-map merging, and an error from
 // align_prepared on grids prepared without it (a capped distance would read as "no wall near").
 TEST(AlignMaps, OptionsThatCompareLongerDistancesGetTheWallDistancesTheyNeed) {
-  core::Random world_random(1);
-  SyntheticWorldOptions wo;
-  wo.width = wo.height = 700;
-  const SyntheticWorld world(wo, world_random);
-  CropPairOptions o;
-  o.width = o.height = 200;
-  o.overlap = 0.5;
-  core::Random random(11);
-  const CropPair pair = make_world_pair(world, o, random);
+  const CropPair pair = furnished_half_overlap_pair();
   MergeOptions options;
   options.quality.contradiction_distance = 6.0;
   EXPECT_GT(needed_wall_distance(options), PrepareOptions{}.max_wall_distance);
