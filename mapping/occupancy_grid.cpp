@@ -49,13 +49,6 @@ void OccupancyGrid::set_state(const Cell& c, CellState s) {
   set_log_odds(c, l);
 }
 
-void OccupancyGrid::set_log_odds(const Cell& c, float l) {
-  if (!contains(c)) return;
-  float& cell = log_odds_[static_cast<std::size_t>(geometry_.index(c))];
-  observed_count_ += (cell == 0.0f) - (l == 0.0f);
-  cell = l;
-}
-
 void OccupancyGrid::update(const Cell& c, float delta) {
   if (!contains(c)) return;
   float& l = log_odds_[static_cast<std::size_t>(geometry_.index(c))];

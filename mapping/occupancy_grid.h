@@ -64,7 +64,13 @@ class OccupancyGrid {
 
   // Sets a cell to a firm state: the clamping bound for Free/Occupied, 0 for Unknown.
   void set_state(const Cell& c, CellState s);
-  void set_log_odds(const Cell& c, float l);
+  // Inline: whole grids are copied cell by cell through it (crops, loaded images, merged maps).
+  void set_log_odds(const Cell& c, float l) {
+    if (!contains(c)) return;
+    float& cell = log_odds_[static_cast<std::size_t>(geometry_.index(c))];
+    observed_count_ += (cell == 0.0f) - (l == 0.0f);
+    cell = l;
+  }
   // Adds `delta` to a cell's log-odds, clamped to the bounds. Ignores cells outside the grid.
   void update(const Cell& c, float delta);
   void update_hit(const Cell& c) { update(c, hit_log_odds_); }
