@@ -120,7 +120,9 @@ std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGr
     RefineOptions level_options = options.refinement;
     if (k == start) level_options.iterations = std::min(level_options.iterations, options.first_level_iterations);
     for (auto& c : active) c.fit = refine_at_level(a, b, c.fit.b_to_a, k, level_options);
-    prune(active, b, options.confidence, std::size_t(k >= 2 ? options.coarse_candidates : options.fine_candidates));
+    // Those few steps rank them roughly: more go on from there than from the finer levels.
+    const bool rough = k == start && k >= 2;
+    prune(active, b, options.confidence, std::size_t(rough ? options.coarse_candidates : options.fine_candidates));
   }
   return active;
 }

@@ -102,8 +102,8 @@ struct MergeOptions {
   std::string method = "auto";   // a name of merge_method_names()
   double min_confidence = 0.5;   // below: not merged, "no reliable overlap"
   bool refine = true;            // refine candidates to sub-cell accuracy (off: the methods' raw answers)
-  int coarse_candidates = 8;     // candidates kept after the coarse levels
-  int fine_candidates = 4;       // candidates taken to full resolution
+  int coarse_candidates = 8;     // candidates kept after the level where they enter, when it is level 2 or coarser
+  int fine_candidates = 4;       // candidates kept after every other level (and taken to full resolution)
   int first_level_iterations = 4;  // refinement steps at the level where the candidates enter
   double sweep_step_deg = 4.0;   // `overlap`'s second pass: rotation sweep step
   int sweep_search_cells = 64;   // ... on a level this coarse (OverlapSearchOptions::search_cells)

@@ -103,13 +103,12 @@ LevelFit refine_at_level(const PreparedGrid& a, const PreparedGrid& b, const cor
     const double dth = std::clamp(delta(2), -0.05, 0.05);
     Eigen::Vector2d dt = delta.head<2>();
     if (dt.norm() > 2.0) dt *= 2.0 / dt.norm();
+    // Converged: a step this small changes nothing that counts, and the counts are at t (taking
+    // the step would cost one more pass to count again).
+    if (dt.norm() < options.converged_cells && std::abs(dth) * options.converged_radius < options.converged_cells) break;
     const core::Transform2 rot(0.0, 0.0, dth);
     const core::Transform2 step(c + dt - rot.apply(c), dth);
     t = step * t;
-    if (dt.norm() < options.converged_cells && std::abs(dth) * options.converged_radius < options.converged_cells) {
-      // Converged: one more pass to report the counts at the final transform.
-      it = options.iterations - 1;
-    }
   }
   // The last pass above was at the final t.
   fit.outliers += interior_outliers(lb, la, t) + interior_outliers(la, lb, t.inverse());
