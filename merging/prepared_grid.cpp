@@ -59,6 +59,63 @@ cv::Mat find_clutter(const cv::Mat& occupied, int gap, int size) {
   return clutter;
 }
 
+// Clears the occupied components (8-connected) of fewer than `min_cells` cells; returns how many
+// cells it cleared. Components of one or two cells are told by their neighbours alone (no occupied
+// neighbour; or one, which has no other), without labelling every component of a large map.
+int remove_specks(cv::Mat& occupied, int min_cells) {
+  if (min_cells <= 1) return 0;
+  int removed = 0;
+  if (min_cells <= 3) {
+    const int w = occupied.cols, h = occupied.rows;
+    // The occupied 8-neighbours of (x, y) but `skip`, and the last one seen.
+    const auto neighbours = [&](int x, int y, cv::Point skip, cv::Point& last) {
+      int n = 0;
+      for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy) {
+        const auto* row = occupied.ptr<std::uint8_t>(yy);
+        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
+          if (!row[xx] || (xx == x && yy == y) || (xx == skip.x && yy == skip.y)) continue;
+          ++n, last = {xx, yy};
+        }
+      }
+      return n;
+    };
+    for (int y = 0; y < h; ++y) {
+      auto* o = occupied.ptr<std::uint8_t>(y);
+      for (int x = 0; x < w; ++x) {
+        if (!o[x]) continue;
+        cv::Point q(-2, -2), unused;
+        const int n = neighbours(x, y, q, q);
+        // A lone cell; or one of two neighbours (the other is cleared when the scan reaches it: it
+        // has no occupied neighbour left).
+        if (n == 0 || (n == 1 && min_cells == 3 && neighbours(q.x, q.y, {x, y}, unused) == 0)) o[x] = 0, ++removed;
+      }
+    }
+    return removed;
+  }
+  // Component sizes counted here: OpenCV's statistics cost ten times the labelling on a large map.
+  cv::Mat labels;
+  const int n = cv::connectedComponents(occupied, labels, 8, CV_32S);
+  std::vector<int> area(std::size_t(std::max(n, 1)), 0);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < labels.cols; ++x) ++area[std::size_t(l[x])];
+  }
+  std::vector<std::uint8_t> speck(area.size(), 0);
+  bool any = false;
+  for (std::size_t i = 1; i < area.size(); ++i) {
+    if (area[i] < min_cells) speck[i] = 1, any = true;
+  }
+  if (!any) return 0;
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    auto* o = occupied.ptr<std::uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      if (speck[std::size_t(l[x])]) o[x] = 0, ++removed;
+    }
+  }
+  return removed;
+}
+
 // Max pooling of a mask by 2 into `out` ((rows + 1) / 2 x (cols + 1) / 2), one output cell at a time.
 void pool_into(const cv::Mat& m, cv::Mat& out) {
   const int w = (m.cols + 1) / 2, h = (m.rows + 1) / 2, pairs = m.cols / 2;
@@ -244,30 +301,7 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
       }
     }
   }
-  if (options.min_obstacle_cells > 1) {
-    // Component sizes counted here: OpenCV's statistics cost ten times the labelling on a large map.
-    cv::Mat labels;
-    const int n = cv::connectedComponents(base.occupied, labels, 8, CV_32S);
-    std::vector<int> area(std::size_t(std::max(n, 1)), 0);
-    for (int y = 0; y < labels.rows; ++y) {
-      const int* l = labels.ptr<int>(y);
-      for (int x = 0; x < labels.cols; ++x) ++area[std::size_t(l[x])];
-    }
-    std::vector<std::uint8_t> speck(area.size(), 0);
-    bool any = false;
-    for (std::size_t i = 1; i < area.size(); ++i) {
-      if (area[i] < options.min_obstacle_cells) speck[i] = 1, any = true;
-    }
-    if (any) {
-      for (int y = 0; y < labels.rows; ++y) {
-        const int* l = labels.ptr<int>(y);
-        auto* o = base.occupied.ptr<std::uint8_t>(y);
-        for (int x = 0; x < labels.cols; ++x) {
-          if (speck[std::size_t(l[x])]) o[x] = 0, --known_cells_;
-        }
-      }
-    }
-  }
+  known_cells_ -= remove_specks(base.occupied, options.min_obstacle_cells);
   const double resolution = grid.resolution() > 0.0 ? grid.resolution() : 0.05;
   // Gaps of two cells at least: a thin wall turned and resampled on another grid breaks every few cells.
   base.clutter = find_clutter(base.occupied, std::max(2, int(std::lround(options.clutter_gap_m / resolution))),

@@ -74,6 +74,64 @@ TEST(PreparedGrid, SpecksAreNoise) {
   EXPECT_EQ(PreparedGrid(grid_from_text(rows), keep).walls().size(), 13u);
 }
 
+// Specks are the occupied components (8-connected) smaller than min_obstacle_cells, whatever their
+// shape; the ones of one or two cells are told apart without labelling: the same cells either way.
+TEST(PreparedGrid, SpecksAreTheSmallComponentsWhateverTheirShape) {
+  // Random occupied cells, about one in six: components of every small shape, touching diagonally.
+  const int w = 61, h = 47;
+  std::vector<std::string> rows(std::size_t(h), std::string(std::size_t(w), '.'));
+  std::uint32_t state = 12345u;
+  for (auto& r : rows)
+    for (auto& c : r) {
+      state = state * 1664525u + 1013904223u;
+      if ((state >> 24) % 6 == 0) c = '#';
+    }
+  // Each component's size, by a flood fill of the text.
+  std::vector<int> label(std::size_t(w * h), -1), size;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (rows[std::size_t(y)][std::size_t(x)] != '#' || label[std::size_t(y * w + x)] >= 0) continue;
+      const int id = int(size.size());
+      size.push_back(0);
+      std::vector<std::pair<int, int>> stack{{x, y}};
+      label[std::size_t(y * w + x)] = id;
+      while (!stack.empty()) {
+        const auto [cx, cy] = stack.back();
+        stack.pop_back();
+        ++size.back();
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = cx + dx, ny = cy + dy;
+            if (nx < 0 || ny < 0 || nx >= w || ny >= h || rows[std::size_t(ny)][std::size_t(nx)] != '#') continue;
+            if (label[std::size_t(ny * w + nx)] >= 0) continue;
+            label[std::size_t(ny * w + nx)] = id;
+            stack.push_back({nx, ny});
+          }
+      }
+    }
+  const auto g = grid_from_text(rows);
+  for (const int min_cells : {1, 2, 3, 4, 6}) {
+    PrepareOptions o;
+    o.min_obstacle_cells = min_cells;
+    o.clutter_size_m = 0.0;
+    const PreparedGrid p(g, o);
+    int kept_by_size = 0, wrong = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const int l = label[std::size_t(y * w + x)];
+        const bool kept = l >= 0 && size[std::size_t(l)] >= min_cells;
+        kept_by_size += kept;
+        wrong += kept != (p.level(0).occupied.at<std::uint8_t>(h - 1 - y, x) != 0);
+      }
+    EXPECT_EQ(wrong, 0) << "min_obstacle_cells " << min_cells;
+    // Every cell of the text is known; a speck's cells become unknown.
+    const auto occupied = std::count_if(label.begin(), label.end(), [](int l) { return l >= 0; });
+    EXPECT_EQ(p.known_cells(), std::int64_t(w * h) - (occupied - kept_by_size)) << "min_obstacle_cells " << min_cells;
+  }
+  // The random map has components of one, two and three cells (so that each rule is tried).
+  for (const int n : {1, 2, 3}) EXPECT_GT(std::count(size.begin(), size.end(), n), 3) << n;
+}
+
 // A chair or a person (a blob of 0.15 m standing alone) is clutter; a wall, and a blob touching
 // it, are not. Clutter walls never contradict the other map: it may have moved between visits.
 TEST(PreparedGrid, SmallLoneObstaclesAreClutterAndNeverContradict) {
