@@ -300,14 +300,13 @@ mapping::OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta
   const bool has_alpha = channels == 2 || channels == 4;
   const int colour_channels = has_alpha ? channels - 1 : channels;
   const float lo = grid.min_log_odds(), hi = grid.max_log_odds();
-  for (int row = 0; row < image.rows; ++row) {
-    const std::uint8_t* p = image.ptr<std::uint8_t>(row);
-    const int y = image.rows - 1 - row;  // image top row is the map's last row
-    for (int x = 0; x < image.cols; ++x, p += channels) {
-      int sum = 0;
-      for (int k = 0; k < colour_channels; ++k) sum += p[k];
+  // A cell's log-odds depends only on the sum of its colour channels and whether it is opaque:
+  // worked out once per value, not once per cell.
+  const int sums = 255 * colour_channels + 1;
+  std::vector<float> table(std::size_t(2 * sums), 0.0f);
+  for (int opaque = 0; opaque < 2; ++opaque) {
+    for (int sum = 0; sum < sums; ++sum) {
       double colour = static_cast<double>(sum) / colour_channels;
-      const bool opaque = !has_alpha || p[channels - 1] == 255;
       if (meta.negate) colour = 255.0 - colour;
       std::optional<double> probability;  // nullopt: unknown
       if (meta.mode == MapMode::Raw) {
@@ -328,7 +327,17 @@ mapping::OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta
             : *probability >= 1.0 ? hi
                                   : std::clamp(static_cast<float>(mapping::probability_to_log_odds(*probability)), lo, hi);
       }
-      grid.set_log_odds({x, y}, l);
+      table[std::size_t(opaque * sums + sum)] = l;
+    }
+  }
+  for (int row = 0; row < image.rows; ++row) {
+    const std::uint8_t* p = image.ptr<std::uint8_t>(row);
+    const int y = image.rows - 1 - row;  // image top row is the map's last row
+    for (int x = 0; x < image.cols; ++x, p += channels) {
+      int sum = 0;
+      for (int k = 0; k < colour_channels; ++k) sum += p[k];
+      const bool opaque = !has_alpha || p[channels - 1] == 255;
+      grid.set_log_odds({x, y}, table[std::size_t((opaque ? sums : 0) + sum)]);
     }
   }
   return grid;
