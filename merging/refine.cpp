@@ -10,16 +10,23 @@ namespace fleetmap::merging {
 
 namespace {
 
-struct Residual {
-  Eigen::Vector2d position;  // in a's (level) frame: where the wall point lies
-  Eigen::Vector2d gradient;  // of the distance, in the frame of the map the distance is read from
-  double r = 0.0;
-  bool from_b = true;
+// The Gauss-Newton sums of one pass, about the origin of a's (level) frame. A residual r at a's
+// position p, whose distance gradient g' is seen from b's frame, has the Jacobian
+// j0 = [g'x, g'y, p.x g'y - p.y g'x] for an update turning about the origin; turning about c
+// instead, j = A j0 with A = [1 0 0; 0 1 0; c.y -c.x 1], so the sums about c (the residuals'
+// mean position, known only at the end of the pass) are A H0 A^T and A g0.
+struct Sums {
+  Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  Eigen::Vector2d position_sum = Eigen::Vector2d::Zero();
+  int count = 0;
 };
 
-// The wall points of `from` moved by t into `to`, with the distance to `to`'s walls.
+// The wall points of `from` moved by t into `to`, with the distance to `to`'s walls, added to
+// `sums`. `to_a` takes `to`'s frame into a's; `turn` the distance gradient into b's frame, negated
+// for a's points (they move by the inverse of the update).
 void collect(const GridLevel& from, const GridLevel& to, const core::Transform2& t, const core::Transform2& to_a,
-             bool from_b, double cutoff, std::vector<Residual>& out, int& inliers, int& outliers) {
+             const Eigen::Matrix2d& turn, double cutoff, Sums& sums, int& inliers, int& outliers) {
   const Eigen::Matrix2f r = t.rotation_matrix().cast<float>();
   const Eigen::Vector2f tr = t.translation().cast<float>();
   // to_a.apply, with its rotation computed once (not once per point).
@@ -36,12 +43,15 @@ void collect(const GridLevel& from, const GridLevel& to, const core::Transform2&
     // A wall of the other map seen from the other side attracts nothing.
     if (d > cutoff || !seen_from_same_side(to, p, r * from.wall_normals[i])) continue;
     if (d <= 1.0f) ++inliers;
-    Residual res;
-    res.position = ra * p.cast<double>() + ta;
-    res.gradient = Eigen::Vector2d(gx, gy);
-    res.r = d;
-    res.from_b = from_b;
-    out.push_back(res);
+    const Eigen::Vector2d position = ra * p.cast<double>() + ta;
+    const Eigen::Vector2d g = turn * Eigen::Vector2d(gx, gy);
+    const Eigen::Vector3d j(g.x(), g.y(), position.x() * g.y() - position.y() * g.x());
+    const double w = d <= 1.0f ? 1.0 : 1.0 / d;  // Huber weights
+    const Eigen::Vector3d wj = w * j;
+    sums.h += wj * j.transpose();
+    sums.g += d * wj;
+    sums.position_sum += position;
+    ++sums.count;
   }
 }
 
@@ -69,32 +79,21 @@ LevelFit refine_at_level(const PreparedGrid& a, const PreparedGrid& b, const cor
   const GridLevel& lb = b.level(level);
   core::Transform2 t = to_level(b_to_a, la.factor);
   LevelFit fit;
-  std::vector<Residual> res;
   for (int it = 0; it <= options.iterations; ++it) {
-    res.clear();
     fit.inliers = fit.outliers = 0;
     const core::Transform2 inv = t.inverse();
-    collect(lb, la, t, core::Transform2::identity(), true, options.inlier_distance, res, fit.inliers, fit.outliers);
-    collect(la, lb, inv, t, false, options.inlier_distance, res, fit.inliers, fit.outliers);
-    if (it == options.iterations || res.size() < 3) break;
-    Eigen::Vector2d c = Eigen::Vector2d::Zero();
-    for (const auto& r : res) c += r.position;
-    c /= double(res.size());
-    // Update T <- L(delta) T, L(delta)(x) = R(dtheta) (x - c) + c + dt, linearised around 0.
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d g = Eigen::Vector3d::Zero();
+    Sums sums;
     const Eigen::Matrix2d rt = t.rotation_matrix().transpose();
-    for (const auto& r : res) {
-      const Eigen::Vector2d d = r.position - c;
-      Eigen::Matrix<double, 2, 3> m;
-      m << 1.0, 0.0, -d.y(), 0.0, 1.0, d.x();
-      // b's points move with the update; a's points move by the inverse, seen from b's frame.
-      const Eigen::RowVector3d j =
-          r.from_b ? Eigen::RowVector3d(r.gradient.transpose() * m) : Eigen::RowVector3d(-(r.gradient.transpose() * rt) * m);
-      const double w = r.r <= 1.0 ? 1.0 : 1.0 / r.r;  // Huber weights
-      h += w * j.transpose() * j;
-      g += w * j.transpose() * r.r;
-    }
+    collect(lb, la, t, core::Transform2::identity(), Eigen::Matrix2d::Identity(), options.inlier_distance, sums,
+            fit.inliers, fit.outliers);
+    collect(la, lb, inv, t, -rt.transpose(), options.inlier_distance, sums, fit.inliers, fit.outliers);
+    if (it == options.iterations || sums.count < 3) break;
+    const Eigen::Vector2d c = sums.position_sum / double(sums.count);
+    // Update T <- L(delta) T, L(delta)(x) = R(dtheta) (x - c) + c + dt, linearised around 0.
+    Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
+    a(2, 0) = c.y(), a(2, 1) = -c.x();
+    Eigen::Matrix3d h = a * sums.h * a.transpose();
+    const Eigen::Vector3d g = a * sums.g;
     // Marquardt damping, relative to each diagonal entry: the rotation entry grows with the
     // square of the map size, so a damping shared by all entries would stall the translation.
     h.diagonal() = h.diagonal() * (1.0 + 1e-3) + Eigen::Vector3d::Constant(1e-9);
