@@ -51,42 +51,27 @@ struct Peak {
 };
 
 // The `count` highest maxima of `s` (CV_32F), each suppressing a square of radius `radius` around
-// it: the highest positive value, then the highest outside the squares of those taken, and so on
-// (equal values in raster order). Taking them one after another needs only the values that are
-// taken or suppressed before the last is taken, at most count * ((2 radius + 1)^2 + 1) of the
-// highest: one pass keeps those (a search of the whole surface per maximum cost eight times more).
-std::vector<Peak> top_peaks(const cv::Mat& s, int count, int radius) {
+// it: the highest positive value (the first in raster order among equals), then the highest
+// outside the squares of those taken, and so on. The maximum of every row, kept up to date for the
+// rows a square covers, finds each in a few rows instead of a search of the whole surface.
+std::vector<Peak> top_peaks(cv::Mat s, int count, int radius) {
   std::vector<Peak> peaks;
-  if (count <= 0) return peaks;
-  const std::size_t side = std::size_t(2 * radius + 1), keep = std::size_t(count) * (side * side + 1);
-  struct Value {
-    float v;
-    int index;
-  };
-  // Higher first; equal values in raster order.
-  const auto before = [](const Value& x, const Value& y) { return x.v > y.v || (x.v == y.v && x.index < y.index); };
-  std::vector<Value> best;  // a heap whose top is the lowest kept value, once `keep` are kept
-  best.reserve(keep + 1);
-  for (int y = 0; y < s.rows; ++y) {
+  if (s.empty() || count <= 0) return peaks;
+  cv::Mat row_max;
+  cv::reduce(s, row_max, 1, cv::REDUCE_MAX);
+  std::vector<float> m(row_max.begin<float>(), row_max.end<float>());
+  for (int i = 0; i < count; ++i) {
+    const int y = int(std::max_element(m.begin(), m.end()) - m.begin());  // the first of equals
+    if (!(m[std::size_t(y)] > 0.0f)) break;
     const float* row = s.ptr<float>(y);
-    for (int x = 0; x < s.cols; ++x) {
-      // Kept values are positive; once `keep` are kept, a new one must beat the lowest.
-      if (!(row[x] > 0.0f) || (best.size() == keep && !(row[x] > best.front().v))) continue;
-      best.push_back({row[x], y * s.cols + x});
-      std::push_heap(best.begin(), best.end(), before);
-      if (best.size() > keep) {
-        std::pop_heap(best.begin(), best.end(), before);
-        best.pop_back();
-      }
+    const int x = int(std::find(row, row + s.cols, m[std::size_t(y)]) - row);
+    peaks.push_back({{x, y}, double(m[std::size_t(y)])});
+    const cv::Rect r = cv::Rect(x - radius, y - radius, 2 * radius + 1, 2 * radius + 1) & cv::Rect(0, 0, s.cols, s.rows);
+    s(r).setTo(-1e30);
+    for (int yy = r.y; yy < r.y + r.height; ++yy) {
+      const float* w = s.ptr<float>(yy);
+      m[std::size_t(yy)] = *std::max_element(w, w + s.cols);
     }
-  }
-  std::sort(best.begin(), best.end(), before);
-  for (const Value& c : best) {
-    const cv::Point at(c.index % s.cols, c.index / s.cols);
-    const auto suppressed = [&](const Peak& p) { return std::abs(p.at.x - at.x) <= radius && std::abs(p.at.y - at.y) <= radius; };
-    if (std::any_of(peaks.begin(), peaks.end(), suppressed)) continue;
-    peaks.push_back({at, double(c.v)});
-    if (int(peaks.size()) == count) break;
   }
   return peaks;
 }
