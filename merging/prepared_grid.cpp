@@ -83,8 +83,8 @@ int remove_specks(cv::Mat& occupied, int min_cells) {
       auto* o = occupied.ptr<std::uint8_t>(y);
       for (int x = 0; x < w; ++x) {
         if (!o[x]) continue;
-        cv::Point q(-2, -2), unused;
-        const int n = neighbours(x, y, q, q);
+        cv::Point q, unused;
+        const int n = neighbours(x, y, cv::Point(-2, -2), q);
         // A lone cell; or one of two neighbours (the other is cleared when the scan reaches it: it
         // has no occupied neighbour left).
         if (n == 0 || (n == 1 && min_cells == 3 && neighbours(q.x, q.y, {x, y}, unused) == 0)) o[x] = 0, ++removed;

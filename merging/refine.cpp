@@ -83,10 +83,10 @@ LevelFit refine_at_level(const PreparedGrid& a, const PreparedGrid& b, const cor
     fit.inliers = fit.outliers = 0;
     const core::Transform2 inv = t.inverse();
     Sums sums;
-    const Eigen::Matrix2d rt = t.rotation_matrix().transpose();
+    // b's points move with the update; a's by its inverse, their gradients turned into b's frame.
     collect(lb, la, t, core::Transform2::identity(), Eigen::Matrix2d::Identity(), options.inlier_distance, sums,
             fit.inliers, fit.outliers);
-    collect(la, lb, inv, t, -rt.transpose(), options.inlier_distance, sums, fit.inliers, fit.outliers);
+    collect(la, lb, inv, t, -t.rotation_matrix(), options.inlier_distance, sums, fit.inliers, fit.outliers);
     if (it == options.iterations || sums.count < 3) break;
     const Eigen::Vector2d c = sums.position_sum / double(sums.count);
     // Update T <- L(delta) T, L(delta)(x) = R(dtheta) (x - c) + c + dt, linearised around 0.
