@@ -57,20 +57,20 @@ struct Peak {
 std::vector<Peak> top_peaks(cv::Mat s, int count, int radius) {
   std::vector<Peak> peaks;
   if (s.empty() || count <= 0) return peaks;
-  cv::Mat row_max;
+  cv::Mat row_max;  // s.rows x 1
   cv::reduce(s, row_max, 1, cv::REDUCE_MAX);
-  std::vector<float> m(row_max.begin<float>(), row_max.end<float>());
+  float* m = row_max.ptr<float>();
   for (int i = 0; i < count; ++i) {
-    const int y = int(std::max_element(m.begin(), m.end()) - m.begin());  // the first of equals
-    if (!(m[std::size_t(y)] > 0.0f)) break;
+    const int y = int(std::max_element(m, m + s.rows) - m);  // the first of equals
+    if (!(m[y] > 0.0f)) break;
     const float* row = s.ptr<float>(y);
-    const int x = int(std::find(row, row + s.cols, m[std::size_t(y)]) - row);
-    peaks.push_back({{x, y}, double(m[std::size_t(y)])});
+    const int x = int(std::find(row, row + s.cols, m[y]) - row);
+    peaks.push_back({{x, y}, double(m[y])});
     const cv::Rect r = cv::Rect(x - radius, y - radius, 2 * radius + 1, 2 * radius + 1) & cv::Rect(0, 0, s.cols, s.rows);
     s(r).setTo(-1e30);
     for (int yy = r.y; yy < r.y + r.height; ++yy) {
       const float* w = s.ptr<float>(yy);
-      m[std::size_t(yy)] = *std::max_element(w, w + s.cols);
+      m[yy] = *std::max_element(w, w + s.cols);
     }
   }
   return peaks;

@@ -6,7 +6,9 @@
 #include <cmath>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "core/random.h"
 #include "merging/acceptance.h"
 #include "merging/grid_level.h"
 #include "tests/merging/merging_test_support.h"
@@ -80,35 +82,18 @@ TEST(PreparedGrid, SpecksAreTheSmallComponentsWhateverTheirShape) {
   // Random occupied cells, about one in six: components of every small shape, touching diagonally.
   const int w = 61, h = 47;
   std::vector<std::string> rows(std::size_t(h), std::string(std::size_t(w), '.'));
-  std::uint32_t state = 12345u;
-  for (auto& r : rows)
-    for (auto& c : r) {
-      state = state * 1664525u + 1013904223u;
-      if ((state >> 24) % 6 == 0) c = '#';
-    }
-  // Each component's size, by a flood fill of the text.
-  std::vector<int> label(std::size_t(w * h), -1), size;
+  core::Random random(12345);
+  cv::Mat occupied_text = cv::Mat::zeros(h, w, CV_8U);  // text rows, top first
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      if (rows[std::size_t(y)][std::size_t(x)] != '#' || label[std::size_t(y * w + x)] >= 0) continue;
-      const int id = int(size.size());
-      size.push_back(0);
-      std::vector<std::pair<int, int>> stack{{x, y}};
-      label[std::size_t(y * w + x)] = id;
-      while (!stack.empty()) {
-        const auto [cx, cy] = stack.back();
-        stack.pop_back();
-        ++size.back();
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = cx + dx, ny = cy + dy;
-            if (nx < 0 || ny < 0 || nx >= w || ny >= h || rows[std::size_t(ny)][std::size_t(nx)] != '#') continue;
-            if (label[std::size_t(ny * w + nx)] >= 0) continue;
-            label[std::size_t(ny * w + nx)] = id;
-            stack.push_back({nx, ny});
-          }
-      }
-    }
+    for (int x = 0; x < w; ++x)
+      if (random.bernoulli(1.0 / 6.0)) rows[std::size_t(y)][std::size_t(x)] = '#', occupied_text.at<std::uint8_t>(y, x) = 255;
+  // Each component's size, from OpenCV's statistics (the code under test labels without them).
+  cv::Mat labels, stats, centroids;
+  const int components = cv::connectedComponentsWithStats(occupied_text, labels, stats, centroids, 8, CV_32S);
+  std::vector<int> label(std::size_t(w * h), -1), size;
+  for (int i = 1; i < components; ++i) size.push_back(stats.at<int>(i, cv::CC_STAT_AREA));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) label[std::size_t(y * w + x)] = labels.at<int>(y, x) - 1;
   const auto g = grid_from_text(rows);
   for (const int min_cells : {1, 2, 3, 4, 6}) {
     PrepareOptions o;
