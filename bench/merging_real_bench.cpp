@@ -77,6 +77,9 @@ struct Args {
   int unrelated = 200;       // pairs of windows of different plans
   int large_pairs = 4;       // 4000 x 4000 pairs (time)
   int two_robots = 10;       // 300 x 300 pairs per overlap with a and b from two robots' maps of one plan
+  std::vector<std::string> real_maps;  // maps of the user's (real laser maps: PNG, PGM + YAML, or built-in names)
+  int real_pairs = 10;       // 300 x 300 pairs per real map and overlap
+  int real_unrelated = 100;  // pairs of windows of two different real maps (with two or more)
   std::vector<double> overlaps = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
   std::string method = "auto";
   double min_confidence = merging::MergeOptions{}.min_confidence;
@@ -90,6 +93,7 @@ struct Args {
 constexpr const char* kUsage =
     "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
     "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
+    "       [--real-maps MAP,...] [--real-pairs N] [--real-unrelated N]\n"
     "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
 
 [[noreturn]] void usage(const std::string& problem) {
@@ -134,6 +138,16 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--unrelated") a.unrelated = int(number(value()));
     else if (k == "--large-pairs") a.large_pairs = int(number(value()));
     else if (k == "--two-robots") a.two_robots = int(number(value()));
+    else if (k == "--real-maps") {
+      const std::string list = value();
+      for (std::size_t p = 0; p <= list.size();) {
+        const std::size_t q = std::min(list.find(',', p), list.size());
+        if (q > p) a.real_maps.push_back(list.substr(p, q - p));
+        p = q + 1;
+      }
+    }
+    else if (k == "--real-pairs") a.real_pairs = int(number(value()));
+    else if (k == "--real-unrelated") a.real_unrelated = int(number(value()));
     else if (k == "--method") a.method = value();
     else if (k == "--min-confidence") a.min_confidence = number(value());
     else if (k == "--no-peer") a.peer = false;
@@ -584,7 +598,7 @@ PeerResult orb_peer(const mapping::OccupancyGrid& a, const mapping::OccupancyGri
 // --- pairs and records --------------------------------------------------------------------
 
 struct Pair {
-  std::string set;       // "house300", "campus1000", "campus4000", "unrelated"
+  std::string set;       // "house300", "house300x2", "real300", "campus1000", "campus4000", "unrelated"
   std::string source;    // plan id(s)
   double overlap = 0.0;  // 0 for unrelated
   mapping::OccupancyGrid a, b;
@@ -902,6 +916,40 @@ int main(int argc, char** argv) {
         }
       }
     }
+    // Windows of the user's maps (--real-maps), as the house windows but without added clutter:
+    // real maps bring their own. Unrelated pairs: windows of two different ones.
+    {
+      std::vector<std::pair<std::string, mapping::OccupancyGrid>> real;
+      for (const auto& name : args.real_maps) real.emplace_back(fs::path(name).stem().string(), maps::load_map_source(name));
+      random = core::Random(args.seed + 5);
+      for (const auto& [name, map] : real) {
+        for (const double f : args.overlaps) {
+          crop.overlap = f;
+          for (int k = 0; k < args.real_pairs; ++k) {
+            try {
+              merging::CropPair c = merging::make_crop_pair(map, crop, random);
+              pairs.push_back(std::make_unique<Pair>(Pair{"real300", name, f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+            } catch (const Error&) {
+              std::cerr << fmt::format("--real-maps: {} has no 300 x 300 windows overlapping {}%\n", name, overlap_percent(f));
+              break;
+            }
+          }
+        }
+      }
+      merging::CropPairOptions one = crop;
+      one.overlap = 0.9;
+      for (int k = 0; real.size() >= 2 && k < args.real_unrelated; ++k) {
+        const std::size_t i = std::size_t(random.uniform_int(0, int(real.size()) - 1));
+        const std::size_t j = (i + std::size_t(random.uniform_int(1, int(real.size()) - 1))) % real.size();
+        try {
+          merging::CropPair ci = merging::make_crop_pair(real[i].second, one, random);
+          merging::CropPair cj = merging::make_crop_pair(real[j].second, one, random);
+          pairs.push_back(std::make_unique<Pair>(Pair{"unrelated", real[i].first + "/" + real[j].first, 0.0, std::move(ci.a),
+                                                      std::move(cj.b), std::nullopt, {}}));
+        } catch (const Error&) {
+        }
+      }
+    }
     // Campus windows.
     const mapping::OccupancyGrid campus = maps::load_map_source("campus");
     merging::CropPairOptions campus_crop = crop;
@@ -990,7 +1038,7 @@ int main(int argc, char** argv) {
       }
       return out;
     };
-    for (const std::string set : {"house300", "house300x2", "campus1000", "campus4000"}) {
+    for (const std::string set : {"house300", "house300x2", "real300", "campus1000", "campus4000"}) {
       std::vector<double> fs_;
       for (const auto& r : records)
         if (r.pair->set == set && std::find(fs_.begin(), fs_.end(), r.pair->overlap) == fs_.end()) fs_.push_back(r.pair->overlap);
@@ -1030,7 +1078,7 @@ int main(int argc, char** argv) {
     if (diag.is_open()) {
       const std::vector<std::string> classes = {"determinable", "rival-scores-higher", "rival-fits-as-well", "one-corner",
                                                 "one-room", "little-evidence", "disagreement"};
-      for (const std::string set : {"house300", "house300x2", "campus1000"}) {
+      for (const std::string set : {"house300", "house300x2", "real300", "campus1000"}) {
         std::vector<double> fs_;
         for (const auto& r : records)
           if (r.pair->set == set && std::find(fs_.begin(), fs_.end(), r.pair->overlap) == fs_.end()) fs_.push_back(r.pair->overlap);

@@ -40,7 +40,8 @@ namespace fleetmap::merging {
 //   (AlignmentQuality::constraint), each weighted by how much better than chance it fits:
 //   ln(chance_rms / residual_rms), where residual_rms is the RMS distance of the walls that land
 //   within the contradiction distance d of the other map's walls and chance_rms the same for walls
-//   placed by chance (uniform within d: d / sqrt(3)). Walls of identical maps coincide to a third
+//   placed by chance (uniform within d: d / sqrt(3)), and residual_rms at least 0.2 cells (closer
+//   is walls inside the other map's thick walls, not precision). Walls of identical maps coincide to a third
 //   of a cell (weight ~1.7); two robots' maps with drift to 0.6-1 cell (~1), and then need more
 //   walls in common; a chance fit of similar rooms lines walls up only roughly. So the bar rises
 //   with the maps' noise instead of being a constant;
