@@ -78,7 +78,8 @@ struct Args {
   int large_pairs = 4;       // 4000 x 4000 pairs (time)
   int two_robots = 10;       // 300 x 300 pairs per overlap with a and b from two robots' maps of one plan
   std::vector<std::string> real_maps;  // maps of the user's (real laser maps: PNG, PGM + YAML, or built-in names)
-  int real_pairs = 10;       // 300 x 300 pairs per real map and overlap
+  int real_pairs = 10;       // pairs per real map and overlap
+  int real_window = 300;     // their windows' side, cells
   int real_unrelated = 100;  // pairs of windows of two different real maps (with two or more)
   std::vector<double> overlaps = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
   std::string method = "auto";
@@ -93,7 +94,7 @@ struct Args {
 constexpr const char* kUsage =
     "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
     "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
-    "       [--real-maps MAP,...] [--real-pairs N] [--real-unrelated N]\n"
+    "       [--real-maps MAP,...] [--real-pairs N] [--real-window CELLS] [--real-unrelated N]\n"
     "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
 
 [[noreturn]] void usage(const std::string& problem) {
@@ -147,6 +148,11 @@ Args parse_args(int argc, char** argv) {
       }
     }
     else if (k == "--real-pairs") a.real_pairs = int(number(value()));
+    else if (k == "--real-window") {
+      const std::string v = value();
+      a.real_window = int(number(v));
+      if (a.real_window < 50) usage("--real-window: '" + v + "' is under 50 cells");
+    }
     else if (k == "--real-unrelated") a.real_unrelated = int(number(value()));
     else if (k == "--method") a.method = value();
     else if (k == "--min-confidence") a.min_confidence = number(value());
@@ -598,7 +604,7 @@ PeerResult orb_peer(const mapping::OccupancyGrid& a, const mapping::OccupancyGri
 // --- pairs and records --------------------------------------------------------------------
 
 struct Pair {
-  std::string set;       // "house300", "house300x2", "real300", "campus1000", "campus4000", "unrelated"
+  std::string set;       // "house300", "house300x2", "real300" (real_set), "campus1000", "campus4000", "unrelated"
   std::string source;    // plan id(s)
   double overlap = 0.0;  // 0 for unrelated
   mapping::OccupancyGrid a, b;
@@ -808,6 +814,9 @@ std::string summary(const std::vector<const Outcome*>& os) {
 
 int overlap_percent(double f) { return int(std::lround(100.0 * f)); }
 
+// The set of the windows of --real-maps: "real300" for 300 x 300 windows.
+std::string real_set(int window) { return "real" + std::to_string(window); }
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -922,21 +931,28 @@ int main(int argc, char** argv) {
       std::vector<std::pair<std::string, mapping::OccupancyGrid>> real;
       for (const auto& name : args.real_maps) real.emplace_back(fs::path(name).stem().string(), maps::load_map_source(name));
       random = core::Random(args.seed + 5);
+      merging::CropPairOptions window = crop;
+      window.width = window.height = args.real_window;
+      const std::string set = real_set(args.real_window);
       for (const auto& [name, map] : real) {
+        std::string missing;  // the overlaps this map has no windows for
         for (const double f : args.overlaps) {
-          crop.overlap = f;
+          window.overlap = f;
           for (int k = 0; k < args.real_pairs; ++k) {
             try {
-              merging::CropPair c = merging::make_crop_pair(map, crop, random);
-              pairs.push_back(std::make_unique<Pair>(Pair{"real300", name, f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+              merging::CropPair c = merging::make_crop_pair(map, window, random);
+              pairs.push_back(std::make_unique<Pair>(Pair{set, name, f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
             } catch (const Error&) {
-              std::cerr << fmt::format("--real-maps: {} has no 300 x 300 windows overlapping {}%\n", name, overlap_percent(f));
+              missing += fmt::format("{}{}%", missing.empty() ? "" : ", ", overlap_percent(f));
               break;
             }
           }
         }
+        if (!missing.empty())
+          std::cerr << fmt::format("--real-maps: {}: no {} x {} windows found at {} overlap (fewer pairs there)\n", name,
+                                   args.real_window, args.real_window, missing);
       }
-      merging::CropPairOptions one = crop;
+      merging::CropPairOptions one = window;
       one.overlap = 0.9;
       for (int k = 0; real.size() >= 2 && k < args.real_unrelated; ++k) {
         const std::size_t i = std::size_t(random.uniform_int(0, int(real.size()) - 1));
@@ -1038,7 +1054,7 @@ int main(int argc, char** argv) {
       }
       return out;
     };
-    for (const std::string set : {"house300", "house300x2", "real300", "campus1000", "campus4000"}) {
+    for (const std::string& set : std::vector<std::string>{"house300", "house300x2", real_set(args.real_window), "campus1000", "campus4000"}) {
       std::vector<double> fs_;
       for (const auto& r : records)
         if (r.pair->set == set && std::find(fs_.begin(), fs_.end(), r.pair->overlap) == fs_.end()) fs_.push_back(r.pair->overlap);
@@ -1078,7 +1094,7 @@ int main(int argc, char** argv) {
     if (diag.is_open()) {
       const std::vector<std::string> classes = {"determinable", "rival-scores-higher", "rival-fits-as-well", "one-corner",
                                                 "one-room", "little-evidence", "disagreement"};
-      for (const std::string set : {"house300", "house300x2", "real300", "campus1000"}) {
+      for (const std::string& set : std::vector<std::string>{"house300", "house300x2", real_set(args.real_window), "campus1000"}) {
         std::vector<double> fs_;
         for (const auto& r : records)
           if (r.pair->set == set && std::find(fs_.begin(), fs_.end(), r.pair->overlap) == fs_.end()) fs_.push_back(r.pair->overlap);
