@@ -28,6 +28,11 @@
 // 1.0 (its `estimation_confidence` default). Its rule that zeroes a confidence above 3 (images
 // too alike, from panorama stitching) is left out, in the peer's favour.
 //
+// --real-maps: windows of maps the user gives (real laser maps: map_server YAML, PGM, PNG), cut as
+// above but without added clutter (set "real300", or "realN" with --real-window N), and unrelated
+// pairs of windows of two of them. They are loaded first, and the HouseExpo maps only when a set of
+// house pairs is asked for.
+//
 // Times are the thread's CPU time per pair (alignment only; windows are cut outside the timing),
 // with OpenCV held to one thread.
 #include <fmt/format.h>
@@ -829,7 +834,11 @@ int main(int argc, char** argv) {
     options.min_confidence = args.min_confidence;
     merging::check_merge_method(options.method);
 
-    // The robot-built maps.
+    // The user's maps first: a wrong path is told before the long part.
+    std::vector<std::pair<std::string, mapping::OccupancyGrid>> real;
+    for (const auto& name : args.real_maps) real.emplace_back(fs::path(name).stem().string(), maps::load_map_source(name));
+
+    // The robot-built maps (only when a set of pairs needs them).
     std::vector<fs::path> plans;
     if (!fs::is_directory(args.plans)) usage("--plans: " + args.plans.string() + " is not a folder");
     for (const auto& e : fs::directory_iterator(args.plans))
@@ -846,7 +855,8 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
-    for (std::size_t i = 0; i < plans.size(); ++i) {
+    const bool houses = args.pairs > 0 || args.two_robots > 0 || args.unrelated > 0;
+    for (std::size_t i = 0; houses && i < plans.size(); ++i) {
       std::cerr << fmt::format("\rmaps: {}/{} {}      ", i + 1, plans.size(), plans[i].stem().string()) << std::flush;
       maps.push_back(build_plan_map(plans[i], int(i), 0, args.cache, args.furniture));
       if (args.two_robots > 0) second.push_back(build_plan_map(plans[i], int(i), 1, args.cache, args.furniture));
@@ -928,8 +938,6 @@ int main(int argc, char** argv) {
     // Windows of the user's maps (--real-maps), as the house windows but without added clutter:
     // real maps bring their own. Unrelated pairs: windows of two different ones.
     {
-      std::vector<std::pair<std::string, mapping::OccupancyGrid>> real;
-      for (const auto& name : args.real_maps) real.emplace_back(fs::path(name).stem().string(), maps::load_map_source(name));
       random = core::Random(args.seed + 5);
       merging::CropPairOptions window = crop;
       window.width = window.height = args.real_window;
@@ -1043,9 +1051,15 @@ int main(int argc, char** argv) {
     std::cerr << "\n";
 
     // Tables.
-    std::cout << "Maps: " << maps.size() << " robot-built HouseExpo maps"
-              << (args.furniture > 0.0 ? fmt::format(", furnished (a piece per {:g} m² of floor)", args.furniture) : std::string(", bare plans"))
-              << " (cache " << args.cache.string() << ")\n\n";
+    if (!maps.empty())
+      std::cout << "Maps: " << maps.size() << " robot-built HouseExpo maps"
+                << (args.furniture > 0.0 ? fmt::format(", furnished (a piece per {:g} m² of floor)", args.furniture) : std::string(", bare plans"))
+                << " (cache " << args.cache.string() << ")\n\n";
+    if (!real.empty()) {
+      std::cout << "Maps of --real-maps (" << args.real_window << " x " << args.real_window << " windows):";
+      for (std::size_t i = 0; i < real.size(); ++i) std::cout << (i ? ", " : " ") << real[i].first;
+      std::cout << "\n\n";
+    }
     const auto select = [&](const std::string& set, std::optional<double> f, bool peer) {
       std::vector<const Outcome*> out;
       for (const auto& r : records) {
@@ -1084,7 +1098,7 @@ int main(int argc, char** argv) {
       std::vector<double> tf, tp;
       for (const auto* o : fl) ff += o->merged, tf.push_back(o->cpu_s);
       for (const auto* o : pe) pf += o->merged, tp.push_back(o->cpu_s);
-      std::cout << fmt::format("### unrelated (windows of two different plans)\n\n| | pairs | false merges | median CPU |\n|---|---|---|---|\n"
+      std::cout << fmt::format("### unrelated (windows of two different plans or maps)\n\n| | pairs | false merges | median CPU |\n|---|---|---|---|\n"
                                "| peer (ORB) | {} | {} | {} |\n| fleetmap | {} | {} | {} |\n\n",
                                args.peer ? int(pe.size()) : 0, args.peer ? std::to_string(pf) : "-", ms(median(tp)),
                                fl.size(), ff, ms(median(tf)));
