@@ -263,8 +263,8 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   // A grid places a wall no closer than about a fifth of a cell: walls that land closer to the
   // other map's walls than that land inside its thick walls (distance 0 within an occupied band,
   // as real laser maps draw walls 2-3 cells thick), which says nothing more about the placement
-  // (seen on a real map: a corridor turned a half turn, slid 2.6 cells along a thick wall, RMS
-  // 0.001 cells, merged at confidence 0.54).
+  // (seen on a real map: a corridor placed 2.6 cells off along its thick walls fitted at RMS
+  // 0.001 cells and was merged at confidence 0.54).
   constexpr double kTightestRms = 0.2;
   // How many wall cells' worth pin a placement, each weighted by how much better than chance it
   // fits. A turned placement of one room is compared with the answer by this measure (below), not
