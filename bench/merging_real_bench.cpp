@@ -107,6 +107,17 @@ constexpr const char* kUsage =
   std::exit(2);
 }
 
+// The comma-separated items of an option's value ("a,b,c"), empty items left out.
+std::vector<std::string> split_list(const std::string& list) {
+  std::vector<std::string> items;
+  for (std::size_t p = 0; p <= list.size();) {
+    const std::size_t q = std::min(list.find(',', p), list.size());
+    if (q > p) items.push_back(list.substr(p, q - p));
+    p = q + 1;
+  }
+  return items;
+}
+
 Args parse_args(int argc, char** argv) {
   Args a;
   for (int i = 1; i < argc; ++i) {
@@ -132,26 +143,14 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--dump") a.dump = value();
     else if (k == "--diagnose") a.diagnose = value();
     else if (k == "--only") {
-      const std::string list = value();
-      for (std::size_t p = 0; p <= list.size();) {
-        const std::size_t q = std::min(list.find(',', p), list.size());
-        a.only.push_back(int(number(list.substr(p, q - p))));
-        p = q + 1;
-      }
+      for (const auto& item : split_list(value())) a.only.push_back(int(number(item)));
     }
     else if (k == "--pairs") a.pairs = int(number(value()));
     else if (k == "--campus-pairs") a.campus_pairs = int(number(value()));
     else if (k == "--unrelated") a.unrelated = int(number(value()));
     else if (k == "--large-pairs") a.large_pairs = int(number(value()));
     else if (k == "--two-robots") a.two_robots = int(number(value()));
-    else if (k == "--real-maps") {
-      const std::string list = value();
-      for (std::size_t p = 0; p <= list.size();) {
-        const std::size_t q = std::min(list.find(',', p), list.size());
-        if (q > p) a.real_maps.push_back(list.substr(p, q - p));
-        p = q + 1;
-      }
-    }
+    else if (k == "--real-maps") a.real_maps = split_list(value());
     else if (k == "--real-pairs") a.real_pairs = int(number(value()));
     else if (k == "--real-window") {
       const std::string v = value();
@@ -179,12 +178,7 @@ Args parse_args(int argc, char** argv) {
     }
     else if (k == "--overlaps") {
       a.overlaps.clear();
-      std::string list = value();
-      for (std::size_t p = 0; p <= list.size();) {
-        const std::size_t q = std::min(list.find(',', p), list.size());
-        a.overlaps.push_back(number(list.substr(p, q - p)));
-        p = q + 1;
-      }
+      for (const auto& item : split_list(value())) a.overlaps.push_back(number(item));
     } else usage("unknown option " + k);
   }
   return a;
@@ -839,12 +833,15 @@ int main(int argc, char** argv) {
     for (const auto& name : args.real_maps) real.emplace_back(fs::path(name).stem().string(), maps::load_map_source(name));
 
     // The robot-built maps (only when a set of pairs needs them).
+    const bool houses = args.pairs > 0 || args.two_robots > 0 || args.unrelated > 0;
     std::vector<fs::path> plans;
-    if (!fs::is_directory(args.plans)) usage("--plans: " + args.plans.string() + " is not a folder");
-    for (const auto& e : fs::directory_iterator(args.plans))
-      if (e.path().extension() == ".yaml") plans.push_back(e.path());
-    std::sort(plans.begin(), plans.end());
-    if (plans.size() < 2) usage("--plans: " + args.plans.string() + " holds fewer than two map_server YAML plans");
+    if (houses || args.build_parts > 0) {
+      if (!fs::is_directory(args.plans)) usage("--plans: " + args.plans.string() + " is not a folder");
+      for (const auto& e : fs::directory_iterator(args.plans))
+        if (e.path().extension() == ".yaml") plans.push_back(e.path());
+      std::sort(plans.begin(), plans.end());
+      if (plans.size() < 2) usage("--plans: " + args.plans.string() + " holds fewer than two map_server YAML plans");
+    }
     std::vector<PlanMap> maps, second;
     if (args.build_parts > 0) {
       // Only fill the cache (run N of these at once, K = 0 .. N-1, to use N cores).
@@ -855,7 +852,6 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
-    const bool houses = args.pairs > 0 || args.two_robots > 0 || args.unrelated > 0;
     for (std::size_t i = 0; houses && i < plans.size(); ++i) {
       std::cerr << fmt::format("\rmaps: {}/{} {}      ", i + 1, plans.size(), plans[i].stem().string()) << std::flush;
       maps.push_back(build_plan_map(plans[i], int(i), 0, args.cache, args.furniture));
