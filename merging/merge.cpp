@@ -44,6 +44,7 @@ bool same_answer(const core::Transform2& x, const core::Transform2& y, const Eig
 struct Candidate {
   Hypothesis hypothesis;
   LevelFit fit;
+  bool leader = false;  // its method's best proposal at its level (refine_candidates)
 };
 
 // Keeps the best-scoring of near-identical candidates, best first, at most `keep`, and also the
@@ -54,7 +55,8 @@ struct Candidate {
 // ranked below placements that fit almost nothing, and was dropped (seen in the simulator: two
 // robots' maps of a house, the right fit 254 walls in and 26 out at the search level, and the pair
 // merged with the room they shared turned a half turn). The full resolution judges it.
-void prune(std::vector<Candidate>& c, const PreparedGrid& b, const ConfidenceOptions& options, std::size_t keep) {
+void prune(std::vector<Candidate>& c, const PreparedGrid& b, const ConfidenceOptions& options, std::size_t keep,
+           bool keep_leaders) {
   std::sort(c.begin(), c.end(), [](const Candidate& x, const Candidate& y) { return x.fit.score > y.fit.score; });
   const Eigen::Vector2d centre_b((b.width() - 1) / 2.0, (b.height() - 1) / 2.0);
   std::size_t largest = c.size();
@@ -69,11 +71,16 @@ void prune(std::vector<Candidate>& c, const PreparedGrid& b, const ConfidenceOpt
       if (same_answer(x.fit.b_to_a, k.fit.b_to_a, centre_b, options)) return;
     kept.push_back(std::move(x));
   };
-  for (std::size_t i = 0; i < c.size() && kept.size() < keep; ++i) {
-    if (i == largest) largest = c.size();  // kept in turn (or a duplicate of a better one)
-    keep_unless_dup(c[i]);
+  std::size_t next = 0;
+  for (; next < c.size() && kept.size() < keep; ++next) {
+    if (next == largest) largest = c.size();  // kept in turn (or a duplicate of a better one)
+    keep_unless_dup(c[next]);
   }
   if (largest < c.size()) keep_unless_dup(c[largest]);
+  if (keep_leaders) {
+    for (std::size_t i = next; i < c.size(); ++i)
+      if (c[i].leader && i != largest) keep_unless_dup(c[i]);
+  }
   c = std::move(kept);
 }
 
@@ -112,17 +119,30 @@ std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGr
   const int top = std::min(a.level_count(), b.level_count()) - 1;
   int start = 0;
   for (const auto& h : candidates) start = std::max(start, std::min(h.level, top));
-  for (int k = start; k >= 0; --k) {
-    for (const auto& h : candidates) {
-      if (std::min(h.level, top) == k) active.push_back({h, LevelFit{h.b_to_a, 0, 0, 0.0}});
+  // Each method's best proposal at each level: what its own search ranks first.
+  std::vector<bool> leader(candidates.size(), false);
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    bool best = true;
+    for (std::size_t j = 0; j < candidates.size() && best; ++j) {
+      const auto &x = candidates[i], &y = candidates[j];
+      if (y.method == x.method && y.level == x.level && (y.score > x.score || (y.score == x.score && j < i))) best = false;
     }
-    // Many candidates enter at the top level; a few steps there are enough to rank them.
-    RefineOptions level_options = options.refinement;
-    if (k == start) level_options.iterations = std::min(level_options.iterations, options.first_level_iterations);
-    for (auto& c : active) c.fit = refine_at_level(a, b, c.fit.b_to_a, k, level_options);
-    // Those few steps rank them roughly: more go on from there than from the finer levels.
+    leader[i] = best;
+  }
+  for (int k = start; k >= 0; --k) {
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      const auto& h = candidates[i];
+      if (std::min(h.level, top) == k) active.push_back({h, LevelFit{h.b_to_a, 0, 0, 0.0}, leader[i]});
+    }
+    // Many candidates enter at the top level; on coarse cells a few steps there are enough to rank
+    // them roughly, and more go on from there than from the finer levels. On cells of one or two
+    // fine cells a candidate is several cells off and takes all the steps (seen on the benchmark: a
+    // house pair searched on cells of 2 x 2 merged 2.6 cells off after four steps, right after ten).
     const bool rough = k == start && k >= 2;
-    prune(active, b, options.confidence, std::size_t(rough ? options.coarse_candidates : options.fine_candidates));
+    RefineOptions level_options = options.refinement;
+    if (rough) level_options.iterations = std::min(level_options.iterations, options.first_level_iterations);
+    for (auto& c : active) c.fit = refine_at_level(a, b, c.fit.b_to_a, k, level_options);
+    prune(active, b, options.confidence, std::size_t(rough ? options.coarse_candidates : options.fine_candidates), rough);
   }
   return active;
 }

@@ -492,5 +492,41 @@ TEST(AlignMaps, WallsFittingCloserThanAFifthOfACellWeighAsAFifth) {
   EXPECT_NEAR(r.evidence, r.quality.constraint * std::log(chance_rms / 0.2), 1e-9 * r.evidence);
 }
 
+// A method's best proposal is refined to full resolution whatever a few steps at the coarse level
+// where it enters make of it: those steps rank candidates roughly, and only a few go on (seen on a
+// real laser map: the right candidate, the rotation sweep's first, ranked 33rd-40th of 73 at 8 x 8
+// cells, 8 went on, and the pair was refused). Here the truth enters a few cells and degrees off,
+// where its walls cross a's free space, behind another method's ten placements that lay b beside a.
+TEST(AlignMaps, AMethodsBestProposalGoesOnWhateverTheCoarseRanking) {
+  const CropPair pair = furnished_half_overlap_pair();
+  const PreparedGrid a(pair.a), b(pair.b);
+  MergeOptions options;
+  options.first_level_iterations = 0;  // the entry level ranks the candidates as they come
+  const int entry = std::min(a.level_count(), b.level_count()) - 1;
+  ASSERT_GE(entry, 2);  // a coarse level, where few go on (MergeOptions::coarse_candidates)
+  const core::Transform2 off(pair.b_to_a.translation() + Eigen::Vector2d(16.0, 8.0),
+                             pair.b_to_a.rotation() + core::deg2rad(3.0));
+  std::vector<Hypothesis> candidates;
+  for (int i = 0; i < 10; ++i) {
+    candidates.push_back({core::Transform2(a.width() + 20.0 + 40.0 * i, 0.0, 0.0), 10.0 - i, entry, "beside"});
+  }
+  candidates.push_back({off, 1.0, entry, "truth"});
+  ASSERT_GT(int(candidates.size()) - 1, options.coarse_candidates);
+  const LevelFit at_entry = refine_at_level(a, b, off, entry, [&] {
+    RefineOptions r = options.refinement;
+    r.iterations = 0;
+    return r;
+  }());
+  // Below the placements beside a (score 0), and not agreeing as a merged answer's walls must.
+  ASSERT_LT(at_entry.score, 0.0);
+  ASSERT_LT(at_entry.inliers, options.confidence.zero_agreement * (at_entry.inliers + at_entry.outliers));
+  const MergeResult r = decide(a, b, candidates, options);
+  ASSERT_TRUE(r.merged) << r.reason;
+  EXPECT_EQ(r.method, "truth");
+  const TransformError e = transform_error(r.transform, pair.b_to_a, pair.overlap_centre_b);
+  EXPECT_LT(e.rotation_deg, kMaxRotationDeg);
+  EXPECT_LT(e.translation_cells, kMaxTranslationCells);
+}
+
 }  // namespace
 }  // namespace fleetmap::merging
