@@ -11,10 +11,10 @@
 namespace fleetmap::merging {
 
 struct OverlapSearchOptions {
-  // The translation search runs on the finest level whose larger side is at most this. On real laser
-  // maps cells of 0.8 m lose the right translation (1000 x 1000-cell windows of 5 cm maps, searched
-  // on 63 x 63 cells: the right placement below the eighth maximum at the right rotation); on cells
-  // of 0.4 m (125 x 125) it was the first (bench/README.md, "Merging robot-built maps").
+  // The translation search runs on the finest level whose larger side is at most this. On 1000 x
+  // 1000-cell windows of real 5 cm laser maps, searched on 63 x 63 cells of 0.8 m, the right
+  // placement was below the eighth maximum at the right rotation; on 125 x 125 cells of 0.4 m it was
+  // the first (bench/README.md, "Large real maps searched on finer cells").
   int search_cells = 128;
   // ... but never on cells larger than this (metres, from the grid's resolution): rooms and doors
   // must stay a few cells wide, however large the map.
