@@ -233,8 +233,25 @@ Placements other_placements(const PreparedGrid& a, const PreparedGrid& b, const 
 
 }  // namespace
 
+namespace {
+
+// Options that would leave no candidate to decide on, or search nothing.
+void check_search_options(const MergeOptions& options) {
+  const auto at_least = [](const char* name, double value, double least) {
+    if (!(value >= least)) throw InputError(fmt::format("merge options: {} must be at least {} (got {})", name, least, value));
+  };
+  at_least("coarse_candidates", options.coarse_candidates, 1);
+  at_least("fine_candidates", options.fine_candidates, 1);
+  at_least("first_level_iterations", options.first_level_iterations, 0);
+  at_least("overlap.search_cells", options.overlap.search_cells, 1);
+  at_least("sweep_search_cells", options.sweep_search_cells, 1);
+}
+
+}  // namespace
+
 MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vector<Hypothesis>& candidates,
                    const MergeOptions& options) {
+  check_search_options(options);
   MergeResult result;
   result.candidates = int(candidates.size());
   if (candidates.empty()) {
@@ -428,6 +445,7 @@ PrepareOptions prepare_options(const MergeOptions& options) {
 
 MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const MergeOptions& options) {
   check_merge_method(options.method);
+  check_search_options(options);
   const double needed = needed_wall_distance(options);
   if (a.max_wall_distance() < needed || b.max_wall_distance() < needed)
     throw InputError(fmt::format("merge options: the maps were prepared with max_wall_distance {} cells, the "

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <optional>
 #include <tuple>
 
@@ -526,6 +527,24 @@ TEST(AlignMaps, AMethodsBestProposalGoesOnWhateverTheCoarseRanking) {
   const TransformError e = transform_error(r.transform, pair.b_to_a, pair.overlap_centre_b);
   EXPECT_LT(e.rotation_deg, kMaxRotationDeg);
   EXPECT_LT(e.translation_cells, kMaxTranslationCells);
+}
+
+// Options that would leave no candidate to decide on are an input error naming the option, not a
+// crash on an empty list.
+TEST(AlignMaps, OptionsKeepingNoCandidateAreAnInputErrorNamingThem) {
+  const auto office = testing::source_map("office");
+  for (const auto& [set, name] : std::vector<std::pair<std::function<void(MergeOptions&)>, std::string>>{
+           {[](MergeOptions& o) { o.fine_candidates = 0; }, "fine_candidates"},
+           {[](MergeOptions& o) { o.coarse_candidates = -1; }, "coarse_candidates"},
+           {[](MergeOptions& o) { o.first_level_iterations = -2; }, "first_level_iterations"},
+           {[](MergeOptions& o) { o.overlap.search_cells = 0; }, "overlap.search_cells"}}) {
+    MergeOptions options;
+    set(options);
+    fleetmap::testing::expect_input_error([&] { align_maps(office, office, options); }, {"merge options", name});
+    const PreparedGrid a(office, prepare_options(options));
+    fleetmap::testing::expect_input_error([&] { decide(a, a, {{core::Transform2::identity(), 1.0, 0, "x"}}, options); },
+                                          {name});
+  }
 }
 
 }  // namespace
