@@ -56,6 +56,7 @@
 
 #include "core/angle.h"
 #include "core/error.h"
+#include "core/format.h"
 #include "core/random.h"
 #include "maps/builtin_maps.h"
 #include "io/map_io.h"
@@ -107,17 +108,6 @@ constexpr const char* kUsage =
   std::exit(2);
 }
 
-// The comma-separated items of an option's value ("a,b,c"), empty items left out.
-std::vector<std::string> split_list(const std::string& list) {
-  std::vector<std::string> items;
-  for (std::size_t p = 0; p <= list.size();) {
-    const std::size_t q = std::min(list.find(',', p), list.size());
-    if (q > p) items.push_back(list.substr(p, q - p));
-    p = q + 1;
-  }
-  return items;
-}
-
 Args parse_args(int argc, char** argv) {
   Args a;
   for (int i = 1; i < argc; ++i) {
@@ -129,6 +119,14 @@ Args parse_args(int argc, char** argv) {
     const auto value = [&]() -> std::string {
       if (i + 1 >= argc) usage(k + " needs a value");
       return argv[++i];
+    };
+    // The comma-separated items of the value ("a,b,c").
+    const auto list = [&]() -> std::vector<std::string> {
+      try {
+        return core::split_list(value(), k);
+      } catch (const InputError& e) {
+        usage(e.what());
+      }
     };
     const auto number = [&](const std::string& v) {
       try {
@@ -143,14 +141,14 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--dump") a.dump = value();
     else if (k == "--diagnose") a.diagnose = value();
     else if (k == "--only") {
-      for (const auto& item : split_list(value())) a.only.push_back(int(number(item)));
+      for (const auto& item : list()) a.only.push_back(int(number(item)));
     }
     else if (k == "--pairs") a.pairs = int(number(value()));
     else if (k == "--campus-pairs") a.campus_pairs = int(number(value()));
     else if (k == "--unrelated") a.unrelated = int(number(value()));
     else if (k == "--large-pairs") a.large_pairs = int(number(value()));
     else if (k == "--two-robots") a.two_robots = int(number(value()));
-    else if (k == "--real-maps") a.real_maps = split_list(value());
+    else if (k == "--real-maps") a.real_maps = list();
     else if (k == "--real-pairs") a.real_pairs = int(number(value()));
     else if (k == "--real-window") {
       const std::string v = value();
@@ -178,7 +176,7 @@ Args parse_args(int argc, char** argv) {
     }
     else if (k == "--overlaps") {
       a.overlaps.clear();
-      for (const auto& item : split_list(value())) a.overlaps.push_back(number(item));
+      for (const auto& item : list()) a.overlaps.push_back(number(item));
     } else usage("unknown option " + k);
   }
   return a;

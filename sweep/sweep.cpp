@@ -20,28 +20,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
-// Comma-separated items, trimmed; an empty item is an error.
-std::vector<std::string> split_list(const std::string& text, const std::string& what) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = text.find(',', start);
-    const std::string item = trim(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (item.empty()) throw InputError(what + ": empty item in the list '" + text + "'");
-    out.push_back(item);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
 using core::join;
+using core::split_list;
+using core::trim;
 
 template <typename T>
 void check_unique(const std::vector<T>& items, const std::string& what) {
