@@ -119,16 +119,18 @@ std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGr
   const int top = std::min(a.level_count(), b.level_count()) - 1;
   int start = 0;
   for (const auto& h : candidates) start = std::max(start, std::min(h.level, top));
-  // Each method's best proposal at each level: what its own search ranks first.
-  std::vector<bool> leader(candidates.size(), false);
+  // Each method's best proposal at each level (the first of equals): what its own search ranks first.
+  std::vector<std::size_t> best;  // one index per (method, level)
   for (std::size_t i = 0; i < candidates.size(); ++i) {
-    bool best = true;
-    for (std::size_t j = 0; j < candidates.size() && best; ++j) {
-      const auto &x = candidates[i], &y = candidates[j];
-      if (y.method == x.method && y.level == x.level && (y.score > x.score || (y.score == x.score && j < i))) best = false;
-    }
-    leader[i] = best;
+    const Hypothesis& h = candidates[i];
+    const auto group = std::find_if(best.begin(), best.end(), [&](std::size_t j) {
+      return candidates[j].level == h.level && candidates[j].method == h.method;
+    });
+    if (group == best.end()) best.push_back(i);
+    else if (h.score > candidates[*group].score) *group = i;
   }
+  std::vector<bool> leader(candidates.size(), false);
+  for (std::size_t i : best) leader[i] = true;
   for (int k = start; k >= 0; --k) {
     for (std::size_t i = 0; i < candidates.size(); ++i) {
       const auto& h = candidates[i];
@@ -230,10 +232,6 @@ Placements other_placements(const PreparedGrid& a, const PreparedGrid& b, const 
     known.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, fit_only), c.fit.b_to_a);
   return known;
 }
-
-}  // namespace
-
-namespace {
 
 // Options that would leave no candidate to decide on, or search nothing.
 void check_search_options(const MergeOptions& options) {
