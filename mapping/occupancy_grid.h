@@ -98,6 +98,9 @@ class OccupancyGrid {
   float miss_log_odds() const { return miss_log_odds_; }
   float min_log_odds() const { return min_log_odds_; }
   float max_log_odds() const { return max_log_odds_; }
+  // The state thresholds: Occupied above the first, Free below the second (state_at).
+  float occupied_log_odds() const { return occupied_log_odds_; }
+  float free_log_odds() const { return free_log_odds_; }
 
   // Same geometry and the same state in every cell (log-odds may differ).
   bool same_states(const OccupancyGrid& other) const;

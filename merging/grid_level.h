@@ -47,9 +47,36 @@ struct GridLevel {
   bool known(int x, int y) const { return occupied.at<std::uint8_t>(y, x) != 0 || free.at<std::uint8_t>(y, x) != 0; }
   bool is_free(int x, int y) const { return free.at<std::uint8_t>(y, x) != 0; }
   // Bilinear wall distance at a continuous cell position; `outside` beyond the level's edges.
-  float distance_at(float x, float y, float outside) const;
+  // (Inline, like the two below: they are on the refinement's and the scores' per-point paths.)
+  float distance_at(float x, float y, float outside) const {
+    if (!(x >= 0.0f && y >= 0.0f && x <= float(width() - 1) && y <= float(height() - 1))) return outside;
+    const Patch q = patch(x, y);
+    return (1 - q.fy) * ((1 - q.fx) * q.a + q.fx * q.b) + q.fy * ((1 - q.fx) * q.c + q.fx * q.d);
+  }
   // The same with the gradient of the bilinear patch (0 beyond the edges).
-  float distance_gradient_at(float x, float y, float outside, float& gx, float& gy) const;
+  float distance_gradient_at(float x, float y, float outside, float& gx, float& gy) const {
+    gx = gy = 0.0f;
+    if (!(x >= 0.0f && y >= 0.0f && x <= float(width() - 1) && y <= float(height() - 1))) return outside;
+    const Patch q = patch(x, y);
+    gx = (1 - q.fy) * (q.b - q.a) + q.fy * (q.d - q.c);
+    gy = (1 - q.fx) * (q.c - q.a) + q.fx * (q.d - q.b);
+    return (1 - q.fy) * ((1 - q.fx) * q.a + q.fx * q.b) + q.fy * ((1 - q.fx) * q.c + q.fx * q.d);
+  }
+
+ private:
+  // The four distances around a position inside the level, a = (x0, y0), b = (x0 + 1, y0),
+  // c = (x0, y0 + 1), d = (x0 + 1, y0 + 1), and the position's offsets from (x0, y0).
+  struct Patch {
+    float a, b, c, d, fx, fy;
+  };
+  Patch patch(float x, float y) const {
+    const int x0 = std::min(int(x), std::max(0, width() - 2));
+    const int y0 = std::min(int(y), std::max(0, height() - 2));
+    const int x1 = std::min(x0 + 1, width() - 1), y1 = std::min(y0 + 1, height() - 1);
+    const float* r0 = wall_distance.ptr<float>(y0);
+    const float* r1 = wall_distance.ptr<float>(y1);
+    return {r0[x0], r0[x1], r1[x0], r1[x1], x - float(x0), y - float(y0)};
+  }
 };
 
 // The nearest cell to a continuous coordinate, or -1 when it lies before the first cell.

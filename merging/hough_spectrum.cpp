@@ -19,14 +19,17 @@ std::vector<double> hough_spectrum(const std::vector<Eigen::Vector2f>& points, i
   // The points relative to their centre, once (not once per angle).
   std::vector<float> dx(points.size()), dy(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) dx[i] = points[i].x() - c.x(), dy[i] = points[i].y() - c.y();
+  std::vector<int> bin(points.size());
   for (int j = 0; j < bins; ++j) {
     const double theta = j * std::numbers::pi / bins;
     const float cs = float(std::cos(theta)), sn = float(std::sin(theta));
-    std::fill(h.begin(), h.end(), 0);
+    // The bins first, then the votes: the first loop is vectorized, the second cannot be.
     for (std::size_t i = 0; i < points.size(); ++i) {
       const float rho = dx[i] * cs + dy[i] * sn;
-      ++h[std::size_t(int(rho + float(offset) + 0.5f))];
+      bin[i] = int(rho + float(offset) + 0.5f);
     }
+    std::fill(h.begin(), h.end(), 0);
+    for (int k : bin) ++h[std::size_t(k)];
     double s = 0.0;
     for (int v : h) s += double(v) * double(v);
     hs[std::size_t(j)] = s;

@@ -481,21 +481,20 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
 }
 
 KnownPart::KnownPart(const mapping::OccupancyGrid& grid, int margin) : full_(&grid) {
-  int x0 = grid.width(), y0 = grid.height(), x1 = -1, y1 = -1;
+  if (grid.width() <= 0 || grid.height() <= 0) return;
+  // Known cells (grid.state_at not Unknown), written for the compiler to vectorize.
+  cv::Mat known(grid.height(), grid.width(), CV_8U);
+  const float occupied_above = grid.occupied_log_odds(), free_below = grid.free_log_odds();
+  const int width = grid.width();  // a local: the stores below might alias grid's members
   for (int y = 0; y < grid.height(); ++y) {
-    const int row = y * grid.width();
-    int first = -1, last = -1;
-    for (int x = 0; x < grid.width(); ++x) {
-      if (grid.state_at(row + x) == mapping::CellState::Unknown) continue;
-      if (first < 0) first = x;
-      last = x;
-    }
-    if (first < 0) continue;
-    x0 = std::min(x0, first), x1 = std::max(x1, last), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    auto* k = known.ptr<std::uint8_t>(y);
+    const float* l = grid.log_odds_data().data() + std::size_t(y) * std::size_t(width);
+    for (int x = 0; x < width; ++x) k[x] = (l[x] > occupied_above) | (l[x] < free_below) ? 255 : 0;
   }
-  if (x1 < 0) return;  // nothing known: keep the map as it is
-  x0 = std::max(0, x0 - margin), y0 = std::max(0, y0 - margin);
-  x1 = std::min(grid.width() - 1, x1 + margin), y1 = std::min(grid.height() - 1, y1 + margin);
+  const cv::Rect box = cv::boundingRect(known);  // of the nonzero cells
+  if (box.empty()) return;                        // nothing known: keep the map as it is
+  const int x0 = std::max(0, box.x - margin), y0 = std::max(0, box.y - margin);
+  const int x1 = std::min(grid.width() - 1, box.br().x - 1 + margin), y1 = std::min(grid.height() - 1, box.br().y - 1 + margin);
   // Copying costs more than it saves unless the cut is clearly smaller.
   if (double(x1 - x0 + 1) * double(y1 - y0 + 1) > 0.8 * double(grid.width()) * double(grid.height())) return;
   origin_ = Eigen::Vector2i(x0, y0);

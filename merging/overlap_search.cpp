@@ -1,6 +1,7 @@
 #include "merging/overlap_search.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <numbers>
 #include <opencv2/core.hpp>
@@ -155,7 +156,11 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
   // share b's three transforms (the spectral candidates come in such pairs, and so do the probes'
   // quarter turns).
   std::vector<bool> done(rotations.size(), false);
-  cv::Mat turned_band, turned_occupied, turned_clear, f_band, f_occupied, f_clear, product, product2, s, shifted;
+  // b turned is drawn straight into the top-left d x d corner of one zero canvas of the transform's
+  // size (the rest stays zero), and transformed from there.
+  cv::Mat canvas = cv::Mat::zeros(size, CV_32F);
+  cv::Mat turned = canvas(cv::Rect(0, 0, d, d));
+  cv::Mat f_band, f_occupied, f_clear, product, product2, s, shifted;
   const auto combine = [&](bool conjugate) {
     cv::mulSpectrums(g_band, f_band, product, 0, conjugate);
     cv::mulSpectrums(g_clear, f_occupied, product2, 0, conjugate);
@@ -171,12 +176,14 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
     const Eigen::Vector2d shift = centre_canvas - rot.apply(centre_b);
     const Eigen::Matrix2d r = rot.rotation_matrix();
     const cv::Mat m = (cv::Mat_<double>(2, 3) << r(0, 0), r(0, 1), shift.x(), r(1, 0), r(1, 1), shift.y());
-    cv::warpAffine(band_b, turned_band, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-    cv::warpAffine(occupied_b, turned_occupied, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-    cv::warpAffine(clear_b, turned_clear, m, cv::Size(d, d), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-    f_band = padded_dft(turned_band, size);
-    f_occupied = padded_dft(turned_occupied, size);
-    f_clear = padded_dft(turned_clear, size);
+    const auto turned_dft = [&](const cv::Mat& image, cv::Mat& spectrum) {
+      cv::warpAffine(image, turned, m, turned.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+      assert(turned.data == canvas.data);  // drawn in place (same size and type), not reallocated
+      cv::dft(canvas, spectrum, 0, d);  // rows past d are zero
+    };
+    turned_dft(band_b, f_band);
+    turned_dft(occupied_b, f_occupied);
+    turned_dft(clear_b, f_clear);
     // S(t) = sum_q band_b(q) band_a_near(q + t)
     //        - w sum_q [occupied_b(q) clear_a(q + t) + clear_b(q) occupied_a(q + t)], all t at once.
     combine(true);

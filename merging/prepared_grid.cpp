@@ -255,32 +255,6 @@ void finish_level(GridLevel& level, const PrepareOptions& options, std::vector<c
 
 }  // namespace
 
-float GridLevel::distance_at(float x, float y, float outside) const {
-  if (!(x >= 0.0f && y >= 0.0f && x <= float(width() - 1) && y <= float(height() - 1))) return outside;
-  const int x0 = std::min(int(x), std::max(0, width() - 2));
-  const int y0 = std::min(int(y), std::max(0, height() - 2));
-  const int x1 = std::min(x0 + 1, width() - 1), y1 = std::min(y0 + 1, height() - 1);
-  const float fx = x - float(x0), fy = y - float(y0);
-  const float* r0 = wall_distance.ptr<float>(y0);
-  const float* r1 = wall_distance.ptr<float>(y1);
-  return (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x1]);
-}
-
-float GridLevel::distance_gradient_at(float x, float y, float outside, float& gx, float& gy) const {
-  gx = gy = 0.0f;
-  if (!(x >= 0.0f && y >= 0.0f && x <= float(width() - 1) && y <= float(height() - 1))) return outside;
-  const int x0 = std::min(int(x), std::max(0, width() - 2));
-  const int y0 = std::min(int(y), std::max(0, height() - 2));
-  const int x1 = std::min(x0 + 1, width() - 1), y1 = std::min(y0 + 1, height() - 1);
-  const float fx = x - float(x0), fy = y - float(y0);
-  const float* r0 = wall_distance.ptr<float>(y0);
-  const float* r1 = wall_distance.ptr<float>(y1);
-  const float a = r0[x0], b = r0[x1], c = r1[x0], d = r1[x1];
-  gx = (1 - fy) * (b - a) + fy * (d - c);
-  gy = (1 - fx) * (c - a) + fx * (d - b);
-  return (1 - fy) * ((1 - fx) * a + fx * b) + fy * ((1 - fx) * c + fx * d);
-}
-
 PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOptions& options)
     : grid_(&grid), max_wall_distance_(options.max_wall_distance) {
   if (!(options.max_wall_distance >= 1.0 && options.max_wall_distance <= 1000.0))
@@ -289,18 +263,19 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
   base.factor = 1;
   base.occupied = cv::Mat::zeros(std::max(grid.height(), 1), std::max(grid.width(), 1), CV_8U);
   base.free = cv::Mat::zeros(base.occupied.size(), CV_8U);
+  // grid.state_at, written for the compiler to vectorize (a million cells per map).
+  const float occupied_above = grid.occupied_log_odds(), free_below = grid.free_log_odds();
+  const int width = grid.width();  // a local: the stores below might alias grid's members
   for (int y = 0; y < grid.height(); ++y) {
     auto* o = base.occupied.ptr<std::uint8_t>(y);
     auto* f = base.free.ptr<std::uint8_t>(y);
-    const int row = y * grid.width();
-    for (int x = 0; x < grid.width(); ++x) {
-      switch (grid.state_at(row + x)) {
-        case mapping::CellState::Occupied: o[x] = 255; ++known_cells_; break;
-        case mapping::CellState::Free: f[x] = 255; ++known_cells_; break;
-        case mapping::CellState::Unknown: break;
-      }
+    const float* l = grid.log_odds_data().data() + std::size_t(y) * std::size_t(width);
+    for (int x = 0; x < width; ++x) {
+      o[x] = l[x] > occupied_above ? 255 : 0;
+      f[x] = l[x] < free_below ? 255 : 0;
     }
   }
+  known_cells_ = cv::countNonZero(base.occupied) + cv::countNonZero(base.free);
   known_cells_ -= remove_specks(base.occupied, options.min_obstacle_cells);
   const double resolution = grid.resolution() > 0.0 ? grid.resolution() : 0.05;
   // Gaps of two cells at least: a thin wall turned and resampled on another grid breaks every few cells.

@@ -33,26 +33,34 @@ void collect(const GridLevel& from, const GridLevel& to, const core::Transform2&
   const Eigen::Matrix2d ra = to_a.rotation_matrix();
   const Eigen::Vector2d ta = to_a.translation();
   constexpr float kFar = 1e4f;
+  // Locals, not the references: the compiler keeps them in registers (the same additions in the
+  // same order).
+  Sums s = sums;
+  int in = 0, out = 0;
+  const int width = to.width(), height = to.height();
   for (std::size_t i = 0; i < from.wall_points.size(); ++i) {
     const Eigen::Vector2f p = r * from.wall_points[i] + tr;
     const int x = nearest_cell(p.x()), y = nearest_cell(p.y());
-    if (x < 0 || y < 0 || x >= to.width() || y >= to.height() || !to.known(x, y)) continue;
+    if (x < 0 || y < 0 || x >= width || y >= height || !to.known(x, y)) continue;
     float gx = 0.0f, gy = 0.0f;
     const float d = to.distance_gradient_at(p.x(), p.y(), kFar, gx, gy);
-    if (d >= 2.5f && !from.wall_clutter[i] && to.is_free(x, y)) ++outliers;
+    if (d >= 2.5f && !from.wall_clutter[i] && to.is_free(x, y)) ++out;
     // A wall of the other map seen from the other side attracts nothing.
     if (d > cutoff || !seen_from_same_side(to, p, r * from.wall_normals[i])) continue;
-    if (d <= 1.0f) ++inliers;
+    if (d <= 1.0f) ++in;
     const Eigen::Vector2d position = ra * p.cast<double>() + ta;
     const Eigen::Vector2d g = turn * Eigen::Vector2d(gx, gy);
     const Eigen::Vector3d j(g.x(), g.y(), position.x() * g.y() - position.y() * g.x());
     const double w = d <= 1.0f ? 1.0 : 1.0 / d;  // Huber weights
     const Eigen::Vector3d wj = w * j;
-    sums.h += wj * j.transpose();
-    sums.g += d * wj;
-    sums.position_sum += position;
-    ++sums.count;
+    s.h += wj * j.transpose();
+    s.g += d * wj;
+    s.position_sum += position;
+    ++s.count;
   }
+  sums = s;
+  inliers += in;
+  outliers += out;
 }
 
 // Interior points of `from` (inside filled obstacles) moved by t onto `to`'s clear free space.

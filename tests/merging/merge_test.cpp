@@ -547,5 +547,36 @@ TEST(AlignMaps, OptionsKeepingNoCandidateAreAnInputErrorNamingThem) {
   }
 }
 
+// The search pays for the map's size, so a robot's map allocated far larger than what it saw is cut
+// to its known cells; a map with nothing known, or known nearly everywhere, is kept whole.
+TEST(KnownPart, CutsAMapToTheBoxOfItsKnownCellsWithTheMargin) {
+  mapping::OccupancyGrid grid(core::GridGeometry(0.05, 100, 80));
+  const KnownPart nothing(grid);
+  EXPECT_EQ(&nothing.grid(), &grid);
+  EXPECT_EQ(nothing.origin(), Eigen::Vector2i::Zero());
+
+  grid.set_state({30, 20}, mapping::CellState::Free);
+  grid.set_state({41, 25}, mapping::CellState::Occupied);
+  grid.set_state({35, 33}, mapping::CellState::Free);
+  const KnownPart part(grid, 2);
+  EXPECT_EQ(part.origin(), Eigen::Vector2i(28, 18));
+  EXPECT_EQ(part.grid().width(), 41 - 30 + 1 + 4);
+  EXPECT_EQ(part.grid().height(), 33 - 20 + 1 + 4);
+  EXPECT_EQ(part.grid().state({41 - 28, 25 - 18}), mapping::CellState::Occupied);
+  EXPECT_EQ(part.grid().state({35 - 28, 33 - 18}), mapping::CellState::Free);
+  EXPECT_EQ(part.grid().count(mapping::CellState::Free) + part.grid().count(mapping::CellState::Occupied), 3);
+
+  // The margin stops at the map's edges.
+  grid.set_state({0, 79}, mapping::CellState::Free);
+  const KnownPart corner(grid, 2);
+  EXPECT_EQ(corner.origin(), Eigen::Vector2i(0, 18));
+  EXPECT_EQ(corner.grid().height(), 80 - 18);
+
+  // Known cells in opposite corners: the box is the whole map, and it is not copied.
+  grid.set_state({99, 0}, mapping::CellState::Occupied);
+  const KnownPart whole(grid, 2);
+  EXPECT_EQ(&whole.grid(), &grid);
+}
+
 }  // namespace
 }  // namespace fleetmap::merging
