@@ -31,7 +31,9 @@
 // --real-maps: windows of maps the user gives (real laser maps: map_server YAML, PGM, PNG), cut as
 // above but without added clutter (set "real300", or "realN" with --real-window N), and unrelated
 // pairs of windows of two of them. They are loaded first, and the HouseExpo maps only when a set of
-// house pairs is asked for.
+// house pairs is asked for. --real-coarsen F sees them through cells F times larger
+// (mapping::coarsen), as a robot mapping at F times the cell size would: the check at another
+// resolution.
 //
 // Times are the thread's CPU time per pair (alignment only; windows are cut outside the timing),
 // with OpenCV held to one thread.
@@ -58,6 +60,7 @@
 #include "core/error.h"
 #include "core/format.h"
 #include "core/random.h"
+#include "mapping/occupancy_grid.h"
 #include "maps/builtin_maps.h"
 #include "io/map_io.h"
 #include "merging/evaluation.h"
@@ -86,6 +89,7 @@ struct Args {
   std::vector<std::string> real_maps;  // maps of the user's (real laser maps: PNG, PGM + YAML, or built-in names)
   int real_pairs = 10;       // pairs per real map and overlap
   int real_window = 300;     // their windows' side, cells
+  int real_coarsen = 1;      // the real maps seen through cells this many times larger
   int real_unrelated = 100;  // pairs of windows of two different real maps (with two or more)
   std::vector<double> overlaps = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
   std::string method = "auto";
@@ -100,7 +104,7 @@ struct Args {
 constexpr const char* kUsage =
     "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
     "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
-    "       [--real-maps MAP,...] [--real-pairs N] [--real-window CELLS] [--real-unrelated N]\n"
+    "       [--real-maps MAP,...] [--real-pairs N] [--real-window CELLS] [--real-coarsen F] [--real-unrelated N]\n"
     "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
 
 [[noreturn]] void usage(const std::string& problem) {
@@ -154,6 +158,12 @@ Args parse_args(int argc, char** argv) {
       const std::string v = value();
       a.real_window = int(number(v));
       if (a.real_window < 50) usage("--real-window: '" + v + "' is under 50 cells");
+    }
+    else if (k == "--real-coarsen") {
+      const std::string v = value();
+      const double f = number(v);
+      if (!(f >= 1.0 && f <= 64.0 && f == std::floor(f))) usage("--real-coarsen: '" + v + "' is not a whole number from 1 to 64");
+      a.real_coarsen = int(f);
     }
     else if (k == "--real-unrelated") a.real_unrelated = int(number(value()));
     else if (k == "--method") a.method = value();
@@ -828,7 +838,8 @@ int main(int argc, char** argv) {
 
     // The user's maps first: a wrong path is told before the long part.
     std::vector<std::pair<std::string, mapping::OccupancyGrid>> real;
-    for (const auto& name : args.real_maps) real.emplace_back(fs::path(name).stem().string(), maps::load_map_source(name));
+    for (const auto& name : args.real_maps)
+      real.emplace_back(fs::path(name).stem().string(), mapping::coarsen(maps::load_map_source(name), args.real_coarsen));
 
     // The robot-built maps (only when a set of pairs needs them).
     const bool houses = args.pairs > 0 || args.two_robots > 0 || args.unrelated > 0;

@@ -457,7 +457,8 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
     return r;
   }
   core::Random random(options.seed);
-  // Steps: lists of passes. Candidates accumulate; each step ends with a decision.
+  // Steps: lists of passes. Candidates accumulate; each step ends with a decision, and a merge at
+  // sure_confidence or more ends the search.
   const auto& registry = merge_method_registry();
   std::vector<std::vector<const ProposeFn*>> steps;
   if (options.method == "auto") {
@@ -474,7 +475,7 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
     }
     MergeResult r = decide(a, b, candidates, options);
     if (best.candidates == 0 || r.confidence > best.confidence) best = std::move(r);
-    if (best.merged) break;
+    if (best.merged && best.confidence >= options.sure_confidence) break;
   }
   best.candidates = int(candidates.size());
   return best;

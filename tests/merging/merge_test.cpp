@@ -413,6 +413,42 @@ TEST(MergeRegistry, AProgramsOwnMethodIsReachedByNameAndRefinedByTheCommonPipeli
   EXPECT_EQ(none.candidates, 0);
 }
 
+int second_pass_calls = 0;
+std::vector<Hypothesis> propose_nothing_counted(const PreparedGrid&, const PreparedGrid&, const MergeOptions&,
+                                                core::Random&) {
+  ++second_pass_calls;
+  return {};
+}
+
+// A merge ends the search only at MergeOptions::sure_confidence or more; below it the next step
+// runs and may find a better answer (on a real map the first step merged a wrong placement at 0.52
+// where the next one found the truth at 0.999).
+TEST(AlignMaps, AMergeBelowTheSureConfidenceIsCheckedByTheNextStep) {
+  if (!merge_method_registry().contains("oracle-then-count")) {
+    register_merge_method("oracle-then-count", "the oracle, then a pass that counts its calls (a test's own)",
+                          {propose_oracle, propose_nothing_counted});
+  }
+  const CropPair pair = furnished_half_overlap_pair();
+  const PreparedGrid a(pair.a), b(pair.b);
+  MergeOptions options;
+  options.method = "oracle-then-count";
+  oracle_answer = pair.b_to_a;
+  second_pass_calls = 0;
+  const MergeResult sure = align_prepared(a, b, options);
+  ASSERT_TRUE(sure.merged) << sure.reason;
+  ASSERT_GE(sure.confidence, options.sure_confidence);
+  EXPECT_EQ(second_pass_calls, 0);
+
+  options.sure_confidence = 1.0;  // no merge is sure: every step runs
+  const MergeResult checked = align_prepared(a, b, options);
+  oracle_answer.reset();
+  EXPECT_EQ(second_pass_calls, 1);
+  ASSERT_TRUE(checked.merged) << checked.reason;
+  const TransformError e = transform_error(checked.transform, pair.b_to_a, pair.overlap_centre_b);
+  EXPECT_LT(e.rotation_deg, kMaxRotationDeg);
+  EXPECT_LT(e.translation_cells, kMaxTranslationCells);
+}
+
 // Distances to walls are kept up to PrepareOptions::max_wall_distance only. Options that compare
 // longer distances get a larger cap from align_maps and multi-map merging, and an error from
 // align_prepared on grids prepared without it (a capped distance would read as "no wall near").
