@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "merging/grid_level.h"
+#include "merging/hamming.h"
 #include "merging/rigid_fit.h"
 
 namespace fleetmap::merging {
@@ -59,14 +60,14 @@ std::vector<Hypothesis> feature_hypotheses(const PreparedGrid& a, const Prepared
     detector->detectAndCompute(img_a, mask_a, kp_a, desc_a);
     detector->detectAndCompute(img_b, mask_b, kp_b, desc_b);
     if (kp_a.size() < 2 || kp_b.size() < 2 || desc_a.empty() || desc_b.empty()) continue;
-    cv::BFMatcher matcher(cv::NORM_HAMMING);
-    std::vector<std::vector<cv::DMatch>> knn;
-    matcher.knnMatch(desc_b, desc_a, knn, 2);
+    const auto nearest = nearest_two_hamming(desc_b, desc_a);
     std::vector<PointPair> pairs;
-    for (const auto& m : knn) {
-      if (m.size() == 2 && m[0].distance < options.ratio * m[1].distance) {
-        const auto& pb = kp_b[std::size_t(m[0].queryIdx)].pt;
-        const auto& pa = kp_a[std::size_t(m[0].trainIdx)].pt;
+    for (std::size_t i = 0; i < nearest.size(); ++i) {
+      const NearestTwo& m = nearest[i];
+      // As a DMatch holds them: floats.
+      if (float(m.distance) < options.ratio * float(m.second_distance)) {
+        const auto& pb = kp_b[i].pt;
+        const auto& pa = kp_a[std::size_t(m.index)].pt;
         // Pixel centres of the scaled image back to cells of the level.
         const auto cell = [&](const cv::Point2f& p) {
           return Eigen::Vector2d((p.x + 0.5) / scale - 0.5, (p.y + 0.5) / scale - 0.5);

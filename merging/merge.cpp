@@ -10,6 +10,7 @@
 
 #include "core/angle.h"
 #include "core/error.h"
+#include "mapping/state_mask.h"
 #include "merging/evaluation.h"
 #include "merging/grid_level.h"
 
@@ -483,17 +484,9 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
 
 KnownPart::KnownPart(const mapping::OccupancyGrid& grid, int margin) : full_(&grid) {
   if (grid.width() <= 0 || grid.height() <= 0) return;
-  // Known cells (grid.state_at not Unknown), written for the compiler to vectorize.
-  cv::Mat known(grid.height(), grid.width(), CV_8U);
-  const float occupied_above = grid.occupied_log_odds(), free_below = grid.free_log_odds();
-  const int width = grid.width();  // a local: the stores below might alias grid's members
-  for (int y = 0; y < grid.height(); ++y) {
-    auto* k = known.ptr<std::uint8_t>(y);
-    const float* l = grid.log_odds_data().data() + std::size_t(y) * std::size_t(width);
-    for (int x = 0; x < width; ++x) k[x] = (l[x] > occupied_above) | (l[x] < free_below) ? 255 : 0;
-  }
-  const cv::Rect box = cv::boundingRect(known);  // of the nonzero cells
-  if (box.empty()) return;                        // nothing known: keep the map as it is
+  // The box of the known cells.
+  const cv::Rect box = cv::boundingRect(mapping::state_mask(grid, {mapping::CellState::Occupied, mapping::CellState::Free}));
+  if (box.empty()) return;  // nothing known: keep the map as it is
   const int x0 = std::max(0, box.x - margin), y0 = std::max(0, box.y - margin);
   const int x1 = std::min(grid.width() - 1, box.br().x - 1 + margin), y1 = std::min(grid.height() - 1, box.br().y - 1 + margin);
   // Copying costs more than it saves unless the cut is clearly smaller.

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/error.h"
+#include "mapping/state_mask.h"
 
 namespace fleetmap::merging {
 
@@ -261,19 +262,12 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
     throw InputError(fmt::format("merge options: max_wall_distance {} is not 1 to 1000 cells", options.max_wall_distance));
   GridLevel base;
   base.factor = 1;
-  base.occupied = cv::Mat::zeros(std::max(grid.height(), 1), std::max(grid.width(), 1), CV_8U);
-  base.free = cv::Mat::zeros(base.occupied.size(), CV_8U);
-  // grid.state_at, written for the compiler to vectorize (a million cells per map).
-  const float occupied_above = grid.occupied_log_odds(), free_below = grid.free_log_odds();
-  const int width = grid.width();  // a local: the stores below might alias grid's members
-  for (int y = 0; y < grid.height(); ++y) {
-    auto* o = base.occupied.ptr<std::uint8_t>(y);
-    auto* f = base.free.ptr<std::uint8_t>(y);
-    const float* l = grid.log_odds_data().data() + std::size_t(y) * std::size_t(width);
-    for (int x = 0; x < width; ++x) {
-      o[x] = l[x] > occupied_above ? 255 : 0;
-      f[x] = l[x] < free_below ? 255 : 0;
-    }
+  if (grid.width() > 0 && grid.height() > 0) {
+    base.occupied = mapping::state_mask(grid, {mapping::CellState::Occupied});
+    base.free = mapping::state_mask(grid, {mapping::CellState::Free});
+  } else {  // one empty cell
+    base.occupied = cv::Mat::zeros(1, 1, CV_8U);
+    base.free = cv::Mat::zeros(1, 1, CV_8U);
   }
   known_cells_ = cv::countNonZero(base.occupied) + cv::countNonZero(base.free);
   known_cells_ -= remove_specks(base.occupied, options.min_obstacle_cells);
