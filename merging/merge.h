@@ -55,6 +55,10 @@ namespace fleetmap::merging {
 //   tested walls, it counts fully for z <= 2 and not at all for z >= 4; and, as the answer, when
 //   its cells agree with a's (its score times the acceptance factor below at its own omega): a
 //   placement that lays free cells on occupied ones could not be merged and is no rival.
+//   A rival cleaner than the answer's rate predicts (z <= -3) at whose own rate the answer's
+//   contradictions are implausible (z >= 4) makes the distinctiveness 0: the maps cannot disagree
+//   as the answer says and agree as the rival says, and a higher score does not tell which of two
+//   placements that both fit many walls is right (a corridor slid by a row of door niches).
 // - corner factor: the matched walls off the two straight lines that hold most of them
 //   (AlignmentQuality::beyond_corner), 0 up to zero_beyond_corner, 1 from full_beyond_corner on
 //   (4 x 4 blocks of wall, counted in both maps: a door jamb seen by both is two), plus the
