@@ -1,6 +1,7 @@
 #include "merging/overlap_search.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <numbers>
 #include <opencv2/core.hpp>
@@ -9,7 +10,6 @@
 #include "core/angle.h"
 #include "merging/grid_level.h"
 #include "merging/hough_spectrum.h"
-#include "merging/real_dft.h"
 
 namespace fleetmap::merging {
 
@@ -37,26 +37,13 @@ cv::Mat clear_free(const GridLevel& level) {
   return as_float(level.free & far);
 }
 
-// The correlation (conjugate) or convolution of three pairs of images, weighted, from their
-// spectra: band_a (x) band_b - w [clear_a (x) occupied_b + occupied_a (x) clear_b].
-void combine_spectra(const HalfSpectrum& g_band, const HalfSpectrum& f_band, const HalfSpectrum& g_clear,
-                     const HalfSpectrum& f_occupied, const HalfSpectrum& g_occupied, const HalfSpectrum& f_clear,
-                     float w, bool conjugate, HalfSpectrum& product) {
-  product.resize(g_band.size());
-  const float sign = conjugate ? -1.0f : 1.0f;  // of b's imaginary parts
-  // g * f (or g * conj f), as floats: the compiler vectorizes this, not std::complex's product.
-  const auto mul = [sign](std::complex<float> g, std::complex<float> f, float& re, float& im, float weight) {
-    const float fi = sign * f.imag();
-    re += weight * (g.real() * f.real() - g.imag() * fi);
-    im += weight * (g.real() * fi + g.imag() * f.real());
-  };
-  for (std::size_t k = 0; k < product.size(); ++k) {
-    float re = 0.0f, im = 0.0f;
-    mul(g_band[k], f_band[k], re, im, 1.0f);
-    mul(g_clear[k], f_occupied[k], re, im, -w);
-    mul(g_occupied[k], f_clear[k], re, im, -w);
-    product[k] = {re, im};
-  }
+cv::Mat padded_dft(const cv::Mat& img, cv::Size size) {
+  cv::Mat padded = cv::Mat::zeros(size, CV_32F);
+  img.copyTo(padded(cv::Rect(0, 0, img.cols, img.rows)));
+  cv::Mat spectrum;
+  // Rows past the image are zero: their row transforms are zero and are skipped.
+  cv::dft(padded, spectrum, 0, img.rows);
+  return spectrum;
 }
 
 struct Peak {
@@ -145,11 +132,9 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
   // b turned by any angle fits a D x D canvas centred on b's centre.
   const int d = int(std::ceil(std::hypot(double(lb.width()), double(lb.height())))) + 2;
   const cv::Size size(cv::getOptimalDFTSize(la.width() + d), cv::getOptimalDFTSize(la.height() + d));
-  RealDft dft(size);
-  HalfSpectrum g_band, g_clear, g_occupied;
-  dft.forward(band_a_near, g_band);
-  dft.forward(clear_free(la), g_clear);
-  dft.forward(occupied_a, g_occupied);
+  const cv::Mat g_band = padded_dft(band_a_near, size);
+  const cv::Mat g_clear = padded_dft(clear_free(la), size);
+  const cv::Mat g_occupied = padded_dft(occupied_a, size);
   const Eigen::Vector2d centre_b((lb.width() - 1) / 2.0, (lb.height() - 1) / 2.0);
   const Eigen::Vector2d centre_canvas((d - 1) / 2.0, (d - 1) / 2.0);
   const int radius = std::max(1, options.peak_separation);
@@ -171,11 +156,18 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
   // share b's three transforms (the spectral candidates come in such pairs, and so do the probes'
   // quarter turns).
   std::vector<bool> done(rotations.size(), false);
-  cv::Mat turned(d, d, CV_32F), s, shifted;
-  HalfSpectrum f_band, f_occupied, f_clear, product;
+  // b turned is drawn straight into the top-left d x d corner of one zero canvas of the transform's
+  // size (the rest stays zero), and transformed from there.
+  cv::Mat canvas = cv::Mat::zeros(size, CV_32F);
+  cv::Mat turned = canvas(cv::Rect(0, 0, d, d));
+  cv::Mat f_band, f_occupied, f_clear, product, product2, s, shifted;
   const auto combine = [&](bool conjugate) {
-    combine_spectra(g_band, f_band, g_clear, f_occupied, g_occupied, f_clear, float(w), conjugate, product);
-    dft.inverse(product, s);
+    cv::mulSpectrums(g_band, f_band, product, 0, conjugate);
+    cv::mulSpectrums(g_clear, f_occupied, product2, 0, conjugate);
+    product -= w * product2;
+    cv::mulSpectrums(g_occupied, f_clear, product2, 0, conjugate);
+    product -= w * product2;
+    cv::idft(product, s, cv::DFT_SCALE | cv::DFT_REAL_OUTPUT);
   };
   for (std::size_t i = 0; i < rotations.size(); ++i) {
     if (done[i]) continue;
@@ -184,9 +176,10 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
     const Eigen::Vector2d shift = centre_canvas - rot.apply(centre_b);
     const Eigen::Matrix2d r = rot.rotation_matrix();
     const cv::Mat m = (cv::Mat_<double>(2, 3) << r(0, 0), r(0, 1), shift.x(), r(1, 0), r(1, 1), shift.y());
-    const auto turned_dft = [&](const cv::Mat& image, HalfSpectrum& spectrum) {
+    const auto turned_dft = [&](const cv::Mat& image, cv::Mat& spectrum) {
       cv::warpAffine(image, turned, m, turned.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
-      dft.forward(turned, spectrum);
+      assert(turned.data == canvas.data);  // drawn in place (same size and type), not reallocated
+      cv::dft(canvas, spectrum, 0, d);  // rows past d are zero
     };
     turned_dft(band_b, f_band);
     turned_dft(occupied_b, f_occupied);
