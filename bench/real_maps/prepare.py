@@ -16,6 +16,7 @@ Usage: /usr/bin/python3 prepare.py [--src DIR] [--out DIR]
 """
 import argparse
 import os
+import sys
 
 import numpy as np
 from PIL import Image
@@ -225,6 +226,10 @@ def main():
     ap.add_argument("--src", default=os.path.join(here, "src"))
     ap.add_argument("--out", default=here)
     args = ap.parse_args()
+    missing = [f for f, *_ in SOURCES.values() if not os.path.isfile(os.path.join(args.src, f))]
+    if missing:
+        print(f"prepare.py: {args.src}: missing {', '.join(missing)} (see bench/real_maps/README.md)", file=sys.stderr)
+        sys.exit(2)
     yamls = []
     for name, (fname, origin, res, (occ_t, free_t)) in SOURCES.items():
         g = load_grey(os.path.join(args.src, fname))
