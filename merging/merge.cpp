@@ -312,10 +312,17 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   result.evidence = evidence_of(best_q);
   const auto support = [&](double evidence) { return 1.0 - std::exp2(-evidence / co.half_evidence); };
 
+  // A placement's rate of walls on the other map's free space (at least min_contradiction_rate),
+  // and how far `contradicted` of `tested` walls lie from what a rate predicts, in standard deviations.
+  const auto contradiction_rate = [&](const AlignmentQuality& q) {
+    return std::max(co.min_contradiction_rate, (q.contradicted + 1.0) / (q.matched + q.contradicted + 2.0));
+  };
+  const auto contradiction_z = [](double contradicted, double tested, double rate) {
+    return (contradicted - rate * tested) / std::sqrt(rate * tested + 1.0);
+  };
   // The best plausible different answer among `others` (placements of `from` in a), relative to
   // the answer's score `best` there: 1 - S2 / S1.
-  const double rate = std::max(co.min_contradiction_rate,
-                               (best_q.contradicted + 1.0) / (best_q.matched + best_q.contradicted + 2.0));
+  const double rate = contradiction_rate(best_q);
   // Also the largest share of the best score that a plausible placement turned by a quarter turn or
   // more from the answer reaches (`turned`).
   double turned = 0.0;
@@ -329,7 +336,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
     for (const auto& [q, t] : others) {
       if (same_answer(t, answer, at, co)) continue;
       const double n = q.matched + q.contradicted;
-      const double z = (q.contradicted - rate * n) / std::sqrt(rate * n + 1.0);
+      const double z = contradiction_z(q.contradicted, n, rate);
       // A rival too clean for the answer's rate whose own rate makes the answer's contradictions
       // implausible: the maps cannot disagree as the answer says and agree as the rival says, so
       // one of two placements that both fit many walls is wrong, and no score tells which (seen
@@ -337,8 +344,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       // it, 1304 walls matched and 65 on free space, merged at 0.56 over the truth's 413 matched
       // and none on free space).
       if (!cleaner && z <= -3.0) {
-        const double rival_rate = std::max(co.min_contradiction_rate, (q.contradicted + 1.0) / (n + 2.0));
-        const double z_answer = (best.contradicted - rival_rate * n_best) / std::sqrt(rival_rate * n_best + 1.0);
+        const double z_answer = contradiction_z(best.contradicted, n_best, contradiction_rate(q));
         if (z_answer >= 4.0 && acceptance_factor_of(acceptance_index(a.level(0), from.level(0), t).omega()) >= 0.5) cleaner = t;
       }
       double plausible = q.score * clamp01((4.0 - z) / 2.0);
