@@ -12,7 +12,7 @@ their colour channels), so a map loaded through the written YAML (thresholds 0.6
 exactly as the source image read through its thresholds; only the edits below change cells.
 
 Needs numpy, Pillow and scipy (Debian: python3-numpy python3-pil python3-scipy).
-Usage: /usr/bin/python3 prepare.py [--src DIR] [--out DIR]
+Usage: /usr/bin/python3 prepare.py --src DIR --out DIR
 """
 import argparse
 import os
@@ -205,39 +205,59 @@ EDITS = {
 }
 
 
-def write_pgm(path, img, comment):
+def write_atomically(path, data):
+    """Writes to a temporary name beside `path`, then renames: an interrupted run leaves no half file."""
+    tmp = path + ".tmp"
+    with open(tmp, "wb") as f:
+        f.write(data)
+    os.replace(tmp, path)
+
+
+def pgm_bytes(img, comment):
     h, w = img.shape
-    with open(path, "wb") as f:
-        f.write(b"P5\n# " + comment.encode() + b"\n" + f"{w} {h}\n255\n".encode())
-        f.write(np.ascontiguousarray(img, np.uint8).tobytes())
+    return b"P5\n# " + comment.encode() + b"\n" + f"{w} {h}\n255\n".encode() + np.ascontiguousarray(img, np.uint8).tobytes()
 
 
-def write_yaml(path, name, resolution):
+def yaml_bytes(name, resolution):
     # Written for every map (origin [0, 0, 0]: the benchmark cuts windows by cells; the
     # repositories' origins, e.g. stata's yaw 3.14, are not kept).
-    with open(path, "w") as f:
-        f.write(f"image: {name}.pgm\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
-                f"occupied_thresh: {STD_THRESH[0]}\nfree_thresh: {STD_THRESH[1]}\nmode: trinary\n")
+    return (f"image: {name}.pgm\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+            f"occupied_thresh: {STD_THRESH[0]}\nfree_thresh: {STD_THRESH[1]}\nmode: trinary\n").encode()
+
+
+def fail(message):
+    print("prepare.py: " + message, file=sys.stderr)
+    sys.exit(2)
 
 
 def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--src", default=os.path.join(here, "src"))
-    ap.add_argument("--out", default=here)
+    ap = argparse.ArgumentParser(description="Writes the 17 real maps of the merging benchmark from their sources.")
+    ap.add_argument("--src", required=True, help="folder with the source images (bench/real_maps/README.md)")
+    ap.add_argument("--out", required=True, help="folder for NAME.pgm and NAME.yaml (created if missing)")
     args = ap.parse_args()
     missing = [f for f, *_ in SOURCES.values() if not os.path.isfile(os.path.join(args.src, f))]
     if missing:
-        print(f"prepare.py: {args.src}: missing {', '.join(missing)} (see bench/real_maps/README.md)", file=sys.stderr)
-        sys.exit(2)
+        fail(f"{args.src}: missing {', '.join(missing)} (see bench/real_maps/README.md)")
+    # Every output path is checked before any work: none may be a source, a folder, or a link.
+    inputs = {os.path.realpath(os.path.join(args.src, f)) for f, *_ in SOURCES.values()}
+    if os.path.exists(args.out) and not os.path.isdir(args.out):
+        fail(f"--out {args.out}: not a folder")
+    for name in SOURCES:
+        for ext in (".pgm", ".yaml"):
+            path = os.path.join(args.out, name + ext)
+            if os.path.realpath(path) in inputs:
+                fail(f"--out {args.out}: {name + ext} would replace a source image; give another folder")
+            if os.path.islink(path) or (os.path.exists(path) and not os.path.isfile(path)):
+                fail(f"--out {args.out}: {name + ext} exists and is not a regular file; not replaced")
+    os.makedirs(args.out, exist_ok=True)
     yamls = []
     for name, (fname, origin, res, (occ_t, free_t)) in SOURCES.items():
         g = load_grey(os.path.join(args.src, fname))
         notes = EDITS[name](g) if name in EDITS else {}
         img = trinary(g, occ_t, free_t)
-        write_pgm(os.path.join(args.out, name + ".pgm"), img, f"fleetmap realmaps {name} from {origin}")
+        write_atomically(os.path.join(args.out, name + ".pgm"), pgm_bytes(img, f"fleetmap realmaps {name} from {origin}"))
         yaml = os.path.join(args.out, name + ".yaml")
-        write_yaml(yaml, name, res)
+        write_atomically(yaml, yaml_bytes(name, res))
         yamls.append(yaml)
         counts = np.bincount(img.ravel(), minlength=256)
         print(f"{name}: {img.shape[1]} x {img.shape[0]} cells, {res} m; occupied {counts[OCC]}, "
