@@ -11,8 +11,15 @@ p > occupied_thresh, free if p < free_thresh, unknown otherwise; RGB(A) images r
 their colour channels), so a map loaded through the written YAML (thresholds 0.65 / 0.196) reads
 exactly as the source image read through its thresholds; only the edits below change cells.
 
+SOURCES also lists 5 held-out maps of other buildings (HELD_OUT: bham_cs_lgfloor,
+upo_centre_sportif, ipa_office, aist_conveni, sapienza_diag), kept apart for a held-out check of
+the merging; they are prepared only when asked for with --only.
+
 Needs numpy, Pillow and scipy (Debian: python3-numpy python3-pil python3-scipy).
-Usage: /usr/bin/python3 prepare.py --src DIR --out DIR
+Usage: /usr/bin/python3 prepare.py --src DIR --out DIR [--only NAME,...|held-out|all]
+  --only restricts the maps prepared, and the source files required in --src, to the names given
+  (comma-separated); 'held-out' means the 5 held-out maps, 'all' all 22. Without it the 17
+  benchmark maps are prepared, as before.
 """
 import argparse
 import os
@@ -51,7 +58,27 @@ SOURCES = {
     "upo_uva_demo": ("upo_uva_demo.pgm", "robotics-upo/upo_robot_navigation : upo_launchers/uva_demo/maps/uva_demo.pgm", 0.05, STD_THRESH),
     "upo_elderly_center": ("upo_elderly_center.pgm", "robotics-upo/upo_robot_navigation : upo_launchers/elderly_center/maps/elderly_center.pgm", 0.05, STD_THRESH),
     "upo_uva_lab": ("upo_uva_lab.pgm", "robotics-upo/upo_robot_navigation : upo_launchers/uva_lab/maps/uva_lab.pgm", 0.05, STD_THRESH),
+    # --- held-out maps (not used while developing the merging; prepare them with --only) ---
+    # Birmingham School of Computer Science, lower ground floor: map_saver output (0/205/254) of a
+    # real Pioneer's gmapping run (ray fans through doors, speckled walls, map at a slant).
+    "bham_cs_lgfloor": ("bham_cs_lgfloor.pgm", "IRUOB/socspioneer : data/lgfloor.pgm", 0.05, STD_THRESH),
+    # TERESA "centre sportif" (a sports centre, not the UPO buildings above): real gmapping map with
+    # long ray fans and clutter; black squares painted in the four corners like uva_demo.
+    "upo_centre_sportif": ("upo_centre_sportif.pgm", "robotics-upo/upo_robot_navigation : upo_launchers/centre_sportif/maps/centre_sportif.pgm", 0.05, STD_THRESH),
+    # Fraunhofer IPA office building, Stuttgart (Care-O-bot env): first version of ipa-office/map.pgm
+    # (commit 226aae7fa0fe8f5973e686b963fc0c1a3243163b "added ipa-office"), a 0/205/254 map_saver
+    # image of a real robot's run: ray fans from every door, speckle in the rooms.
+    "ipa_office": ("ipa_office.pgm", "ipa320/cob_environments : cob_default_env_config/ipa-office/map.pgm @226aae7f", 0.05, STD_THRESH),
+    # AIST mock convenience store (JSK aero robot, rooms/aist/raw_maps/map.pgm at commit
+    # ba93ca5d634495e591d0f8fca2e1cec3ea847cbb, its YAML names it aist_conveni.pgm, 0.025 m):
+    # 0/205/254 map of a real laser run with ray fans, shelf rows with ragged outlines.
+    "aist_conveni": ("aist_conveni.pgm", "jsk-ros-pkg/jsk_robot : jsk_aero_robot/jsk_aero_startup/rooms/aist/raw_maps/map.pgm @ba93ca5d", 0.025, STD_THRESH),
+    # DIAG, Sapienza University of Rome, B1 floor corridors (SPQReL Pepper team, 0.025 m): real
+    # laser map with ray fans into rooms and broken walls; 0/205/254 plus 55 stray anti-aliasing
+    # greys (207-253) that the trinary rule reads as free.
+    "sapienza_diag": ("sapienza_diag.png", "LCAS/spqrel_navigation : maps/diag.png", 0.025, STD_THRESH),
 }
+HELD_OUT = ("bham_cs_lgfloor", "upo_centre_sportif", "ipa_office", "aist_conveni", "sapienza_diag")
 
 
 def load_grey(path):
@@ -192,12 +219,18 @@ def edit_upo_elderly_center(g):
     return clear_corner_squares(g, "elderly_center")
 
 
+def edit_upo_centre_sportif(g):
+    # 23-24-cell black squares in the four corners.
+    return clear_corner_squares(g, "centre_sportif")
+
+
 EDITS = {
     "utexas_gdc_1": edit_utexas_gdc_1,
     "utexas_gdc_2": edit_utexas_gdc_2,
     "strands_tsc": edit_strands_tsc,
     "upo_uva_demo": edit_upo_uva_demo,
     "upo_elderly_center": edit_upo_elderly_center,
+    "upo_centre_sportif": edit_upo_centre_sportif,
     # intel_lab: no cell edit; its grey levels (free 255, unknown 230, occupied 64 and greys in
     # between) are mapped to 0 / 205 / 254 by the trinary rule with ITS OWN thresholds from
     # intel.yaml (occupied_thresh 0.2 -> grey <= 203 occupied, free_thresh 0.05 -> grey >= 243
@@ -231,18 +264,33 @@ def fail(message):
 
 
 def main():
-    ap = argparse.ArgumentParser(description="Writes the 17 real maps of the merging benchmark from their sources.")
+    ap = argparse.ArgumentParser(description="Writes the real maps of the merging benchmark (17, and 5 held-out with --only) from their sources.")
     ap.add_argument("--src", required=True, help="folder with the source images (bench/real_maps/README.md)")
     ap.add_argument("--out", required=True, help="folder for NAME.pgm and NAME.yaml (created if missing)")
+    ap.add_argument("--only", default="", metavar="NAME,...",
+                    help="prepare (and require in --src) only these maps; default: the 17 benchmark maps; "
+                         "'held-out' names the held-out maps, 'all' every map")
     args = ap.parse_args()
-    missing = [f for f, *_ in SOURCES.values() if not os.path.isfile(os.path.join(args.src, f))]
+    if args.only in ("", "benchmark"):
+        names = [n for n in SOURCES if n not in HELD_OUT]
+    elif args.only == "all":
+        names = list(SOURCES)
+    elif args.only == "held-out":
+        names = list(HELD_OUT)
+    else:
+        names = [n for n in args.only.split(",") if n]
+        unknown = [n for n in names if n not in SOURCES]
+        if unknown or not names:
+            fail(f"--only: unknown map name(s) {', '.join(unknown) or '(none given)'}; known: {', '.join(SOURCES)}")
+    sources = {n: SOURCES[n] for n in SOURCES if n in names}
+    missing = [f for f, *_ in sources.values() if not os.path.isfile(os.path.join(args.src, f))]
     if missing:
         fail(f"{args.src}: missing {', '.join(missing)} (see bench/real_maps/README.md)")
     # Every output path is checked before any work: none may be a source, a folder, or a link.
-    inputs = {os.path.realpath(os.path.join(args.src, f)) for f, *_ in SOURCES.values()}
+    inputs = {os.path.realpath(os.path.join(args.src, f)) for f, *_ in sources.values()}
     if os.path.exists(args.out) and not os.path.isdir(args.out):
         fail(f"--out {args.out}: not a folder")
-    for name in SOURCES:
+    for name in sources:
         for ext in (".pgm", ".yaml"):
             path = os.path.join(args.out, name + ext)
             if os.path.realpath(path) in inputs:
@@ -251,7 +299,7 @@ def main():
                 fail(f"--out {args.out}: {name + ext} exists and is not a regular file; not replaced")
     os.makedirs(args.out, exist_ok=True)
     yamls = []
-    for name, (fname, origin, res, (occ_t, free_t)) in SOURCES.items():
+    for name, (fname, origin, res, (occ_t, free_t)) in sources.items():
         g = load_grey(os.path.join(args.src, fname))
         notes = EDITS[name](g) if name in EDITS else {}
         img = trinary(g, occ_t, free_t)
