@@ -1095,6 +1095,41 @@ int main(int argc, char** argv) {
       const auto fl = select(set, std::nullopt, false), pe = select(set, std::nullopt, true);
       std::cout << fmt::format("| all | {} | {} | {} | {} |\n\n", args.peer ? summary(pe) : "-",
                                args.peer ? std::to_string(found(pe, false)) : "-", summary(fl), found(fl, true));
+      // Real maps differ more from one another than from one overlap to the next: the same pairs
+      // by map (merged right of the pairs, per overlap), so that a hard building shows.
+      if (set != real_set(args.real_window)) continue;
+      std::vector<std::string> sources;
+      for (const auto& r : records)
+        if (r.pair->set == set && std::find(sources.begin(), sources.end(), r.pair->source) == sources.end())
+          sources.push_back(r.pair->source);
+      std::cout << "### " << set << " by map (fleetmap merged right / pairs)\n\n| map |";
+      for (const double f : fs_) std::cout << " " << overlap_percent(f) << "% |";
+      std::cout << " all | wrong |" << (args.peer ? " peer (ORB): all, wrong |" : "") << "\n|---|";
+      for (std::size_t k = 0; k < fs_.size() + 2 + (args.peer ? 1 : 0); ++k) std::cout << "---|";
+      std::cout << "\n";
+      for (const auto& source : sources) {
+        const auto count = [&](std::optional<double> f, bool peer, bool wrong_only) {
+          int n = 0, hits = 0;
+          for (const auto& r : records) {
+            if (r.pair->set != set || r.pair->source != source || (f && std::abs(r.pair->overlap - *f) > 1e-9)) continue;
+            const Outcome& o = peer ? r.peer : r.fleetmap;
+            ++n;
+            hits += wrong_only ? wrong(o) : success(o);
+          }
+          return std::pair(hits, n);
+        };
+        std::cout << "| " << source << " |";
+        for (const double f : fs_) {
+          const auto [k, n] = count(f, false, false);
+          std::cout << " " << (n ? fmt::format("{}/{}", k, n) : "-") << " |";
+        }
+        const auto [k, n] = count(std::nullopt, false, false);
+        std::cout << fmt::format(" {}/{} | {} |", k, n, count(std::nullopt, false, true).first);
+        if (args.peer)
+          std::cout << fmt::format(" {}/{}, {} |", count(std::nullopt, true, false).first, n, count(std::nullopt, true, true).first);
+        std::cout << "\n";
+      }
+      std::cout << "\n";
     }
     {
       const auto fl = select("unrelated", std::nullopt, false);
