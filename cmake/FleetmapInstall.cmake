@@ -11,7 +11,7 @@ set(FLEETMAP_MODULES core mapping io viz maps localization merging planning expl
 # nlohmann::json) in their declarations, and only fleetmap's own sources and the CLI need them.
 # The pictures (viz/, the run, sweep and experiment reports) are OpenCV images throughout.
 set(FLEETMAP_INTERNAL_HEADERS
-  io/yaml_reader.h io/map_image.h maps/generated_maps.h merging/grid_level.h merging/hamming.h mapping/state_mask.h sim/scenario_yaml.h sim/run_output.h sim/run_replay.h
+  sim/video_module.h io/yaml_reader.h io/map_image.h maps/generated_maps.h merging/grid_level.h merging/hamming.h mapping/state_mask.h sim/scenario_yaml.h sim/run_output.h sim/run_replay.h
   sweep/sweep_report.h experiments/slam_output.h experiments/corridor_output.h)
 file(GLOB viz_headers RELATIVE ${PROJECT_SOURCE_DIR} CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/viz/*.h)
 list(APPEND FLEETMAP_INTERNAL_HEADERS ${viz_headers})
@@ -62,6 +62,9 @@ install(TARGETS ${module_targets} fleetmap_library EXPORT fleetmapTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${stage_dir}/fleetmap DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# The video module RunVideo loads (sim/video_module.h): P/lib/fleetmap, which an installed program
+# finds from P/bin, and the configured prefix's is baked into the library.
+install(TARGETS fleetmap_video LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/fleetmap)
 install(EXPORT fleetmapTargets NAMESPACE fleetmap:: DESTINATION ${FLEETMAP_INSTALL_CMAKEDIR})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/fleetmapConfig.cmake.in
                               ${PROJECT_BINARY_DIR}/fleetmapConfig.cmake

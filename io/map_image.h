@@ -21,6 +21,12 @@ mapping::OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta
 // The map_saver image: 254 free, 0 occupied, 205 unknown, 8-bit single channel, top row first.
 cv::Mat grid_to_image(const mapping::OccupancyGrid& grid);
 
+// PNG bytes of an 8- or 16-bit image of 1, 3 (BGR) or 4 (BGRA) channels, byte for byte what OpenCV's
+// cv::imencode(".png") writes with the same level (libpng with OpenCV's settings; fleetmap does not
+// link OpenCV's image-file module: it pulls in over a hundred libraries a program loads at start).
+// compression_level < 0: OpenCV's fast default; 0-9: zlib's level. Empty for other images.
+std::string encode_png(const cv::Mat& image, int compression_level = -1);
+
 // The bytes of `image` in the format an extension names (".png", ".pgm"). Throws InputError
 // naming `what` when fleetmap cannot write that format for this image.
 std::string encode_image(const std::string& extension, const cv::Mat& image, const std::string& what);

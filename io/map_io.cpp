@@ -4,14 +4,15 @@
 
 #include <png.h>
 #include <yaml-cpp/yaml.h>
+#include <zlib.h>
 
 #include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <opencv2/imgcodecs.hpp>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <vector>
 
@@ -390,20 +391,79 @@ std::vector<fs::path> map_files(const fs::path& path) {
   }
 }
 
+namespace {
+
+// Binary PGM (P5) of an 8- or 16-bit single-channel image, 16-bit samples big-endian, as Netpbm
+// (and OpenCV) write it; empty for other images.
+std::string encode_pgm(const cv::Mat& image) {
+  if (image.empty() || image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U)) return {};
+  const bool sixteen = image.depth() == CV_16U;
+  std::string out = fmt::format("P5\n{} {}\n{}\n", image.cols, image.rows, sixteen ? 65535 : 255);
+  for (int y = 0; y < image.rows; ++y) {
+    if (!sixteen) {
+      out.append(image.ptr<char>(y), std::size_t(image.cols));
+      continue;
+    }
+    for (const std::uint16_t v : std::span(image.ptr<std::uint16_t>(y), std::size_t(image.cols))) {
+      out.push_back(char(v >> 8));
+      out.push_back(char(v & 0xff));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string encode_png(const cv::Mat& image, int compression_level) {
+  const int depth = image.depth(), channels = image.channels();
+  if (image.empty() || (depth != CV_8U && depth != CV_16U) || (channels != 1 && channels != 3 && channels != 4)) return {};
+  // libpng reports errors by longjmp from this handler; warnings are dropped (nothing below cli prints).
+  png_structp png = png_create_write_struct(
+      PNG_LIBPNG_VER_STRING, nullptr, [](png_structp p, png_const_charp) { png_longjmp(p, 1); },
+      [](png_structp, png_const_charp) {});
+  if (!png) return {};
+  png_infop info = png_create_info_struct(png);
+  std::string buffer;
+  std::vector<png_bytep> rows(std::size_t(image.rows));
+  volatile bool ok = false;  // set after setjmp: volatile, so that a longjmp cannot leave a stale copy
+  if (info && setjmp(png_jmpbuf(png)) == 0) {
+    png_set_write_fn(
+        png, &buffer,
+        [](png_structp p, png_bytep data, png_size_t n) {
+          static_cast<std::string*>(png_get_io_ptr(p))->append(reinterpret_cast<const char*>(data), n);
+        },
+        [](png_structp) {});
+    if (compression_level >= 0) {
+      png_set_compression_level(png, std::min(compression_level, Z_BEST_COMPRESSION));
+      png_set_compression_strategy(png, Z_DEFAULT_STRATEGY);
+    } else {  // fast: OpenCV's default
+      png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+      png_set_compression_level(png, Z_BEST_SPEED);
+      png_set_compression_strategy(png, Z_RLE);
+    }
+    png_set_IHDR(png, info, png_uint_32(image.cols), png_uint_32(image.rows), depth == CV_8U ? 8 : 16,
+                 channels == 1 ? PNG_COLOR_TYPE_GRAY : channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    png_set_bgr(png);   // OpenCV's channel order
+    png_set_swap(png);  // 16-bit samples are little-endian in memory here, big-endian in a PNG
+    for (int y = 0; y < image.rows; ++y) rows[std::size_t(y)] = const_cast<png_bytep>(image.ptr<png_byte>(y));
+    png_write_image(png, rows.data());
+    png_write_end(png, info);
+    ok = true;
+  }
+  png_destroy_write_struct(&png, &info);
+  return ok ? buffer : std::string();
+}
+
 std::string encode_image(const std::string& ext, const cv::Mat& image, const std::string& what) {
   if (ext.empty()) throw InputError(what + ": output image needs an extension (.png, .pgm)");
-  std::vector<std::uint8_t> buffer;
-  bool ok = false;
-  try {
-    ok = (ext == ".png" || ext == ".pgm") && cv::imencode(ext, image, buffer);
-  } catch (const cv::Exception&) {
-    ok = false;
-  }
-  if (!ok) {
+  const std::string bytes = ext == ".png" ? encode_png(image) : ext == ".pgm" ? encode_pgm(image) : std::string();
+  if (bytes.empty()) {
     throw InputError(what + ": cannot write " + (image.channels() == 1 ? "a map image" : "a picture") + " as '" + ext +
                      "' (" + (image.channels() == 1 ? "use .png or .pgm" : "use .png") + ")");
   }
-  return std::string(reinterpret_cast<const char*>(buffer.data()), buffer.size());
+  return bytes;
 }
 
 void check_picture_path(const fs::path& path, const std::string& what) {

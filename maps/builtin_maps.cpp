@@ -6,13 +6,13 @@
 #include <cstdlib>
 #include <numbers>
 #include <optional>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "core/format.h"
 #include "core/error.h"
 #include "core/random.h"
 #include "io/file_io.h"
+#include "io/map_image.h"
 
 #ifndef FLEETMAP_SOURCE_MAPS_DIR
 #define FLEETMAP_SOURCE_MAPS_DIR ""
@@ -430,9 +430,7 @@ GeneratedMap generate_builtin_map(std::string_view name) {
 }
 
 std::string encode_png(const cv::Mat& image) {
-  std::vector<std::uint8_t> buf;
-  cv::imencode(".png", image, buf, {cv::IMWRITE_PNG_COMPRESSION, 9});
-  return {buf.begin(), buf.end()};
+  return io::encode_png(image, 9);
 }
 
 fs::path builtin_maps_dir() {

@@ -1,10 +1,12 @@
 #include "sim/run_output.h"
 
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
+
+#include <dlfcn.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 
 #include <fmt/format.h>
@@ -16,6 +18,7 @@
 #include "io/map_io.h"
 #include "io/octomap_io.h"
 #include "sim/run_metrics.h"
+#include "sim/video_module.h"
 #include "viz/render.h"
 
 namespace fleetmap::sim {
@@ -304,6 +307,59 @@ const std::vector<VideoCodec>& codecs_for(const std::string& extension) {
   return extension == ".mp4" ? kMp4 : extension == ".webm" ? kWebm : kNone;
 }
 
+struct VideoModule {
+  fleetmap_video_open_fn open = nullptr;
+  fleetmap_video_write_fn write = nullptr;
+  fleetmap_video_close_fn close = nullptr;
+};
+
+// Where the video module is looked for, in order: $FLEETMAP_VIDEO_MODULE; beside the running
+// program and in its ../lib/fleetmap (an installed fleetmap, whatever its prefix); where the build
+// wrote it; where `cmake --install` puts it under the configured prefix.
+std::vector<fs::path> video_module_candidates() {
+  std::vector<fs::path> out;
+  if (const char* env = std::getenv("FLEETMAP_VIDEO_MODULE"); env && *env) out.emplace_back(env);
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    out.push_back(exe.parent_path() / FLEETMAP_VIDEO_MODULE_NAME);
+    out.push_back(exe.parent_path().parent_path() / "lib" / "fleetmap" / FLEETMAP_VIDEO_MODULE_NAME);
+  }
+  out.emplace_back(FLEETMAP_VIDEO_MODULE_BUILD);
+  out.emplace_back(FLEETMAP_VIDEO_MODULE_INSTALL);
+  return out;
+}
+
+// The module, loaded on first use (the first frame of a run's video).
+const VideoModule& video_module() {
+  static const VideoModule module = [] {
+    std::string tried;
+    for (const auto& path : video_module_candidates()) {
+      std::error_code ec;
+      if (!fs::is_regular_file(path, ec)) {
+        tried += (tried.empty() ? "" : ", ") + path.string();
+        continue;
+      }
+      void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!handle) {
+        const char* why = dlerror();
+        tried += (tried.empty() ? "" : ", ") + path.string() + " (" + (why ? why : "cannot load") + ")";
+        continue;
+      }
+      VideoModule m;
+      m.open = reinterpret_cast<fleetmap_video_open_fn>(dlsym(handle, "fleetmap_video_open"));
+      m.write = reinterpret_cast<fleetmap_video_write_fn>(dlsym(handle, "fleetmap_video_write"));
+      m.close = reinterpret_cast<fleetmap_video_close_fn>(dlsym(handle, "fleetmap_video_close"));
+      if (m.open && m.write && m.close) return m;  // stays loaded for the program's life
+      dlclose(handle);
+      tried += (tried.empty() ? "" : ", ") + path.string() + " (not fleetmap's video module)";
+    }
+    throw Error(std::string("cannot write a video: fleetmap's video module ") + FLEETMAP_VIDEO_MODULE_NAME +
+                " was not found (looked at " + tried + "); set FLEETMAP_VIDEO_MODULE to its path");
+  }();
+  return module;
+}
+
 }  // namespace
 
 const std::vector<std::string>& video_extensions() {
@@ -314,7 +370,8 @@ const std::vector<std::string>& video_extensions() {
 struct RunVideo::Impl {
   fs::path path, tmp;
   double fps = 12.0;
-  cv::VideoWriter writer;
+  const VideoModule* module = nullptr;
+  void* writer = nullptr;  // the module's, open from the first frame until finish()
   cv::Size size;
   int frames = 0;
   std::string codec, note;
@@ -328,11 +385,12 @@ RunVideo::RunVideo(fs::path path, double fps) : impl_(std::make_unique<Impl>()) 
   impl_->tmp = impl_->path;
   impl_->tmp.replace_extension(".partial" + impl_->path.extension().string());
   impl_->fps = fps;
+  impl_->module = &video_module();  // before the run: a missing module is said at once
 }
 
 RunVideo::~RunVideo() {
-  if (impl_ && impl_->writer.isOpened()) {
-    impl_->writer.release();
+  if (impl_ && impl_->writer) {
+    impl_->module->close(impl_->writer);
     std::error_code ec;
     fs::remove(impl_->tmp, ec);
   }
@@ -365,20 +423,20 @@ void RunVideo::add_frame(const Simulation& sim, const std::string& map_label) {
   ro.title = fmt::format("{}: step {}, {:.1f}%", map_label, sim.step_count(), 100.0 * sim.coverage());
   ro.max_size_px = 1600;
   cv::Mat frame = viz::render_map(sim.merged_map(), o, ro);
-  if (!impl_->writer.isOpened()) {
+  if (!impl_->writer) {
     // Even dimensions keep every codec happy; a little room for longer titles later.
     impl_->size = cv::Size(frame.cols + 40 + (frame.cols % 2), frame.rows + (frame.rows % 2));
     io::ensure_directory(impl_->path.parent_path());
     const auto& codecs = codecs_for(impl_->path.extension().string());
     for (const auto& c : codecs) {
-      const int fourcc = cv::VideoWriter::fourcc(c.fourcc[0], c.fourcc[1], c.fourcc[2], c.fourcc[3]);
-      if (impl_->writer.open(impl_->tmp.string(), cv::CAP_FFMPEG, fourcc, impl_->fps, impl_->size)) {
+      impl_->writer = impl_->module->open(impl_->tmp.c_str(), c.fourcc, impl_->fps, impl_->size.width, impl_->size.height);
+      if (impl_->writer) {
         impl_->codec = c.name;
         break;
       }
       impl_->note += fmt::format("{}OpenCV's FFmpeg cannot write {} ({:.4s})", impl_->note.empty() ? "" : "; ", c.name, std::string_view(c.fourcc, 4));
     }
-    if (!impl_->writer.isOpened()) {
+    if (!impl_->writer) {
       throw Error(impl_->path.string() + ": cannot open a video writer: " + impl_->note);
     }
     if (!impl_->note.empty()) impl_->note += "; wrote " + impl_->codec;
@@ -390,13 +448,16 @@ void RunVideo::add_frame(const Simulation& sim, const std::string& map_label) {
   }
   cv::Mat padded(impl_->size, CV_8UC3, cv::Scalar(255, 255, 255));
   frame.copyTo(padded(cv::Rect(0, 0, std::min(frame.cols, impl_->size.width), std::min(frame.rows, impl_->size.height))));
-  impl_->writer.write(padded);
+  if (impl_->module->write(impl_->writer, padded.data, padded.step, padded.cols, padded.rows) != 0) {
+    throw Error(impl_->path.string() + ": cannot write a frame");
+  }
   ++impl_->frames;
 }
 
 void RunVideo::finish() {
-  if (!impl_->writer.isOpened() || impl_->frames == 0) throw Error(impl_->path.string() + ": no frames to write");
-  impl_->writer.release();
+  if (!impl_->writer || impl_->frames == 0) throw Error(impl_->path.string() + ": no frames to write");
+  impl_->module->close(impl_->writer);
+  impl_->writer = nullptr;
   std::error_code ec;
   fs::rename(impl_->tmp, impl_->path, ec);
   if (ec) throw Error(impl_->path.string() + ": cannot move the video into place (" + ec.message() + ")");
