@@ -361,5 +361,42 @@ TEST(MapIoBadInput, BareImageWithBadResolution) {
   expect_input_error([&] { load_map(dir / "m.png", o); }, {"m.png", "resolution"});
 }
 
+// fleetmap writes PNG with libpng itself (it does not link OpenCV's image-file module); the files
+// must stay byte for byte what cv::imencode writes, as the committed maps and every earlier output
+// were: seeded images of each kind fleetmap writes (map images, pictures with and without alpha,
+// 16-bit), noise and flat areas with lines, at OpenCV's fast default and at level 9.
+TEST(MapIoEncode, PngBytesAreOpenCvsAndPgmIsNetpbm) {
+  cv::RNG rng(7);
+  const int types[] = {CV_8UC1, CV_8UC3, CV_8UC4, CV_16UC1};
+  for (int i = 0; i < 24; ++i) {
+    const int w = 1 + rng.uniform(0, 200), h = 1 + rng.uniform(0, 200);
+    cv::Mat image(h, w, types[i % 4]);
+    if (i % 3 == 0) {
+      rng.fill(image, cv::RNG::UNIFORM, 0, 256);
+    } else {
+      image.setTo(cv::Scalar::all(205));
+      image(cv::Rect(w / 4, h / 4, std::max(1, w / 2), std::max(1, h / 2))).setTo(cv::Scalar::all(254));
+      image.row(h / 2).setTo(cv::Scalar::all(0));
+    }
+    for (const int level : {-1, 9}) {
+      std::vector<uchar> expected;
+      std::vector<int> params;
+      if (level >= 0) params = {cv::IMWRITE_PNG_COMPRESSION, level};
+      ASSERT_TRUE(cv::imencode(".png", image, expected, params));
+      EXPECT_EQ(encode_png(image, level), std::string(expected.begin(), expected.end()))
+          << "type " << image.type() << ", " << w << " x " << h << ", level " << level;
+    }
+    if (image.channels() == 1) {
+      std::vector<uchar> expected;
+      ASSERT_TRUE(cv::imencode(".pgm", image, expected));
+      EXPECT_EQ(encode_image(".pgm", image, "test"), std::string(expected.begin(), expected.end()));
+    }
+  }
+  // What fleetmap cannot write is refused, naming the output.
+  expect_input_error([] { encode_image(".pgm", cv::Mat(4, 4, CV_8UC3, cv::Scalar::all(0)), "out.pgm"); }, {"out.pgm", ".png"});
+  expect_input_error([] { encode_image(".png", cv::Mat(4, 4, CV_32FC1, cv::Scalar::all(0)), "out.png"); }, {"out.png"});
+  expect_input_error([] { encode_image(".jpg", cv::Mat(4, 4, CV_8UC1, cv::Scalar::all(0)), "out.jpg"); }, {"out.jpg"});
+}
+
 }  // namespace
 }  // namespace fleetmap::io
