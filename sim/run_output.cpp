@@ -330,20 +330,23 @@ std::vector<fs::path> video_module_candidates() {
   return out;
 }
 
-// The module, loaded on first use (the first frame of a run's video).
+// The module, loaded on first use (a RunVideo being made).
 const VideoModule& video_module() {
   static const VideoModule module = [] {
     std::string tried;
+    const auto note = [&](const fs::path& path, const std::string& why) {
+      tried += (tried.empty() ? "" : ", ") + path.string() + (why.empty() ? "" : " (" + why + ")");
+    };
     for (const auto& path : video_module_candidates()) {
       std::error_code ec;
       if (!fs::is_regular_file(path, ec)) {
-        tried += (tried.empty() ? "" : ", ") + path.string();
+        note(path, "");
         continue;
       }
       void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
       if (!handle) {
         const char* why = dlerror();
-        tried += (tried.empty() ? "" : ", ") + path.string() + " (" + (why ? why : "cannot load") + ")";
+        note(path, why ? why : "cannot load");
         continue;
       }
       VideoModule m;
@@ -352,7 +355,7 @@ const VideoModule& video_module() {
       m.close = reinterpret_cast<fleetmap_video_close_fn>(dlsym(handle, "fleetmap_video_close"));
       if (m.open && m.write && m.close) return m;  // stays loaded for the program's life
       dlclose(handle);
-      tried += (tried.empty() ? "" : ", ") + path.string() + " (not fleetmap's video module)";
+      note(path, "not fleetmap's video module");
     }
     throw Error(std::string("cannot write a video: fleetmap's video module ") + FLEETMAP_VIDEO_MODULE_NAME +
                 " was not found (looked at " + tried + "); set FLEETMAP_VIDEO_MODULE to its path");

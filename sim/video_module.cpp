@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <type_traits>
 
 extern "C" {
 
@@ -42,3 +43,8 @@ __attribute__((visibility("default"))) void fleetmap_video_close(void* writer) {
 }
 
 }
+
+// The loader (sim/run_output.cpp) casts what dlsym finds to these types.
+static_assert(std::is_same_v<decltype(&fleetmap_video_open), fleetmap_video_open_fn>);
+static_assert(std::is_same_v<decltype(&fleetmap_video_write), fleetmap_video_write_fn>);
+static_assert(std::is_same_v<decltype(&fleetmap_video_close), fleetmap_video_close_fn>);

@@ -1,6 +1,6 @@
 #pragma once
 // The C interface of the video module (sim/video_module.cpp, built as its own shared object and
-// loaded by RunVideo on a run's first frame): OpenCV's video writer and the FFmpeg it links are
+// loaded when a RunVideo is made): OpenCV's video writer and the FFmpeg it links are
 // hundreds of shared libraries that would otherwise load, and cost 0.1 s, at every start of
 // every program that links fleetmap. Internal: not installed.
 #include <cstddef>
