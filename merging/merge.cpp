@@ -56,15 +56,29 @@ struct Candidate {
 // ranked below placements that fit almost nothing, and was dropped (seen in the simulator: two
 // robots' maps of a house, the right fit 254 walls in and 26 out at the search level, and the pair
 // merged with the room they shared turned a half turn). The full resolution judges it.
+// One such fit per turn: the largest agreeing fit, then the largest turned by more than 45 degrees
+// from it, and so on. A symmetric place has a large agreeing fit at each of its turns, and the
+// right one may be the smaller: seen in the simulator, two robots' maps of a rectangular hall, the
+// wrong placement turned a half turn 525 walls in and 58 out at full resolution, the right one
+// 356 in and 26 out (twice the score), but 216 in and 36 out on cells of two, where it ranked last
+// and went, and the pair merged 10 m off; the symmetry probes, pruned the same way, did not see it.
 void prune(std::vector<Candidate>& c, const PreparedGrid& b, const ConfidenceOptions& options, std::size_t keep,
            bool keep_leaders) {
   std::sort(c.begin(), c.end(), [](const Candidate& x, const Candidate& y) { return x.fit.score > y.fit.score; });
   const Eigen::Vector2d centre_b((b.width() - 1) / 2.0, (b.height() - 1) / 2.0);
-  std::size_t largest = c.size();
+  std::vector<std::size_t> agreeing;
   for (std::size_t i = 0; i < c.size(); ++i) {
     const LevelFit& f = c[i].fit;
-    const bool agrees = f.inliers > 0 && f.inliers >= options.zero_agreement * (f.inliers + f.outliers);
-    if (agrees && (largest == c.size() || f.inliers > c[largest].fit.inliers)) largest = i;
+    if (f.inliers > 0 && f.inliers >= options.zero_agreement * (f.inliers + f.outliers)) agreeing.push_back(i);
+  }
+  std::stable_sort(agreeing.begin(), agreeing.end(),
+                   [&](std::size_t i, std::size_t j) { return c[i].fit.inliers > c[j].fit.inliers; });
+  std::vector<std::size_t> largest;  // the largest agreeing fit of each turn
+  for (const std::size_t i : agreeing) {
+    const bool new_turn = std::all_of(largest.begin(), largest.end(), [&](std::size_t j) {
+      return std::abs(core::normalize_angle(c[i].fit.b_to_a.rotation() - c[j].fit.b_to_a.rotation())) > std::numbers::pi / 4.0;
+    });
+    if (new_turn) largest.push_back(i);
   }
   std::vector<Candidate> kept;
   const auto keep_unless_dup = [&](Candidate& x) {
@@ -73,14 +87,13 @@ void prune(std::vector<Candidate>& c, const PreparedGrid& b, const ConfidenceOpt
     kept.push_back(std::move(x));
   };
   std::size_t next = 0;
-  for (; next < c.size() && kept.size() < keep; ++next) {
-    if (next == largest) largest = c.size();  // kept in turn (or a duplicate of a better one)
-    keep_unless_dup(c[next]);
-  }
-  if (largest < c.size()) keep_unless_dup(c[largest]);
+  for (; next < c.size() && kept.size() < keep; ++next) keep_unless_dup(c[next]);
+  // Those below `next` are kept already, or were duplicates of better ones.
+  for (const std::size_t i : largest)
+    if (i >= next) keep_unless_dup(c[i]);
   if (keep_leaders) {
     for (std::size_t i = next; i < c.size(); ++i)
-      if (c[i].leader && i != largest) keep_unless_dup(c[i]);
+      if (c[i].leader && std::find(largest.begin(), largest.end(), i) == largest.end()) keep_unless_dup(c[i]);
   }
   c = std::move(kept);
 }
@@ -229,7 +242,16 @@ Placements other_placements(const PreparedGrid& a, const PreparedGrid& b, const 
   probe.translation_peaks = 4;
   QualityOptions fit_only = options.quality;
   fit_only.shape = false;
-  for (const auto& c : refine_candidates(a, b, overlap_hypotheses_at(a, b, turns, probe), options))
+  // Each turn's best proposal by the search's own ranking goes on from the coarse level where they
+  // enter (as a method's best does: refine_candidates): there a wall on the other map's free space
+  // weighs ten, and a rival that the full resolution scores higher than the answer may rank last
+  // (the hall of prune's comment). The finer levels keep each turn's largest agreeing fit.
+  std::vector<Hypothesis> proposals = overlap_hypotheses_at(a, b, turns, probe);
+  for (auto& h : proposals) {
+    const double from_answer = core::normalize_angle(h.b_to_a.rotation() - answer.rotation());
+    h.method = "probe, turn " + std::to_string(int(std::lround(from_answer / (std::numbers::pi / 2.0)) + 4) % 4);
+  }
+  for (const auto& c : refine_candidates(a, b, proposals, options))
     known.emplace_back(evaluate_alignment(a, b, c.fit.b_to_a, fit_only), c.fit.b_to_a);
   return known;
 }

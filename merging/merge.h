@@ -77,12 +77,20 @@ namespace fleetmap::merging {
 // half_evidence: the evidence (times distinctiveness) at which the last factor is 0.5, set on the
 // development benchmark of robot-built maps (bench/merging_real_bench.cpp) so that the default
 // min_confidence accepts no wrong answer there; bench/README.md shows the reliability table.
+// The symmetry probes run only on answers that could be merged (their confidence before the
+// distinctiveness reaches min_confidence), so a confidence below the threshold is an upper bound,
+// and a bar set by the best wrong answer below it was set by answers never probed: 13 was, by an
+// unrelated pair of bare houses at 0.46 that the probes put at 0.18 (another placement fits
+// nearly as well) and one at 0.45 that they refuse as one room. 9.5 is where the development sets
+// still merge no wrong answer with the probes run on every answer that could be merged
+// (bench/README.md, "The bar set by answers the probes never saw"); it merges right answers of
+// small overlaps and corridors that 13 refused.
 struct ConfidenceOptions {
   double zero_agreement = 0.85;
   double full_agreement = 0.95;
   double zero_acceptance = 0.93;
   double full_acceptance = 0.98;
-  double half_evidence = 13.0;
+  double half_evidence = 9.5;
   double zero_beyond_corner = 1.0;
   double full_beyond_corner = 4.0;
   double distinct_distance = 4.0;
@@ -111,8 +119,9 @@ struct MergeOptions {
   // can merge a wrong placement weakly (seen on a real laser map seen through 0.1 m cells: 29 m
   // off at 0.52, where the rotation sweep of the next step finds the truth at 0.999). The wrong
   // merges of the benchmark were at 0.52-0.62; checking merges up to 0.9 changed no decision
-  // between 0.75 and 0.9 and cost a third of the time of a set of bare rooms.
-  double sure_confidence = 0.75;
+  // between 0.75 and 0.9 and cost a third of the time of a set of bare rooms. (Those were
+  // confidences with half_evidence 13; the same evidence reads 0.85 with 9.5.)
+  double sure_confidence = 0.85;
   bool refine = true;            // refine candidates to sub-cell accuracy (off: the methods' raw answers)
   // Candidates kept after the level where they enter, when it is level 2 or coarser, and besides them
   // each method's best proposal at that level (its own ranking, Hypothesis::score): a few steps on
