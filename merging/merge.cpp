@@ -36,6 +36,12 @@ std::vector<Hypothesis> propose_features(const PreparedGrid& a, const PreparedGr
   return feature_hypotheses(a, b, options.features, random);
 }
 
+// Two placements of b turned from each other by more than 45 degrees: another turn of a symmetric
+// place (a room's quarter or half turn), not a variant of one placement.
+bool turned_apart(const core::Transform2& x, const core::Transform2& y) {
+  return std::abs(core::normalize_angle(x.rotation() - y.rotation())) > std::numbers::pi / 4.0;
+}
+
 bool same_answer(const core::Transform2& x, const core::Transform2& y, const Eigen::Vector2d& at_b,
                  const ConfidenceOptions& options) {
   const double dtheta = std::abs(core::rad2deg(core::normalize_angle(x.rotation() - y.rotation())));
@@ -61,7 +67,8 @@ struct Candidate {
 // right one may be the smaller: seen in the simulator, two robots' maps of a rectangular hall, the
 // wrong placement turned a half turn 525 walls in and 58 out at full resolution, the right one
 // 356 in and 26 out (twice the score), but 216 in and 36 out on cells of two, where it ranked last
-// and went, and the pair merged 10 m off; the symmetry probes, pruned the same way, did not see it.
+// and went, and the pair merged 10 m off (min_confidence 0.4 on the old scale of the confidence);
+// the symmetry probes, pruned the same way, did not see it.
 void prune(std::vector<Candidate>& c, const PreparedGrid& b, const ConfidenceOptions& options, std::size_t keep,
            bool keep_leaders) {
   std::sort(c.begin(), c.end(), [](const Candidate& x, const Candidate& y) { return x.fit.score > y.fit.score; });
@@ -76,7 +83,7 @@ void prune(std::vector<Candidate>& c, const PreparedGrid& b, const ConfidenceOpt
   std::vector<std::size_t> largest;  // the largest agreeing fit of each turn
   for (const std::size_t i : agreeing) {
     const bool new_turn = std::all_of(largest.begin(), largest.end(), [&](std::size_t j) {
-      return std::abs(core::normalize_angle(c[i].fit.b_to_a.rotation() - c[j].fit.b_to_a.rotation())) > std::numbers::pi / 4.0;
+      return turned_apart(c[i].fit.b_to_a, c[j].fit.b_to_a);
     });
     if (new_turn) largest.push_back(i);
   }
@@ -375,7 +382,6 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       // the answer (seen on the benchmark: a quarter-turned corner of one room laid on a's walls).
       if (plausible > second) plausible *= acceptance_factor_of(acceptance_index(a.level(0), from.level(0), t).omega());
       if (plausible > second) second = plausible, alternative = t;
-      const double dtheta = std::abs(core::normalize_angle(t.rotation() - answer.rotation()));
       // A turned placement fits as well when it is plausible, or when the maps contradict it at
       // most twice as often as the answer: contradictions come in clumps (an obstacle in a doorway
       // in one map, a wall the other saw through), and between two rough fits of one room a clump
@@ -386,7 +392,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       // simulator with scan matching: evidence 55 at 93% against the half-turned room's 35 at 98%).
       const bool as_rough = n > 0.0 && q.contradicted <= 2.0 * rate * n;
       const bool stronger = n > 0.0 && q.matched >= co.zero_agreement * n && evidence_of(q) >= own;
-      if ((z <= 2.0 || as_rough || stronger) && dtheta > std::numbers::pi / 4.0 && own > 0.0) turned = std::max(turned, evidence_of(q) / own);
+      if ((z <= 2.0 || as_rough || stronger) && turned_apart(t, answer) && own > 0.0) turned = std::max(turned, evidence_of(q) / own);
     }
     if (cleaner) return std::pair(0.0, cleaner);
     return std::pair(best.score > 0.0 ? clamp01(1.0 - second / best.score) : 0.0, alternative);
