@@ -713,7 +713,8 @@ std::string ambiguity_class(bool merged, bool found, merging::Refusal refusal) {
   switch (refusal) {
     case Refusal::AnotherPlacement: return "rival-fits-as-well";
     case Refusal::OneCorner: return "one-corner";
-    case Refusal::OneRoom: return "one-room";
+    case Refusal::OneRoom:
+    case Refusal::HallEnd: return "one-room";
     case Refusal::FreeToSlide:
     case Refusal::LittleFit: return "little-evidence";
     default: return "disagreement";

@@ -257,6 +257,39 @@ int junction_arms(const std::vector<Eigen::Vector2d>& points, const Line& l1, co
   return arms;
 }
 
+// Whether the first three of `lines` are one end of a hall: two of them parallel (within 10
+// degrees) and the third across them (within 10 degrees of square), with the points on the two
+// parallel lines (within `tolerance`) on one side of the third, more than `tolerance` off it, and
+// the points on the third between the other two. A U, whichever order the Hough transform found
+// its sides in.
+bool closed_end(const std::vector<Eigen::Vector2d>& points, const std::vector<Line>& lines, double tolerance) {
+  const double parallel = std::cos(10.0 * std::numbers::pi / 180.0), square = std::sin(10.0 * std::numbers::pi / 180.0);
+  for (int across = 0; across < 3; ++across) {
+    const Line& c = lines[std::size_t(across)];
+    const Line& s1 = lines[std::size_t((across + 1) % 3)];
+    const Line& s2 = lines[std::size_t((across + 2) % 3)];
+    if (std::abs(s1.normal.dot(s2.normal)) < parallel || std::abs(c.normal.dot(s1.normal)) > square) continue;
+    const double side_offset = s1.normal.dot(s2.on - s1.on);  // s2 from s1, along s1's normal
+    if (std::abs(side_offset) < 4.0 * tolerance) continue;  // one thick wall, not two
+    int before = 0, beyond = 0, between = 0, outside = 0;
+    for (const auto& p : points) {
+      const double along = c.normal.dot(p - c.on);
+      const double from_s1 = s1.normal.dot(p - s1.on), from_s2 = s2.normal.dot(p - s2.on);
+      if (std::abs(from_s1) <= tolerance || std::abs(from_s2) <= tolerance) {
+        if (along > tolerance) ++beyond;
+        else if (along < -tolerance) ++before;
+      } else if (std::abs(along) <= tolerance) {
+        // Between the parallel lines: on the same side of s1 as s2 is, and closer to s1 than s2 is.
+        const double t = from_s1 * (side_offset >= 0.0 ? 1.0 : -1.0);
+        if (t > 0.0 && t < std::abs(side_offset)) ++between;
+        else ++outside;
+      }
+    }
+    if (std::min(before, beyond) <= 1 && std::max(before, beyond) >= 3 && between >= 3 && outside <= 1) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a,
@@ -278,6 +311,7 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
     if (lines.size() >= 2) q.junction_arms = junction_arms(t.structure_positions, lines[0], lines[1], 2.0, 4.0, 3);
     q.wall_ends = t.wall_ends;
     q.beyond_room = left[3];
+    if (lines.size() >= 3 && closed_end(t.structure_positions, lines, 2.0)) q.beyond_end = left[2];
   }
   if (t.positions.size() < 3) return q;
   Eigen::Vector2d c = Eigen::Vector2d::Zero();

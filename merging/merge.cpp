@@ -443,6 +443,14 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   const bool one_room =
       co.min_turned_share > 0.0 && best_q.beyond_room <= co.zero_beyond_corner && turned >= co.min_turned_share;
   if (one_room) result.distinctiveness = 0.0;
+  // One end of a bare hall: the common walls are two parallel walls and one across them, nothing
+  // else (no wall off those lines, no opening in them seen by both). The two maps may show the
+  // same end or the two ends of a longer hall, each reaching into the other's unknown: the second
+  // placement lays no wall on a wall, so no probe finds it, and nothing in the maps tells which
+  // (seen in the simulator with scan matching: two robots' maps of a 25 m wide hall, each a U of
+  // its own end, merged turned a half turn, 19 m off, at confidence 0.60).
+  const bool hall_end = best_q.beyond_end >= 0 && best_q.beyond_end <= co.zero_beyond_corner && best_q.wall_ends == 0;
+  if (hall_end) result.distinctiveness = 0.0;
   const double support_factor = support(result.evidence * result.distinctiveness);
   // Matched wall ends count with the blocks off the corner's two lines: an opening in a wall, seen in
   // both maps at one place, tells the corner from the room's other corners as a wall beyond does.
@@ -460,6 +468,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       if (corner_factor < 0.5)
         return {Refusal::OneCorner, "the common walls are one corner (two straight walls), which fits any other corner of a bare room as well"};
       if (one_room) return {Refusal::OneRoom, "the common walls are the sides of one rectangular room, which fits itself turned as well"};
+      if (hall_end)
+        return {Refusal::HallEnd, "the common walls are one end of a bare hall (two parallel walls and one across), which the "
+                                  "hall's other end fits as well: the maps may show its two ends"};
       if (result.distinctiveness < 0.5)
         return {Refusal::AnotherPlacement, "another placement fits nearly as well, or without the answer's contradictions (repeated or symmetric places)"};
       if (constraint < co.half_evidence)

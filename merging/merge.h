@@ -74,6 +74,11 @@ namespace fleetmap::merging {
 //   the probes find a turned placement free of contradictions with at least that share of the
 //   answer's evidence, the distinctiveness is 0: which of the two lays more of one map on the other
 //   says nothing in a symmetric room.
+// - one end of a bare hall (AlignmentQuality::beyond_end): when the common walls are two parallel
+//   walls and one across them and nothing else (at most zero_beyond_corner blocks off those three
+//   lines, no matched wall end), the maps may show the same end or the two ends of a longer hall,
+//   each reaching into the other's unknown: the distinctiveness is 0. That second placement lays no
+//   wall on a wall, so no probe finds it.
 // half_evidence: the evidence (times distinctiveness) at which the last factor is 0.5, set on the
 // development benchmark of robot-built maps (bench/merging_real_bench.cpp) so that the default
 // min_confidence accepts no wrong answer there; bench/README.md shows the reliability table.
@@ -154,6 +159,7 @@ enum class Refusal {
   CellsDisagree,      // free in one, occupied in the other (acceptance)
   OneCorner,          // the common walls are one corner of a bare room
   OneRoom,            // the common walls are the sides of one rectangular room
+  HallEnd,            // the common walls are one end of a bare hall, which its other end fits as well
   AnotherPlacement,   // another placement fits nearly as well (distinctiveness)
   FreeToSlide,        // the common walls leave the placement free to slide or turn (constraint)
   LittleFit,          // too little of the common walls fits better than chance

@@ -201,6 +201,55 @@ TEST(AlignMaps, OneRectangularRoomTurnedAHalfTurnIsRefused) {
   expect_refused_as_one_room("bare_hall_step534_robot_1.png", "bare_hall_step534_robot_3.png");
 }
 
+// The wrong merge left in the simulator with scan matching (HouseExpo plan 84537130db40, the bare
+// hall, 25 m wide; the scenario above with `localization: {method: scan-matching}`, robot 3 into
+// robot 2 at step 222, both maps in the robots' common frame). Robot 2 saw the hall's top end and
+// robot 3 its bottom end, 31 m apart, each as three walls (a U) ending in unknown: turned a half
+// turn, one U lies on the other wall for wall (the run merged that, 19 m off, at 0.60), while the
+// right placement shares free space and no wall, so no probe finds it. Nothing in either map tells
+// the same end from the other: refused, saying why.
+TEST(AlignMaps, TheTwoEndsOfABareHallAreRefused) {
+  const auto a = load_houseexpo_map("bare_hall_scan_matching_step222_robot_2.png", 0.05);
+  const auto b = load_houseexpo_map("bare_hall_scan_matching_step222_robot_3.png", 0.05);
+  ASSERT_GT(a.count(mapping::CellState::Occupied), 500);
+  const MergeResult r = align_maps(a, b);
+  EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
+  EXPECT_EQ(r.refusal, Refusal::HallEnd) << r.reason;
+  EXPECT_NE(r.reason.find("end of a bare hall"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.quality.beyond_end, 0);
+  // The answer refused is the half turn (the truth is the identity, up to the drift).
+  EXPECT_GT(std::abs(core::rad2deg(r.transform.rotation())), 170.0) << r.transform;
+}
+
+// One end of the bare hall seen from two places (a U: the left wall and parts of the top and
+// bottom ones) is refused: the hall's other end, or the same end turned, fits it as well. With a short wall standing out
+// from the end wall, seen by both, which end it is is pinned: merged, within a cell.
+TEST(AlignMaps, OneEndOfABareHallIsMergedOnlyWithMoreThanItsWalls) {
+  for (const bool stub : {false, true}) {
+    SCOPED_TRACE(stub ? "a short wall out from the end wall" : "bare");
+    auto a = bare_hall_view({70, 150});
+    auto hall_b = bare_hall_view({90, 140});
+    if (stub) {
+      for (auto* g : {&a, &hall_b})
+        for (int y = 100; y < 102; ++y)
+          for (int x = 2; x < 30; ++x) g->set_state({x, y}, mapping::CellState::Occupied);
+    }
+    // b's own frame: turned by 20 degrees, its 320 x 320 window centred on where it looked from.
+    const core::Transform2 b_to_hall = core::Transform2(Eigen::Vector2d(90, 140), core::deg2rad(20.0)) *
+                                       core::Transform2(Eigen::Vector2d(-160, -160), 0.0);
+    const auto b = resample_grid(hall_b, b_to_hall, 320, 320);
+    const MergeResult r = align_maps(a, b);
+    if (stub) {
+      ASSERT_TRUE(r.merged) << r.reason;
+      EXPECT_LT(mean_displacement(r.transform, b_to_hall, b), 1.0) << r.transform;
+    } else {
+      EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
+      // The hall turned a half turn about the U fits it too, which the probes find here.
+      EXPECT_TRUE(r.refusal == Refusal::HallEnd || r.refusal == Refusal::OneRoom) << r.reason;
+    }
+  }
+}
+
 // Two robots' maps from the simulator (HouseExpo plan 95144b9b8ec8; three robots, ideal
 // localization, seed 2, communication range 8 m; robots 1 and 2 at step 80, written by
 // `fleetmap explore --merge-attempts`). Both saw the room they started in and a room beyond it on
