@@ -257,12 +257,12 @@ int junction_arms(const std::vector<Eigen::Vector2d>& points, const Line& l1, co
   return arms;
 }
 
-// Whether the first three of `lines` are one end of a hall: two of them parallel (within 10
-// degrees) and the third across them (within 10 degrees of square), with the points on the two
-// parallel lines (within `tolerance`) on one side of the third, more than `tolerance` off it, and
-// the points on the third between the other two. A U, whichever order the Hough transform found
-// its sides in.
-bool closed_end(const std::vector<Eigen::Vector2d>& points, const std::vector<Line>& lines, double tolerance) {
+// Which of the first three of `lines` closes one end of a hall, or -1: two of them parallel
+// (within 10 degrees, at least 4 tolerances apart) and the third across them (within 10 degrees of
+// square), with the points on the two parallel lines (within `tolerance`) on one side of the third,
+// more than `tolerance` off it, and the points on the third between the other two. A U, whichever
+// order the Hough transform found its sides in.
+int closed_end(const std::vector<Eigen::Vector2d>& points, const std::vector<Line>& lines, double tolerance) {
   const double parallel = std::cos(10.0 * std::numbers::pi / 180.0), square = std::sin(10.0 * std::numbers::pi / 180.0);
   for (int across = 0; across < 3; ++across) {
     const Line& c = lines[std::size_t(across)];
@@ -285,9 +285,28 @@ bool closed_end(const std::vector<Eigen::Vector2d>& points, const std::vector<Li
         else ++outside;
       }
     }
-    if (std::min(before, beyond) <= 1 && std::max(before, beyond) >= 3 && between >= 3 && outside <= 1) return true;
+    if (std::min(before, beyond) <= 1 && std::max(before, beyond) >= 3 && between >= 3 && outside <= 1) return across;
   }
-  return false;
+  return -1;
+}
+
+// The share of a map's free cells (every second row and column) that lie outside the strip
+// between the two parallel lines s1 and s2 by more than `margin`: what the map saw past a hall's
+// side walls. `to_a` places the map's cells in the frame of the lines.
+double free_outside_strip(const GridLevel& g, const core::Transform2& to_a, const Line& s1, const Line& s2, double margin) {
+  const double width = std::abs(s1.normal.dot(s2.on - s1.on));
+  // A cell is inside when its distance from the strip's centre line, along s1's normal, is at most
+  // half the width plus the margin.
+  const Eigen::Vector2d& n = s1.normal;
+  const double centre = 0.5 * (n.dot(s1.on) + n.dot(s2.on)), reach = 0.5 * width + margin;
+  long total = 0, out = 0;
+  for (int y = 0; y < g.height(); y += 2)
+    for (int x = 0; x < g.width(); x += 2) {
+      if (!g.is_free(x, y)) continue;
+      ++total;
+      out += std::abs(n.dot(to_a.apply(Eigen::Vector2d(x, y))) - centre) > reach;
+    }
+  return total > 0 ? double(out) / double(total) : 0.0;
 }
 
 }  // namespace
@@ -311,7 +330,19 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
     if (lines.size() >= 2) q.junction_arms = junction_arms(t.structure_positions, lines[0], lines[1], 2.0, 4.0, 3);
     q.wall_ends = t.wall_ends;
     q.beyond_room = left[3];
-    if (lines.size() >= 3 && closed_end(t.structure_positions, lines, 2.0)) q.beyond_end = left[2];
+    if (lines.size() >= 3) {
+      const int across = closed_end(t.structure_positions, lines, 2.0);
+      if (across >= 0) {
+        // One end of a hall only if neither map saw past the hall's side walls (its free cells
+        // between them): a map that saw rooms beside the hall shows where along it the end is.
+        const Line& s1 = lines[std::size_t((across + 1) % 3)];
+        const Line& s2 = lines[std::size_t((across + 2) % 3)];
+        constexpr double kMargin = 4.0, kMostOutside = 0.02;
+        if (free_outside_strip(a.level(0), core::Transform2::identity(), s1, s2, kMargin) <= kMostOutside &&
+            free_outside_strip(b.level(0), b_to_a, s1, s2, kMargin) <= kMostOutside)
+          q.beyond_end = left[2];
+      }
+    }
   }
   if (t.positions.size() < 3) return q;
   Eigen::Vector2d c = Eigen::Vector2d::Zero();

@@ -75,10 +75,12 @@ struct AlignmentQuality {
   // rectangular room (or fewer lines), which fits itself turned a half turn.
   int beyond_room = 0;
   // When the three lines that hold the most matched walls are one end of a hall (two parallel walls
-  // and one across them, the parallel walls' blocks on one side of it): the blocks off those three
-  // lines. 0 when the common walls are the closed end of a bare hall or corridor and nothing else,
-  // which the other end of a longer hall fits as well: each map may have seen a different end.
-  // -1 when the three lines are not such an end (or shape is off).
+  // and one across them, the parallel walls' blocks on one side of it) and neither map saw past the
+  // two parallel walls (at most 2% of its free cells more than 4 cells outside them): the blocks
+  // off those three lines. 0 when the common walls are the closed end of a bare hall or corridor
+  // and nothing else, which the other end of a longer hall fits as well: each map may have seen a
+  // different end. -1 when the three lines are not such an end, or a map saw rooms beside it, whose
+  // place along it tells where the end is (or shape is off).
   int beyond_end = -1;
   double overlap_radius = 0.0;  // RMS distance of the matched walls from their centroid, in cells
   Eigen::Vector2d overlap_centre = Eigen::Vector2d::Zero();  // that centroid, in a's cells

@@ -444,11 +444,14 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       co.min_turned_share > 0.0 && best_q.beyond_room <= co.zero_beyond_corner && turned >= co.min_turned_share;
   if (one_room) result.distinctiveness = 0.0;
   // One end of a bare hall: the common walls are two parallel walls and one across them, nothing
-  // else (no wall off those lines, no opening in them seen by both). The two maps may show the
-  // same end or the two ends of a longer hall, each reaching into the other's unknown: the second
-  // placement lays no wall on a wall, so no probe finds it, and nothing in the maps tells which
-  // (seen in the simulator with scan matching: two robots' maps of a 25 m wide hall, each a U of
-  // its own end, merged turned a half turn, 19 m off, at confidence 0.60).
+  // else (no wall off those lines, no opening in them seen by both), and neither map saw past the
+  // two parallel walls. The two maps may show the same end or the two ends of a longer hall, each
+  // reaching into the other's unknown: the second placement lays no wall on a wall, so no probe
+  // finds it, and nothing in the maps tells which (seen in the simulator with scan matching: two
+  // robots' maps of a 25 m wide hall, each a U of its own end, merged turned a half turn, 19 m off,
+  // at confidence 0.60). Rooms beside the hall, seen by either map, would lie on the other map's
+  // rooms or walls at the other end: the end is determined (seen in the simulator: three sides of
+  // a room in common, each map holding the rooms on its own side, merged right at 0.61).
   const bool hall_end = best_q.beyond_end >= 0 && best_q.beyond_end <= co.zero_beyond_corner && best_q.wall_ends == 0;
   if (hall_end) result.distinctiveness = 0.0;
   const double support_factor = support(result.evidence * result.distinctiveness);

@@ -76,9 +76,9 @@ namespace fleetmap::merging {
 //   says nothing in a symmetric room.
 // - one end of a bare hall (AlignmentQuality::beyond_end): when the common walls are two parallel
 //   walls and one across them and nothing else (at most zero_beyond_corner blocks off those three
-//   lines, no matched wall end), the maps may show the same end or the two ends of a longer hall,
-//   each reaching into the other's unknown: the distinctiveness is 0. That second placement lays no
-//   wall on a wall, so no probe finds it.
+//   lines, no matched wall end), and neither map saw past the two parallel walls, the maps may show
+//   the same end or the two ends of a longer hall, each reaching into the other's unknown: the
+//   distinctiveness is 0. That second placement lays no wall on a wall, so no probe finds it.
 // half_evidence: the evidence (times distinctiveness) at which the last factor is 0.5, set on the
 // development benchmark of robot-built maps (bench/merging_real_bench.cpp) so that the default
 // min_confidence accepts no wrong answer there; bench/README.md shows the reliability table.

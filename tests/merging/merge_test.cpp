@@ -204,7 +204,8 @@ TEST(AlignMaps, OneRectangularRoomTurnedAHalfTurnIsRefused) {
 // The wrong merge left in the simulator with scan matching (HouseExpo plan 84537130db40, the bare
 // hall, 25 m wide; the scenario above with `localization: {method: scan-matching}`, robot 3 into
 // robot 2 at step 222, both maps in the robots' common frame). Robot 2 saw the hall's top end and
-// robot 3 its bottom end, 31 m apart, each as three walls (a U) ending in unknown: turned a half
+// robot 3 its bottom end, 31 m apart, each as three walls (a U) ending in unknown, and neither
+// anything past the hall's side walls: turned a half
 // turn, one U lies on the other wall for wall (the run merged that, 19 m off, at 0.60), while the
 // right placement shares free space and no wall, so no probe finds it. Nothing in either map tells
 // the same end from the other: refused, saying why.
@@ -219,6 +220,23 @@ TEST(AlignMaps, TheTwoEndsOfABareHallAreRefused) {
   EXPECT_EQ(r.quality.beyond_end, 0);
   // The answer refused is the half turn (the truth is the identity, up to the drift).
   EXPECT_GT(std::abs(core::rad2deg(r.transform.rotation())), 170.0) << r.transform;
+}
+
+// Three sides of one room are what two robots' maps share (HouseExpo plan 5c4be780b96b; the scenario
+// above, ideal localization, robots 1 and 3 at step 65), but each map also holds the rooms on its
+// own side, past the room's side walls: the room is no hall whose other end could be the same
+// shape, and the maps' other rooms would lie on each other's. Merged (the run merged it, 7 mm off),
+// not refused as one end of a bare hall. The truth: robot 3's map is in robot 2's frame (they merged
+// at step 20), and robot 2 started 0.6 m from robot 1 along x, facing the same way; the maps'
+// origins differ by 0.5 m along both axes.
+TEST(AlignMaps, ThreeSidesOfARoomWithRoomsBesideItAreNoHallEnd) {
+  const auto a = load_houseexpo_map("house_5c4be780b96b_step65_robot_1.png", 0.05);
+  const auto b = load_houseexpo_map("house_5c4be780b96b_step65_robot_3.png", 0.05);
+  const core::Transform2 truth(2.0, -10.0, 0.0);
+  const MergeResult r = align_maps(a, b);
+  ASSERT_TRUE(r.merged) << r.reason;
+  EXPECT_EQ(r.quality.beyond_end, -1);
+  EXPECT_LT(mean_displacement(r.transform, truth, b), 1.0) << r.transform;
 }
 
 // One end of the bare hall seen from two places (a U: the left wall and parts of the top and
