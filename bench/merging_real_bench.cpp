@@ -30,7 +30,8 @@
 //
 // --real-maps: windows of maps the user gives (real laser maps: map_server YAML, PGM, PNG), cut as
 // above but without added clutter (set "real300", or "realN" with --real-window N), and unrelated
-// pairs of windows of two of them. They are loaded first, and the HouseExpo maps only when a set of
+// pairs of windows of two of them (of two resolutions: the finer window seen through the coarser
+// one's cells, as `fleetmap merge` aligns them). They are loaded first, and the HouseExpo maps only when a set of
 // house pairs is asked for. --real-coarsen F sees them through cells F times larger
 // (mapping::coarsen), as a robot mapping at F times the cell size would: the check at another
 // resolution.
@@ -974,6 +975,11 @@ int main(int argc, char** argv) {
         try {
           merging::CropPair ci = merging::make_crop_pair(real[i].second, one, random);
           merging::CropPair cj = merging::make_crop_pair(real[j].second, one, random);
+          // Maps of two resolutions are compared as `fleetmap merge` compares them: through the
+          // coarser map's cells.
+          const double coarser = std::max(ci.a.resolution(), cj.b.resolution());
+          if (ci.a.resolution() != coarser) ci.a = mapping::resample(ci.a, coarser);
+          if (cj.b.resolution() != coarser) cj.b = mapping::resample(cj.b, coarser);
           pairs.push_back(std::make_unique<Pair>(Pair{"unrelated", real[i].first + "/" + real[j].first, 0.0, std::move(ci.a),
                                                       std::move(cj.b), std::nullopt, {}}));
         } catch (const Error&) {

@@ -32,8 +32,9 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kConvention =
-    "pixel (u, v) of an input (u = column, v = row from the top) lies at R(theta) (u, v) + (tx, ty) in the first "
-    "input's pixel grid, R(theta) = [[cos, -sin], [sin, cos]]";
+    "pixel (u, v) of an input (u = column, v = row from the top) lies at scale R(theta) (u, v) + (tx, ty) in the "
+    "first input's pixel grid, R(theta) = [[cos, -sin], [sin, cos]], scale = the input's metres per cell / the first's "
+    "(1 for maps of one resolution)";
 
 struct MergeCommandOptions {
   std::vector<std::string> maps;
@@ -46,20 +47,47 @@ struct MergeCommandOptions {
   double resolution = 0.05;
 };
 
-// An input's transform into the first input's pixel grid, as the convention states it.
-core::Transform2 to_first_pixels(const core::Transform2& cells, const mapping::OccupancyGrid& first,
-                                 const mapping::OccupancyGrid& input) {
-  return merging::flip_rows(cells, first.height(), input.height());
+// A placement in cells of `from` metres turned into cells of `to` metres: a cell's centre (c + 1/2)
+// cells from the origin corner, so c_a = R c_b + t is m_a = R m_b + from (t + h - R h) in metres,
+// h = (1/2, 1/2).
+core::Transform2 rescale_cells(const core::Transform2& t, double from, double to) {
+  const Eigen::Vector2d h(0.5, 0.5);
+  const Eigen::Matrix2d r = t.rotation_matrix();
+  const Eigen::Vector2d metres = from * (t.translation() + h - r * h);
+  return {metres / to - h + r * h, t.rotation()};
 }
 
-nlohmann::json transform_json(const std::string& map, const core::Transform2& pixels, const merging::MergeResult& pair,
+// An input's place in the first input's pixel grid, as the convention states it: its pixel p lies at
+// scale R(theta) p + t.
+struct PixelPlacement {
+  core::Transform2 rigid;  // R(theta) and t
+  double scale = 1.0;
+};
+
+// `cells` takes the cells of `merged` (the input as merged: `original`, resampled to the first
+// input's resolution when its own differs) into the first input's cells. A pixel (u, v) of
+// `original` is the cell (u, H - 1 - v), whose centre lies s (u, H - 1 - v) + c (1, 1) in
+// `merged`'s cells (same origin; s = its cell size / the first's, c = (s - 1) / 2), which is the
+// pixel s (u, v) + o of `merged`; the rigid placement of `merged`'s pixels then gives
+// s R p + (R o + t).
+PixelPlacement to_first_pixels(const core::Transform2& cells, const mapping::OccupancyGrid& first,
+                               const mapping::OccupancyGrid& merged, const mapping::OccupancyGrid& original) {
+  const core::Transform2 rigid = merging::flip_rows(cells, first.height(), merged.height());
+  const double s = original.resolution() / merged.resolution();
+  const double c = (s - 1.0) / 2.0;
+  const Eigen::Vector2d o(c, merged.height() - 1.0 - s * (original.height() - 1.0) - c);
+  return {core::Transform2(rigid.rotation_matrix() * o + rigid.translation(), rigid.rotation()), s};
+}
+
+nlohmann::json transform_json(const std::string& map, const PixelPlacement& pixels, const merging::MergeResult& pair,
                               double confidence, const std::string& method, const std::string& via) {
   nlohmann::json j;
   j["map"] = map;
   j["merged"] = true;
-  j["tx"] = pixels.translation().x();
-  j["ty"] = pixels.translation().y();
-  j["theta_deg"] = core::rad2deg(pixels.rotation());
+  j["tx"] = pixels.rigid.translation().x();
+  j["ty"] = pixels.rigid.translation().y();
+  j["theta_deg"] = core::rad2deg(pixels.rigid.rotation());
+  j["scale"] = pixels.scale;
   j["acceptance"] = pair.acceptance;
   j["confidence"] = confidence;
   j["method"] = method;
@@ -147,25 +175,55 @@ int run_merge(const MergeCommandOptions& o) {
   std::FILE* report = report_stream(outputs);
   io::MapLoadOptions load;
   load.default_resolution = o.resolution;
-  std::vector<mapping::OccupancyGrid> grids;
+  // Maps of different resolutions are aligned through the coarsest map's cells (a finer map's walls
+  // pooled, as mapping::resample keeps them; a coarse map drawn on finer cells would have walls
+  // twice as thick as the fine map's, on its free cells), and fused in the first map's cells.
+  std::vector<mapping::OccupancyGrid> originals;
   for (const auto& m : o.maps) {
-    grids.push_back(maps::load_map_source(m, load));
-    const auto& g = grids.back();
-    if (g.known_count() == 0) throw InputError(m + ": every cell is unknown; there is nothing to merge");
-    const double r0 = grids.front().resolution();
-    if (std::abs(g.resolution() - r0) > 1e-9 * r0) {
-      throw InputError(fmt::format("{}: resolution {} m differs from {}'s {} m; merge maps of one resolution", m,
-                                   g.resolution(), o.maps.front(), r0));
-    }
+    originals.push_back(maps::load_map_source(m, load));
+    if (originals.back().known_count() == 0) throw InputError(m + ": every cell is unknown; there is nothing to merge");
   }
-  std::vector<const mapping::OccupancyGrid*> pointers;
-  for (const auto& g : grids) pointers.push_back(&g);
+  const double r0 = originals.front().resolution();
+  double coarsest = r0;
+  for (const auto& g : originals) coarsest = std::max(coarsest, g.resolution());
+  const auto same = [](double x, double y) { return std::abs(x - y) <= 1e-9 * std::max(x, y); };
+  // Each map in cells of `resolution`: itself, or its resampled copy, kept in `cells`.
+  const auto in_cells = [&](double resolution, std::vector<mapping::OccupancyGrid>& cells) {
+    std::vector<const mapping::OccupancyGrid*> out;
+    cells.reserve(originals.size());
+    for (std::size_t i = 0; i < originals.size(); ++i) {
+      const auto& g = originals[i];
+      if (same(g.resolution(), resolution)) {
+        out.push_back(&g);
+        continue;
+      }
+      const double count = double(g.width()) * double(g.height()) * std::pow(g.resolution() / resolution, 2.0);
+      if (count > double(load.max_cells)) {
+        throw InputError(fmt::format("{}: its {} m cells seen through {} m cells would make {:.0f} cells, over the "
+                                     "limit of {}; give a map of coarser cells first",
+                                     o.maps[i], g.resolution(), resolution, count, load.max_cells));
+      }
+      cells.push_back(mapping::resample(g, resolution));
+      out.push_back(&cells.back());
+    }
+    return out;
+  };
+  std::vector<mapping::OccupancyGrid> aligned_cells, fused_cells;
+  const std::vector<const mapping::OccupancyGrid*> fused_grids = in_cells(r0, fused_cells);
+  const std::vector<const mapping::OccupancyGrid*> pointers =
+      same(coarsest, r0) ? fused_grids : in_cells(coarsest, aligned_cells);
 
   merging::MergeOptions options;
   options.method = o.method;
   options.min_confidence = o.min_confidence;
   options.seed = o.seed;
   const merging::MultiMergeResult merged = merging::merge_maps(pointers, options);
+  // The placements in the first map's cells, for the fused map and the pixels.
+  merging::MultiMergeResult in_first = merged;
+  for (auto& t : in_first.to_first) {
+    if (t) t = rescale_cells(*t, coarsest, r0);
+  }
+  in_first.max_loop_gap *= coarsest / r0;
 
   // The pair that placed each input, for its acceptance.
   const auto pair_of = [&](int i, int parent) -> const merging::MergeResult& {
@@ -181,7 +239,11 @@ int run_merge(const MergeCommandOptions& o) {
   j["transforms"] = nlohmann::json::array();
   int placed = 1;
   fmt::print(report, "{}: the reference (first input)\n", o.maps.front());
-  for (std::size_t i = 1; i < grids.size(); ++i) {
+  if (!fused_cells.empty()) {
+    fmt::print(report, "maps of different resolutions: aligned through {} m cells (the coarsest), fused in {}'s {} m cells\n",
+               coarsest, o.maps.front(), r0);
+  }
+  for (std::size_t i = 1; i < originals.size(); ++i) {
     const auto& name = o.maps[i];
     if (!merged.to_first[i]) {
       nlohmann::json t;
@@ -193,19 +255,21 @@ int run_merge(const MergeCommandOptions& o) {
       continue;
     }
     ++placed;
-    const core::Transform2 pixels = to_first_pixels(*merged.to_first[i], grids.front(), grids[i]);
+    const PixelPlacement pixels = to_first_pixels(*in_first.to_first[i], originals.front(), *fused_grids[i], originals[i]);
     const int parent = merged.parent[i];
     const auto& pair = pair_of(int(i), parent);
     j["transforms"].push_back(transform_json(name, pixels, pair, merged.confidence[i], merged.method[i],
                                              o.maps[std::size_t(parent)]));
-    fmt::print(report, "{}: tx {:.2f} ty {:.2f} px, theta {:.3f} deg, acceptance {:.3f}, confidence {:.2f} ({}, via {})\n",
-               name, pixels.translation().x(), pixels.translation().y(), core::rad2deg(pixels.rotation()),
-               pair.acceptance, merged.confidence[i], merged.method[i], o.maps[std::size_t(parent)]);
+    const std::string scale = pixels.scale == 1.0 ? "" : fmt::format(", scale {:.4g}", pixels.scale);
+    fmt::print(report, "{}: tx {:.2f} ty {:.2f} px, theta {:.3f} deg{}, acceptance {:.3f}, confidence {:.2f} ({}, via {})\n",
+               name, pixels.rigid.translation().x(), pixels.rigid.translation().y(),
+               core::rad2deg(pixels.rigid.rotation()), scale, pair.acceptance, merged.confidence[i], merged.method[i],
+               o.maps[std::size_t(parent)]);
   }
   j["merged_maps"] = placed;
-  j["max_loop_gap_px"] = merged.max_loop_gap;
+  j["max_loop_gap_px"] = in_first.max_loop_gap;
 
-  const merging::FusedMap fused = merging::fuse_merged(pointers, merged);
+  const merging::FusedMap fused = merging::fuse_merged(fused_grids, in_first);
   j["conflict_cells"] = fused.conflict_cells;
   if (!o.json.empty()) write_output(o.json, j.dump(2) + "\n");
   if (out_is_map) io::save_map(fused.grid, o.out);
@@ -213,9 +277,9 @@ int run_merge(const MergeCommandOptions& o) {
   for (const auto& out : outputs) {
     if (!out.path.empty() && !io::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
   }
-  if (placed < int(grids.size())) {
+  if (placed < int(originals.size())) {
     fmt::print(stderr, "fleetmap merge: {} of {} maps merged; the others have no reliable overlap\n", placed,
-               grids.size());
+               originals.size());
     return 1;
   }
   return 0;
@@ -230,8 +294,10 @@ Command add_merge_command(CLI::App& root) {
                 "\nEvery answer has a confidence in [0, 1]; below --min-confidence a map is not merged (\"no reliable\n"
                 "overlap\"): a wrong merge is worse than none. More than two maps: every pair is aligned, and the most\n"
                 "confident pairs chain each map to the first.\n"
+                "Maps of different resolutions are aligned through the coarsest map's cells and fused in the first's.\n"
                 "--json holds `transforms`: per input after the first, map, merged, tx, ty (pixels), theta_deg,\n"
-                "acceptance, confidence, method, via (the input it was aligned to); or merged: false and the reason.\n"
+                "scale, acceptance, confidence, method, via (the input it was aligned to); or merged: false and the\n"
+                "reason.\n"
                 "The picture tints each input's free cells in its own colour, walls black; red cells are free in one\n"
                 "map, occupied in another; it holds the known cells and half a metre around them, with metre axes. A map file (--out merged.yaml) holds the fused map as map_server writes maps (0 occupied,\n"
                 "254 free, 205 unknown), with the first map's resolution and origin: `fleetmap plan --map merged.yaml`\n"

@@ -5,6 +5,8 @@
 #include <limits>
 #include <ostream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/error.h"
 
@@ -79,43 +81,71 @@ std::ostream& operator<<(std::ostream& os, const OccupancyGrid& g) {
 OccupancyGrid coarsen(const OccupancyGrid& fine, int factor) {
   if (factor < 1) throw Error("coarsen: factor must be at least 1, got " + std::to_string(factor));
   if (factor == 1) return fine;
-  const int w = fine.width(), h = fine.height();
-  const int cw = (w + factor - 1) / factor, ch = (h + factor - 1) / factor;
-  OccupancyGrid coarse(GridGeometry(fine.resolution() * factor, cw, ch, fine.geometry().origin()), fine.options());
-  const float occupied = float(probability_to_log_odds(fine.options().occupied_threshold));
-  const float free = float(probability_to_log_odds(fine.options().free_threshold));
-  // Per coarse column of the current band of rows: free cells, their log-odds sum, the largest log-odds.
-  std::vector<int> free_cells(static_cast<std::size_t>(cw));
-  std::vector<float> free_sum(static_cast<std::size_t>(cw)), most(static_cast<std::size_t>(cw));
-  const auto& l = fine.log_odds_data();
-  for (int cy = 0; cy < ch; ++cy) {
-    std::fill(free_cells.begin(), free_cells.end(), 0);
-    std::fill(free_sum.begin(), free_sum.end(), 0.0f);
-    std::fill(most.begin(), most.end(), -std::numeric_limits<float>::infinity());
-    const int y_end = std::min(h, (cy + 1) * factor);
-    for (int y = cy * factor; y < y_end; ++y) {
-      const float* row = l.data() + std::size_t(y) * std::size_t(w);
-      for (int x = 0; x < w; ++x) {
-        const float v = row[x];
-        const auto cx = std::size_t(x / factor);
-        most[cx] = std::max(most[cx], v);
-        if (v < free) {
-          ++free_cells[cx];
-          free_sum[cx] += v;
+  return resample(fine, fine.resolution() * factor);
+}
+
+namespace {
+
+// For each new cell along one axis, the old cells whose centres lie inside it, [first, end); the
+// old cell holding its centre when none does. `ratio` = new cell size / old cell size.
+std::vector<std::pair<int, int>> covered_cells(int old_count, int new_count, double ratio) {
+  std::vector<std::pair<int, int>> ranges(static_cast<std::size_t>(new_count));
+  for (int k = 0; k < new_count; ++k) {
+    // Old cell i's centre is at i + 0.5 old cells; it lies in [k, k + 1) new cells when
+    // k * ratio - 0.5 <= i < (k + 1) * ratio - 0.5.
+    int first = std::max(0, int(std::ceil(k * ratio - 0.5)));
+    int end = std::min(old_count, int(std::ceil((k + 1) * ratio - 0.5)));
+    if (first >= end) {
+      first = std::clamp(int(std::floor((k + 0.5) * ratio)), 0, old_count - 1);
+      end = first + 1;
+    }
+    ranges[static_cast<std::size_t>(k)] = {first, end};
+  }
+  return ranges;
+}
+
+}  // namespace
+
+OccupancyGrid resample(const OccupancyGrid& grid, double resolution) {
+  if (!(resolution > 0.0) || !std::isfinite(resolution)) {
+    throw Error("resample: resolution must be positive, got " + std::to_string(resolution));
+  }
+  const double ratio = resolution / grid.resolution();
+  const int w = grid.width(), h = grid.height();
+  // Rounded up to whole cells; a sliver of a millionth of a cell (the ratio's rounding) is none.
+  const auto cells_for = [&](int old_count) { return std::max(0, int(std::ceil(old_count / ratio - 1e-6))); };
+  const int nw = cells_for(w), nh = cells_for(h);
+  OccupancyGrid out(GridGeometry(resolution, nw, nh, grid.geometry().origin()), grid.options());
+  if (w == 0 || h == 0) return out;
+  const float occupied = float(probability_to_log_odds(grid.options().occupied_threshold));
+  const float free = float(probability_to_log_odds(grid.options().free_threshold));
+  const auto columns = covered_cells(w, nw, ratio), rows = covered_cells(h, nh, ratio);
+  const auto& l = grid.log_odds_data();
+  for (int ny = 0; ny < nh; ++ny) {
+    const auto [y0, y1] = rows[static_cast<std::size_t>(ny)];
+    for (int nx = 0; nx < nw; ++nx) {
+      const auto [x0, x1] = columns[static_cast<std::size_t>(nx)];
+      float most = -std::numeric_limits<float>::infinity(), free_sum = 0.0f;
+      int free_cells = 0;
+      for (int y = y0; y < y1; ++y) {
+        const float* row = l.data() + std::size_t(y) * std::size_t(w);
+        for (int x = x0; x < x1; ++x) {
+          const float v = row[x];
+          most = std::max(most, v);
+          if (v < free) {
+            ++free_cells;
+            free_sum += v;
+          }
         }
       }
-    }
-    const int rows = y_end - cy * factor;
-    for (int cx = 0; cx < cw; ++cx) {
-      const int cells = rows * (std::min(w, (cx + 1) * factor) - cx * factor);
-      const auto k = std::size_t(cx);
+      const int cells = (y1 - y0) * (x1 - x0);
       float v = 0.0f;
-      if (most[k] > occupied) v = most[k];
-      else if (2 * free_cells[k] >= cells) v = free_sum[k] / float(free_cells[k]);
-      if (v != 0.0f) coarse.set_log_odds({cx, cy}, v);
+      if (most > occupied) v = most;
+      else if (2 * free_cells >= cells) v = free_sum / float(free_cells);
+      if (v != 0.0f) out.set_log_odds({nx, ny}, v);
     }
   }
-  return coarse;
+  return out;
 }
 
 }  // namespace fleetmap::mapping

@@ -121,8 +121,16 @@ std::ostream& operator<<(std::ostream& os, const OccupancyGrid& g);
 // wall never disappears; it takes the largest log-odds of the block), Free when at least half of
 // its cells are Free and none Occupied (mean log-odds of those free cells: the unseen gaps between
 // far beams do not turn free space into unknown), and Unknown otherwise. factor 1 returns a copy.
-// Throws fleetmap::Error unless factor >= 1.
+// Throws fleetmap::Error unless factor >= 1. (resample with resolution * factor.)
 OccupancyGrid coarsen(const OccupancyGrid& fine, int factor);
+
+// The grid seen through cells of another size (same origin and options; the extent rounded up to
+// whole cells), as two robots with different map resolutions need before their maps can be
+// compared cell by cell. A new cell takes the cells whose centres lie inside it, by coarsen's rule
+// (Occupied when any is, Free when at least half are Free), or, when no centre lies inside it (a
+// finer resolution), the cell it lies in. A whole number of times coarser is coarsen's result
+// exactly. Throws fleetmap::Error unless resolution > 0.
+OccupancyGrid resample(const OccupancyGrid& grid, double resolution);
 
 template <typename OnCell>
 int OccupancyGrid::integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit, OnCell&& on_cell) {

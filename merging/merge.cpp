@@ -506,6 +506,10 @@ PrepareOptions prepare_options(const MergeOptions& options) {
 MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const MergeOptions& options) {
   check_merge_method(options.method);
   check_search_options(options);
+  const double ra = a.grid().resolution(), rb = b.grid().resolution();
+  if (std::abs(ra - rb) > 1e-9 * ra)
+    throw InputError(fmt::format("merge: the maps' cells are {} m and {} m; resample one to the other's resolution first",
+                                 ra, rb));
   const double needed = needed_wall_distance(options);
   if (a.max_wall_distance() < needed || b.max_wall_distance() < needed)
     throw InputError(fmt::format("merge options: the maps were prepared with max_wall_distance {} cells, the "

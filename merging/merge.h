@@ -220,7 +220,8 @@ class KnownPart {
 MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b);
 
 // Aligns b to a. Never throws for hard inputs (no walls, no overlap): the result says why it did
-// not merge. Throws InputError for an unknown method name.
+// not merge. Throws InputError for an unknown method name, and for maps of different resolutions
+// (cells are compared one to one: mapping::resample one map to the other's cells first).
 MergeResult align_maps(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
                        const MergeOptions& options = {});
 // The same on grids prepared once (N-map merging prepares each map once for all its pairs), with

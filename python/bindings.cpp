@@ -314,6 +314,18 @@ PYBIND11_MODULE(_fleetmap, m) {
             else io::save_map_image(g, path);
           },
           py::arg("path"), ".yaml / .yml: map_server YAML and a .pgm beside it; .png / .pgm: the image alone.")
+      .def(
+          "resampled", [](const mapping::OccupancyGrid& g, double resolution) {
+            if (!(resolution >= io::kResolutionRange.lo && resolution <= io::kResolutionRange.hi)) {
+              throw InputError("resampled: resolution: expected " + core::expected_text(io::kResolutionRange) +
+                               " metres per cell");
+            }
+            return mapping::resample(g, resolution);
+          },
+          py::arg("resolution"),
+          "The map seen through cells of `resolution` metres (same origin and extent): a cell is occupied when "
+          "any cell of the old map inside it is, free when half of them are. Maps must share a resolution to be "
+          "merged: resample one to the other's.")
       .def("__repr__", [](const mapping::OccupancyGrid& g) {
         return "<fleetmap.Map " + std::to_string(g.width()) + " x " + std::to_string(g.height()) + " cells of " +
                std::to_string(g.resolution()) + " m>";

@@ -40,6 +40,9 @@ class Map:
     def occupied_cells(self) -> int: ...
     def save(self, path: PathLike) -> None:
         """.yaml: map_server YAML plus a .pgm beside it; .png / .pgm: the image alone."""
+    def resampled(self, resolution: float) -> "Map":
+        """The map seen through cells of `resolution` metres (same origin and extent): a cell is
+        occupied when any old cell inside it is, free when half of them are."""
 
 class MergeResult:
     merged: bool

@@ -150,8 +150,19 @@ TEST(DataSafety, MessagesNameNumbersAsTyped) {
   TempDir dir;
   write_room_map(dir, "a");
   dir.write("b/map.yaml", "image: ../a/map.pgm\nresolution: 0.05\n");
-  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge a/map.yaml b/map.yaml", dir),
-                        "b/map.yaml: resolution 0.05 m differs from a/map.yaml's 0.1 m");
+  const auto r = run_fleetmap("merge a/map.yaml b/map.yaml --out m.png", dir);
+  EXPECT_NE(r.out.find("maps of different resolutions: aligned through 0.1 m cells (the coarsest), fused in a/map.yaml's 0.1 m cells"), std::string::npos) << r.out;
+}
+
+// A map of much coarser cells than the first would be resampled to more cells than a map may have.
+TEST(DataSafety, AResampledMapOverTheCellLimitIsRefused) {
+  TempDir dir;
+  write_room_map(dir, "a");
+  dir.write("b/map.yaml", "image: ../a/map.pgm\nresolution: 1000\n");
+  const auto r = run_fleetmap("merge a/map.yaml b/map.yaml --out m.png", dir);
+  EXPECT_ONE_LINE_ERROR(r, "b/map.yaml: its 1000 m cells seen through 0.1 m cells would make");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir / "m.png"));
 }
 
 #if !FLEETMAP_SANITIZED  // AddressSanitizer reserves more address space than the limit below

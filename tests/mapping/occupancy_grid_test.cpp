@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "core/error.h"
+#include "core/random.h"
 
 namespace fleetmap::mapping {
 namespace {
@@ -126,6 +129,116 @@ TEST(Coarsen, FactorOneIsACopyAndBelowOneIsRefused) {
   fine.integrate_ray({0.05, 0.05}, {0.45, 0.35}, true);
   EXPECT_TRUE(coarsen(fine, 1).same_states(fine));
   EXPECT_THROW(coarsen(fine, 0), Error);
+}
+
+// A room of 0.05 m cells with walls, free inside and unknown beyond, seen by a seeded fan of beams
+// from its middle (as a robot's map is: speckled free space, walls of one or two cells).
+OccupancyGrid scanned_room(double resolution) {
+  OccupancyGrid g(GridGeometry(resolution, int(std::lround(6.0 / resolution)), int(std::lround(4.0 / resolution)),
+                               core::Pose2(1.0, -2.0, 0.0)));
+  core::Random random(3);
+  for (int k = 0; k < 2000; ++k) {
+    const double a = random.uniform(0.0, 2.0 * M_PI);
+    const Eigen::Vector2d from(3.9, -0.1);
+    // The room is [1.5, 6.5] x [-1.6, 1.6]: a beam ends on its wall.
+    const Eigen::Vector2d d(std::cos(a), std::sin(a));
+    const double tx = d.x() > 0 ? (6.5 - from.x()) / d.x() : (1.5 - from.x()) / d.x();
+    const double ty = d.y() > 0 ? (1.6 - from.y()) / d.y() : (-1.6 - from.y()) / d.y();
+    g.integrate_ray(from, from + std::min(tx, ty) * d, true);
+  }
+  return g;
+}
+
+TEST(Resample, AWholeNumberOfTimesCoarserTakesWholeBlocks) {
+  const OccupancyGrid fine = scanned_room(0.05);
+  for (int factor : {2, 3, 4}) {
+    const OccupancyGrid coarse = resample(fine, 0.05 * factor);
+    ASSERT_EQ(coarse.width(), (fine.width() + factor - 1) / factor);
+    ASSERT_EQ(coarse.height(), (fine.height() + factor - 1) / factor);
+    for (int cy = 0; cy < coarse.height(); ++cy) {
+      for (int cx = 0; cx < coarse.width(); ++cx) {
+        int cells = 0, free = 0, occupied = 0;
+        for (int y = cy * factor; y < std::min(fine.height(), (cy + 1) * factor); ++y)
+          for (int x = cx * factor; x < std::min(fine.width(), (cx + 1) * factor); ++x) {
+            ++cells;
+            free += fine.state({x, y}) == CellState::Free;
+            occupied += fine.state({x, y}) == CellState::Occupied;
+          }
+        const CellState want = occupied > 0 ? CellState::Occupied
+                                            : (2 * free >= cells ? CellState::Free : CellState::Unknown);
+        EXPECT_EQ(coarse.state({cx, cy}), want) << factor << " at " << cx << ", " << cy;
+      }
+    }
+    EXPECT_TRUE(coarse.same_states(coarsen(fine, factor))) << factor;
+  }
+}
+
+TEST(Resample, TheSamePlaceInMetresHoldsTheSameThing) {
+  const OccupancyGrid g = scanned_room(0.05);
+  // Finer (each cell split in two), a little coarser than 0.05 m (stata's 0.0504 m), 0.03 m and
+  // 0.07 m (no whole ratio): the extent is kept, and a cell's state is the state at its centre
+  // wherever the old map is the same all around it.
+  for (double r : {0.025, 0.0504, 0.03, 0.07}) {
+    const OccupancyGrid out = resample(g, r);
+    EXPECT_DOUBLE_EQ(out.resolution(), r);
+    EXPECT_EQ(out.geometry().origin(), g.geometry().origin());
+    EXPECT_NEAR(out.width() * r, g.geometry().width_m(), r) << r;
+    EXPECT_GE(out.width() * r, g.geometry().width_m() - 1e-9) << r;
+    EXPECT_NEAR(out.height() * r, g.geometry().height_m(), r) << r;
+    int checked = 0, same = 0;
+    for (int y = 0; y < out.height(); ++y) {
+      for (int x = 0; x < out.width(); ++x) {
+        const Eigen::Vector2d p = out.geometry().cell_center({x, y});
+        const auto c = g.geometry().world_to_cell(p);
+        if (!c) continue;
+        const CellState s = g.state(*c);
+        bool uniform = true;  // the old cells within a new cell and a half of p: all one state
+        for (int dy = -2; dy <= 2 && uniform; ++dy)
+          for (int dx = -2; dx <= 2 && uniform; ++dx) uniform = g.state(*c + Cell{dx, dy}) == s;
+        if (!uniform) continue;
+        ++checked;
+        same += out.state({x, y}) == s;
+      }
+    }
+    EXPECT_GT(checked, out.width() * out.height() / 4) << r;
+    EXPECT_EQ(same, checked) << r;
+    // Walls stay walls, and none is made up: every old wall cell's centre lies in a new wall cell,
+    // and every new wall cell lies within an old cell of an old wall.
+    for (int y = 0; y < g.height(); ++y) {
+      for (int x = 0; x < g.width(); ++x) {
+        if (g.state({x, y}) != CellState::Occupied) continue;
+        const auto c = out.geometry().world_to_cell(g.geometry().cell_center({x, y}));
+        ASSERT_TRUE(c);
+        EXPECT_EQ(out.state(*c), CellState::Occupied) << r << " at " << x << ", " << y;
+      }
+    }
+    for (int y = 0; y < out.height(); ++y) {
+      for (int x = 0; x < out.width(); ++x) {
+        if (out.state({x, y}) != CellState::Occupied) continue;
+        const Eigen::Vector2d p = out.geometry().cell_center({x, y});
+        bool near = false;
+        for (double dy : {-1.0, 0.0, 1.0})
+          for (double dx : {-1.0, 0.0, 1.0}) {
+            const auto c = g.geometry().world_to_cell(p + 0.5 * r * Eigen::Vector2d(dx, dy));
+            near = near || (c && g.state(*c) == CellState::Occupied);
+          }
+        EXPECT_TRUE(near) << r << " at " << x << ", " << y;
+      }
+    }
+  }
+}
+
+TEST(Resample, ThereAndBackAgainLosesNoWall) {
+  const OccupancyGrid g = scanned_room(0.05);
+  const OccupancyGrid back = resample(resample(g, 0.025), 0.05);
+  EXPECT_TRUE(back.same_states(g));
+}
+
+TEST(Resample, ANonPositiveResolutionIsRefused) {
+  const OccupancyGrid g = scanned_room(0.05);
+  EXPECT_THROW(resample(g, 0.0), Error);
+  EXPECT_THROW(resample(g, -0.05), Error);
+  EXPECT_THROW(resample(g, std::nan("")), Error);
 }
 
 }  // namespace

@@ -130,6 +130,23 @@ INSTANTIATE_TEST_SUITE_P(AllMethods, MethodOnDisjointMaps, ::testing::ValuesIn(r
 // Found by the benchmark: two views of the synthetic world that do not overlap fit edge to edge,
 // one's top wall on the other's bottom wall with several cross walls in line (walls agree 97%).
 // The cells beside those walls disagree (omega 0.83), and that refuses it.
+// Cells are compared one to one: a map of 0.1 m cells laid on one of 0.05 m cells would be an
+// answer at the wrong scale, so it is refused with what to do instead.
+TEST(AlignMaps, MapsOfDifferentResolutionsAreRefusedNotMisaligned) {
+  const auto office = testing::source_map("office");
+  const auto coarse = mapping::coarsen(office, 2);
+  try {
+    align_maps(office, coarse);
+    FAIL() << "merged maps of 0.05 m and 0.1 m cells";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("resample one to the other's resolution"), std::string::npos) << e.what();
+  }
+  // Seen through the same cells, they merge where they are.
+  const MergeResult r = align_maps(mapping::resample(office, coarse.resolution()), coarse);
+  EXPECT_TRUE(r.merged) << r.reason;
+  EXPECT_LT(r.transform.translation().norm(), 0.5);
+}
+
 TEST(AlignMaps, UnrelatedMapsLaidEdgeToEdgeAlongAWallAreRefused) {
   core::Random world_random(2000);
   SyntheticWorldOptions wo;
@@ -640,7 +657,7 @@ TEST(AlignMaps, MapsWithoutWallsAreRefusedWithAReason) {
   const auto unknown = testing::grid_from_text({"    ", "    "});
   const auto office = testing::source_map("office");
   for (const auto* g : {&free_only, &unknown}) {
-    const MergeResult r = align_maps(office, *g);
+    const MergeResult r = align_maps(office, mapping::resample(*g, office.resolution()));
     EXPECT_FALSE(r.merged);
     EXPECT_EQ(r.confidence, 0.0);
     EXPECT_NE(r.reason.find("second map has no walls"), std::string::npos) << r.reason;
