@@ -30,11 +30,15 @@
 //
 // --real-maps: windows of maps the user gives (real laser maps: map_server YAML, PGM, PNG), cut as
 // above but without added clutter (set "real300", or "realN" with --real-window N), and unrelated
-// pairs of windows of two of them (of two resolutions: the finer window seen through the coarser
-// one's cells, as `fleetmap merge` aligns them). They are loaded first, and the HouseExpo maps only when a set of
+// pairs of windows of two of them (of two resolutions: aligned as `fleetmap merge` aligns them,
+// merging::align_across_resolutions). They are loaded first, and the HouseExpo maps only when a set of
 // house pairs is asked for. --real-coarsen F sees them through cells F times larger
 // (mapping::coarsen), as a robot mapping at F times the cell size would: the check at another
-// resolution.
+// resolution. --real-mixed F makes each real pair one of two resolutions, as `fleetmap merge` gets from
+// two robots mapping at different cell sizes: the second window is seen through cells F times
+// larger, pooled on its own lattice (turned with the window and shifted by a random 0..F-1 cells),
+// and the pair aligned as `fleetmap merge` aligns maps of two resolutions
+// (merging::align_across_resolutions); errors are in the coarse cells.
 //
 // Times are the thread's CPU time per pair (alignment only; windows are cut outside the timing),
 // with OpenCV held to one thread.
@@ -66,6 +70,7 @@
 #include "io/map_io.h"
 #include "merging/evaluation.h"
 #include "merging/merge.h"
+#include "merging/resolutions.h"
 #include "sim/simulation.h"
 
 namespace {
@@ -91,6 +96,7 @@ struct Args {
   int real_pairs = 10;       // pairs per real map and overlap
   int real_window = 300;     // their windows' side, cells
   int real_coarsen = 1;      // the real maps seen through cells this many times larger
+  int real_mixed = 1;        // the second window of each real pair mapped at this many times the cell size
   int real_unrelated = 100;  // pairs of windows of two different real maps (with two or more)
   std::vector<double> overlaps = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
   std::string method = "auto";
@@ -105,7 +111,8 @@ struct Args {
 constexpr const char* kUsage =
     "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
     "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
-    "       [--real-maps MAP,...] [--real-pairs N] [--real-window CELLS] [--real-coarsen F] [--real-unrelated N]\n"
+    "       [--real-maps MAP,...] [--real-pairs N] [--real-window CELLS] [--real-coarsen F] [--real-mixed F]\n"
+    "       [--real-unrelated N]\n"
     "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
 
 [[noreturn]] void usage(const std::string& problem) {
@@ -165,6 +172,12 @@ Args parse_args(int argc, char** argv) {
       const double f = number(v);
       if (!(f >= 1.0 && f <= 64.0 && f == std::floor(f))) usage("--real-coarsen: '" + v + "' is not a whole number from 1 to 64");
       a.real_coarsen = int(f);
+    }
+    else if (k == "--real-mixed") {
+      const std::string v = value();
+      const double f = number(v);
+      if (!(f >= 1.0 && f <= 16.0 && f == std::floor(f))) usage("--real-mixed: '" + v + "' is not a whole number from 1 to 16");
+      a.real_mixed = int(f);
     }
     else if (k == "--real-unrelated") a.real_unrelated = int(number(value()));
     else if (k == "--method") a.method = value();
@@ -657,7 +670,11 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
   Outcome o;
   const auto w0 = std::chrono::steady_clock::now();
   const double c0 = thread_seconds();
-  const merging::MergeResult r = merging::align_maps(p.a, p.b, options);
+  // Maps of two resolutions (--real-mixed, unrelated real maps) as `fleetmap merge` aligns them: the
+  // result is between the two seen through the coarser cells.
+  const bool mixed = p.a.resolution() != p.b.resolution();
+  const merging::MergeResult r =
+      mixed ? merging::align_across_resolutions(p.a, p.b, options) : merging::align_maps(p.a, p.b, options);
   o.cpu_s = thread_seconds() - c0;
   o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
   o.merged = r.merged;
@@ -666,7 +683,10 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
     o.error = merging::mean_displacement(r.transform, p.reference.value_or(*p.truth), p.b);
     o.found = o.error < kSuccessCells;
   }
-  const merging::Acceptance acc = merging::acceptance_index(p.a, p.b, r.transform);
+  const double coarser = std::max(p.a.resolution(), p.b.resolution());
+  const merging::Acceptance acc =
+      mixed ? merging::acceptance_index(mapping::resample(p.a, coarser), mapping::resample(p.b, coarser), r.transform)
+            : merging::acceptance_index(p.a, p.b, r.transform);
   if (r.alternative) {
     const double dth = core::rad2deg(core::normalize_angle(r.alternative->rotation() - r.transform.rotation()));
     const double dd = merging::mean_displacement(*r.alternative, r.transform, p.b);
@@ -826,6 +846,20 @@ int overlap_percent(double f) { return int(std::lround(100.0 * f)); }
 // The set of the windows of --real-maps: "real300" for 300 x 300 windows.
 std::string real_set(int window) { return "real" + std::to_string(window); }
 
+// --real-mixed: b seen through cells `f` times larger on its own lattice (shifted by a random
+// 0..f-1 cells); the truth between b and a seen through such cells on a's lattice (the cells of
+// align_across_resolutions's result). A coarse cell X
+// of b has its centre at b's fine cell f X + c + d (c = (f - 1) / 2, d the shift), and a's fine
+// cell p is a's coarse cell (p - c) / f: the truth R p + t becomes R X + (R (c + d) + t - c) / f.
+void mix_resolutions(merging::CropPair& pair, int f, core::Random& random) {
+  const int dx = random.uniform_int(0, f - 1), dy = random.uniform_int(0, f - 1);
+  const mapping::OccupancyGrid shifted = merging::crop_grid(pair.b, dx, dy, pair.b.width() - dx, pair.b.height() - dy);
+  pair.b = mapping::coarsen(shifted, f);
+  const Eigen::Vector2d c = Eigen::Vector2d::Constant((f - 1) / 2.0), d(dx, dy);
+  const Eigen::Matrix2d r = pair.b_to_a.rotation_matrix();
+  pair.b_to_a = core::Transform2((r * (c + d) + pair.b_to_a.translation() - c) / f, pair.b_to_a.rotation());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -956,6 +990,7 @@ int main(int argc, char** argv) {
           for (int k = 0; k < args.real_pairs; ++k) {
             try {
               merging::CropPair c = merging::make_crop_pair(map, window, random);
+              if (args.real_mixed > 1) mix_resolutions(c, args.real_mixed, random);
               pairs.push_back(std::make_unique<Pair>(Pair{set, name, f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
             } catch (const Error&) {
               missing += fmt::format("{}{}%", missing.empty() ? "" : ", ", overlap_percent(f));
@@ -975,11 +1010,10 @@ int main(int argc, char** argv) {
         try {
           merging::CropPair ci = merging::make_crop_pair(real[i].second, one, random);
           merging::CropPair cj = merging::make_crop_pair(real[j].second, one, random);
-          // Maps of two resolutions are compared as `fleetmap merge` compares them: through the
-          // coarser map's cells.
-          const double coarser = std::max(ci.a.resolution(), cj.b.resolution());
-          if (ci.a.resolution() != coarser) ci.a = mapping::resample(ci.a, coarser);
-          if (cj.b.resolution() != coarser) cj.b = mapping::resample(cj.b, coarser);
+          if (args.real_mixed > 1) {
+            mix_resolutions(ci, args.real_mixed, random);
+            mix_resolutions(cj, args.real_mixed, random);
+          }
           pairs.push_back(std::make_unique<Pair>(Pair{"unrelated", real[i].first + "/" + real[j].first, 0.0, std::move(ci.a),
                                                       std::move(cj.b), std::nullopt, {}}));
         } catch (const Error&) {

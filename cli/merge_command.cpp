@@ -47,16 +47,6 @@ struct MergeCommandOptions {
   double resolution = 0.05;
 };
 
-// A placement in cells of `from` metres turned into cells of `to` metres: a cell's centre (c + 1/2)
-// cells from the origin corner, so c_a = R c_b + t is m_a = R m_b + from (t + h - R h) in metres,
-// h = (1/2, 1/2).
-core::Transform2 rescale_cells(const core::Transform2& t, double from, double to) {
-  const Eigen::Vector2d h(0.5, 0.5);
-  const Eigen::Matrix2d r = t.rotation_matrix();
-  const Eigen::Vector2d metres = from * (t.translation() + h - r * h);
-  return {metres / to - h + r * h, t.rotation()};
-}
-
 // An input's place in the first input's pixel grid, as the convention states it: its pixel p lies at
 // scale R(theta) p + t.
 struct PixelPlacement {
@@ -175,55 +165,39 @@ int run_merge(const MergeCommandOptions& o) {
   std::FILE* report = report_stream(outputs);
   io::MapLoadOptions load;
   load.default_resolution = o.resolution;
-  // Maps of different resolutions are aligned through the coarsest map's cells (a finer map's walls
-  // pooled, as mapping::resample keeps them; a coarse map drawn on finer cells would have walls
-  // twice as thick as the fine map's, on its free cells), and fused in the first map's cells.
+  // Maps of different resolutions: each pair is aligned through the coarser map's cells
+  // (merging::align_across_resolutions), and the maps are fused in the first map's cells.
   std::vector<mapping::OccupancyGrid> originals;
   for (const auto& m : o.maps) {
     originals.push_back(maps::load_map_source(m, load));
     if (originals.back().known_count() == 0) throw InputError(m + ": every cell is unknown; there is nothing to merge");
   }
   const double r0 = originals.front().resolution();
-  double coarsest = r0;
-  for (const auto& g : originals) coarsest = std::max(coarsest, g.resolution());
-  const auto same = [](double x, double y) { return std::abs(x - y) <= 1e-9 * std::max(x, y); };
-  // Each map in cells of `resolution`: itself, or its resampled copy, kept in `cells`.
-  const auto in_cells = [&](double resolution, std::vector<mapping::OccupancyGrid>& cells) {
-    std::vector<const mapping::OccupancyGrid*> out;
-    cells.reserve(originals.size());
-    for (std::size_t i = 0; i < originals.size(); ++i) {
-      const auto& g = originals[i];
-      if (same(g.resolution(), resolution)) {
-        out.push_back(&g);
-        continue;
-      }
-      const double count = double(g.width()) * double(g.height()) * std::pow(g.resolution() / resolution, 2.0);
-      if (count > double(load.max_cells)) {
-        throw InputError(fmt::format("{}: its {} m cells seen through {} m cells would make {:.0f} cells, over the "
-                                     "limit of {}; give a map of coarser cells first",
-                                     o.maps[i], g.resolution(), resolution, count, load.max_cells));
-      }
-      cells.push_back(mapping::resample(g, resolution));
-      out.push_back(&cells.back());
+  std::vector<mapping::OccupancyGrid> resampled;  // the maps of other resolutions in the first's cells
+  resampled.reserve(originals.size());
+  std::vector<const mapping::OccupancyGrid*> pointers, fused_grids;
+  for (std::size_t i = 0; i < originals.size(); ++i) {
+    const auto& g = originals[i];
+    pointers.push_back(&g);
+    if (g.resolution() == r0) {
+      fused_grids.push_back(&g);
+      continue;
     }
-    return out;
-  };
-  std::vector<mapping::OccupancyGrid> aligned_cells, fused_cells;
-  const std::vector<const mapping::OccupancyGrid*> fused_grids = in_cells(r0, fused_cells);
-  const std::vector<const mapping::OccupancyGrid*> pointers =
-      same(coarsest, r0) ? fused_grids : in_cells(coarsest, aligned_cells);
+    const double count = double(g.width()) * double(g.height()) * std::pow(g.resolution() / r0, 2.0);
+    if (count > double(load.max_cells)) {
+      throw InputError(fmt::format("{}: its {} m cells seen through {}'s {} m cells would make {:.0f} cells, over the "
+                                   "limit of {}; give a map of coarser cells first",
+                                   o.maps[i], g.resolution(), o.maps.front(), r0, count, load.max_cells));
+    }
+    resampled.push_back(mapping::resample(g, r0));
+    fused_grids.push_back(&resampled.back());
+  }
 
   merging::MergeOptions options;
   options.method = o.method;
   options.min_confidence = o.min_confidence;
   options.seed = o.seed;
   const merging::MultiMergeResult merged = merging::merge_maps(pointers, options);
-  // The placements in the first map's cells, for the fused map and the pixels.
-  merging::MultiMergeResult in_first = merged;
-  for (auto& t : in_first.to_first) {
-    if (t) t = rescale_cells(*t, coarsest, r0);
-  }
-  in_first.max_loop_gap *= coarsest / r0;
 
   // The pair that placed each input, for its acceptance.
   const auto pair_of = [&](int i, int parent) -> const merging::MergeResult& {
@@ -239,9 +213,9 @@ int run_merge(const MergeCommandOptions& o) {
   j["transforms"] = nlohmann::json::array();
   int placed = 1;
   fmt::print(report, "{}: the reference (first input)\n", o.maps.front());
-  if (!fused_cells.empty()) {
-    fmt::print(report, "maps of different resolutions: aligned through {} m cells (the coarsest), fused in {}'s {} m cells\n",
-               coarsest, o.maps.front(), r0);
+  if (!resampled.empty()) {
+    fmt::print(report, "maps of different resolutions: each pair aligned through the coarser one's cells, fused in {}'s {} m cells\n",
+               o.maps.front(), r0);
   }
   for (std::size_t i = 1; i < originals.size(); ++i) {
     const auto& name = o.maps[i];
@@ -255,7 +229,7 @@ int run_merge(const MergeCommandOptions& o) {
       continue;
     }
     ++placed;
-    const PixelPlacement pixels = to_first_pixels(*in_first.to_first[i], originals.front(), *fused_grids[i], originals[i]);
+    const PixelPlacement pixels = to_first_pixels(*merged.to_first[i], originals.front(), *fused_grids[i], originals[i]);
     const int parent = merged.parent[i];
     const auto& pair = pair_of(int(i), parent);
     j["transforms"].push_back(transform_json(name, pixels, pair, merged.confidence[i], merged.method[i],
@@ -267,9 +241,9 @@ int run_merge(const MergeCommandOptions& o) {
                o.maps[std::size_t(parent)]);
   }
   j["merged_maps"] = placed;
-  j["max_loop_gap_px"] = in_first.max_loop_gap;
+  j["max_loop_gap_px"] = merged.max_loop_gap;
 
-  const merging::FusedMap fused = merging::fuse_merged(fused_grids, in_first);
+  const merging::FusedMap fused = merging::fuse_merged(fused_grids, merged);
   j["conflict_cells"] = fused.conflict_cells;
   if (!o.json.empty()) write_output(o.json, j.dump(2) + "\n");
   if (out_is_map) io::save_map(fused.grid, o.out);
@@ -294,7 +268,8 @@ Command add_merge_command(CLI::App& root) {
                 "\nEvery answer has a confidence in [0, 1]; below --min-confidence a map is not merged (\"no reliable\n"
                 "overlap\"): a wrong merge is worse than none. More than two maps: every pair is aligned, and the most\n"
                 "confident pairs chain each map to the first.\n"
-                "Maps of different resolutions are aligned through the coarsest map's cells and fused in the first's.\n"
+                "Maps of different resolutions are aligned pair by pair through the coarser one's cells and fused in\n"
+                "the first's.\n"
                 "--json holds `transforms`: per input after the first, map, merged, tx, ty (pixels), theta_deg,\n"
                 "scale, acceptance, confidence, method, via (the input it was aligned to); or merged: false and the\n"
                 "reason.\n"

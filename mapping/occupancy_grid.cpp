@@ -148,4 +148,50 @@ OccupancyGrid resample(const OccupancyGrid& grid, double resolution) {
   return out;
 }
 
+OccupancyGrid pool(const OccupancyGrid& grid, double resolution, const core::Transform2& place, int width, int height,
+                   const core::Pose2& origin) {
+  if (!(resolution >= grid.resolution() * (1.0 - 1e-9)) || !std::isfinite(resolution)) {
+    throw Error("pool: resolution " + std::to_string(resolution) + " m is finer than the grid's " +
+                std::to_string(grid.resolution()) + " m");
+  }
+  OccupancyGrid out(GridGeometry(resolution, width, height, origin), grid.options());
+  const float occupied = float(probability_to_log_odds(grid.options().occupied_threshold));
+  const float free = float(probability_to_log_odds(grid.options().free_threshold));
+  const std::size_t n = std::size_t(width) * std::size_t(height);
+  std::vector<int> cells(n, 0), free_cells(n, 0);
+  std::vector<float> free_sum(n, 0.0f), most(n, -std::numeric_limits<float>::infinity());
+  // A cell p of grid has its centre at s p + c in resample(grid, resolution)'s cells.
+  const double s = grid.resolution() / resolution, c = (s - 1.0) / 2.0;
+  const Eigen::Matrix2d r = place.rotation_matrix() * s;
+  const Eigen::Vector2d t = place.rotation_matrix() * Eigen::Vector2d(c, c) + place.translation();
+  const auto& l = grid.log_odds_data();
+  for (int y = 0; y < grid.height(); ++y) {
+    const float* row = l.data() + std::size_t(y) * std::size_t(grid.width());
+    for (int x = 0; x < grid.width(); ++x) {
+      const Eigen::Vector2d q = r * Eigen::Vector2d(x, y) + t;
+      const int nx = int(std::floor(q.x() + 0.5)), ny = int(std::floor(q.y() + 0.5));
+      if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
+      const std::size_t k = std::size_t(ny) * std::size_t(width) + std::size_t(nx);
+      const float v = row[x];
+      ++cells[k];
+      most[k] = std::max(most[k], v);
+      if (v < free) {
+        ++free_cells[k];
+        free_sum[k] += v;
+      }
+    }
+  }
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t k = std::size_t(y) * std::size_t(width) + std::size_t(x);
+      if (cells[k] == 0) continue;
+      float v = 0.0f;
+      if (most[k] > occupied) v = most[k];
+      else if (2 * free_cells[k] >= cells[k]) v = free_sum[k] / float(free_cells[k]);
+      if (v != 0.0f) out.set_log_odds({x, y}, v);
+    }
+  }
+  return out;
+}
+
 }  // namespace fleetmap::mapping

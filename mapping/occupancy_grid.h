@@ -132,6 +132,17 @@ OccupancyGrid coarsen(const OccupancyGrid& fine, int factor);
 // exactly. Throws fleetmap::Error unless resolution > 0.
 OccupancyGrid resample(const OccupancyGrid& grid, double resolution);
 
+// `grid`'s cells pooled into a width x height grid of `resolution` cells (at least grid's) laid
+// anywhere: `place` takes the cells of resample(grid, resolution) (same origin; a cell's centre at
+// integer coordinates) into the new grid's cells, and each cell of `grid` goes to the new cell its
+// centre lands in. A new cell is Occupied when any cell landing in it is, Free when at least half
+// of them are Free, Unknown otherwise (as resample). The new grid has `origin` and grid's options.
+// Two maps of different resolutions compare cell for cell only when the finer one is pooled
+// through the coarser one's own cells, not a lattice of its own half a cell off.
+// Throws fleetmap::Error for a resolution finer than grid's or a negative size.
+OccupancyGrid pool(const OccupancyGrid& grid, double resolution, const core::Transform2& place, int width, int height,
+                   const core::Pose2& origin = {});
+
 template <typename OnCell>
 int OccupancyGrid::integrate_ray(const Eigen::Vector2d& from, const Eigen::Vector2d& to, bool hit, OnCell&& on_cell) {
   const auto end_cell = geometry_.world_to_cell(to);

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "core/error.h"
+#include "merging/resolutions.h"
 
 namespace fleetmap::merging {
 
@@ -23,11 +24,25 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
     parts.push_back(std::make_unique<KnownPart>(*g));
     prepared.push_back(std::make_unique<PreparedGrid>(parts.back()->grid(), prepare_options(options)));
   }
+  // Every pair's result in the first map's cells (each map seen through them: its own cells when it
+  // has the first's resolution).
+  const double first = grids[0]->resolution();
+  const auto in_first_cells = [&](MergeResult r, double resolution) {
+    if (resolution == first) return r;
+    r.transform = rescale_cells(r.transform, resolution, first);
+    if (r.alternative) r.alternative = rescale_cells(*r.alternative, resolution, first);
+    const Eigen::Vector2d h(0.5, 0.5);
+    r.quality.overlap_centre = (r.quality.overlap_centre + h) * (resolution / first) - h;
+    return r;
+  };
   const int total = n * (n - 1) / 2;
   for (int i = 0; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       const auto si = std::size_t(i), sj = std::size_t(j);
-      out.pairs.push_back({i, j, uncut(align_prepared(*prepared[si], *prepared[sj], options), *parts[si], *parts[sj])});
+      const double ri = grids[si]->resolution(), rj = grids[sj]->resolution();
+      MergeResult r = ri == rj ? uncut(align_prepared(*prepared[si], *prepared[sj], options), *parts[si], *parts[sj])
+                               : align_across_resolutions(*grids[si], *grids[sj], options);
+      out.pairs.push_back({i, j, in_first_cells(std::move(r), std::max(ri, rj))});
       if (progress) progress(int(out.pairs.size()), total);
     }
   }

@@ -13,6 +13,10 @@
 
 namespace fleetmap::merging {
 
+// Maps of different resolutions are aligned pair by pair through the coarser map's cells
+// (align_across_resolutions), and every transform is given between the maps seen through the first
+// map's cells (mapping::resample(grid, first.resolution()): a map's own cells when it has the first's
+// resolution).
 struct PairAlignment {
   int a = 0, b = 0;     // b's cells into a's cells (a < b)
   MergeResult result;

@@ -151,7 +151,7 @@ TEST(DataSafety, MessagesNameNumbersAsTyped) {
   write_room_map(dir, "a");
   dir.write("b/map.yaml", "image: ../a/map.pgm\nresolution: 0.05\n");
   const auto r = run_fleetmap("merge a/map.yaml b/map.yaml --out m.png", dir);
-  EXPECT_NE(r.out.find("maps of different resolutions: aligned through 0.1 m cells (the coarsest), fused in a/map.yaml's 0.1 m cells"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("maps of different resolutions: each pair aligned through the coarser one's cells, fused in a/map.yaml's 0.1 m cells"), std::string::npos) << r.out;
 }
 
 // A map of much coarser cells than the first would be resampled to more cells than a map may have.
@@ -160,7 +160,7 @@ TEST(DataSafety, AResampledMapOverTheCellLimitIsRefused) {
   write_room_map(dir, "a");
   dir.write("b/map.yaml", "image: ../a/map.pgm\nresolution: 1000\n");
   const auto r = run_fleetmap("merge a/map.yaml b/map.yaml --out m.png", dir);
-  EXPECT_ONE_LINE_ERROR(r, "b/map.yaml: its 1000 m cells seen through 0.1 m cells would make");
+  EXPECT_ONE_LINE_ERROR(r, "b/map.yaml: its 1000 m cells seen through a/map.yaml's 0.1 m cells would make");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_FALSE(std::filesystem::exists(dir / "m.png"));
 }

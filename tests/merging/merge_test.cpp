@@ -13,6 +13,7 @@
 
 #include "core/angle.h"
 #include "merging/evaluation.h"
+#include "merging/resolutions.h"
 #include "tests/merging/merging_test_support.h"
 #include "tests/test_support.h"
 
@@ -145,6 +146,31 @@ TEST(AlignMaps, MapsOfDifferentResolutionsAreRefusedNotMisaligned) {
   const MergeResult r = align_maps(mapping::resample(office, coarse.resolution()), coarse);
   EXPECT_TRUE(r.merged) << r.reason;
   EXPECT_LT(r.transform.translation().norm(), 0.5);
+}
+
+// A robot mapping at twice the cell size pools walls on a lattice of its own: one cell off the
+// other map's pooled lattice in x and y, the cells beside walls disagree. Pooled through the coarse
+// map's own cells where the first answer puts it, the fine map agrees cell for cell.
+TEST(AlignAcrossResolutions, AFineMapIsPooledThroughTheCoarseMapsOwnCells) {
+  const auto office = testing::source_map("office");
+  const double r = office.resolution();
+  // The coarse robot's map: the office from fine cell (1, 1) on, through cells of 2 r.
+  const auto coarse = mapping::coarsen(crop_grid(office, 1, 1, office.width() - 1, office.height() - 1), 2);
+  // Its cell X has its centre at the office's fine cell 2 X + (1.5, 1.5): at (2 X + 1.5 + 0.5) / 2 - 0.5
+  // = X + 0.5 in the office's cells of 2 r.
+  const core::Transform2 truth(0.5, 0.5, 0.0);
+  const MergeResult pooled_apart = align_maps(mapping::resample(office, 2 * r), coarse);
+  const MergeResult r2 = align_across_resolutions(office, coarse);
+  ASSERT_TRUE(r2.merged) << r2.reason;
+  EXPECT_LT(mean_displacement(r2.transform, truth, coarse), 0.25);
+  EXPECT_GT(r2.acceptance, pooled_apart.acceptance);
+  EXPECT_GT(r2.acceptance, 0.99);
+  // The other way round: the result is between the coarse map and the office seen through its cells.
+  const MergeResult back = align_across_resolutions(coarse, office);
+  ASSERT_TRUE(back.merged) << back.reason;
+  EXPECT_LT(mean_displacement(back.transform, truth.inverse(), mapping::resample(office, 2 * r)), 0.25);
+  // One resolution: align_maps itself.
+  EXPECT_TRUE(align_across_resolutions(office, office).transform.is_approx(core::Transform2::identity(), 0.05));
 }
 
 TEST(AlignMaps, UnrelatedMapsLaidEdgeToEdgeAlongAWallAreRefused) {
