@@ -234,6 +234,25 @@ TEST(Resample, ThereAndBackAgainLosesNoWall) {
   EXPECT_TRUE(back.same_states(g));
 }
 
+TEST(Pool, InPlaceItIsResampleAndAPlacementMovesTheCells) {
+  const OccupancyGrid g = scanned_room(0.05);
+  const OccupancyGrid coarse = resample(g, 0.1);
+  const OccupancyGrid same = pool(g, 0.1, core::Transform2::identity(), coarse.width(), coarse.height(),
+                                  g.geometry().origin());
+  EXPECT_TRUE(same.same_states(coarse));
+  // Placed one cell right and two up: cell (x, y) of `coarse` is cell (x + 1, y + 2) of the new grid.
+  const OccupancyGrid moved = pool(g, 0.1, core::Transform2(1.0, 2.0, 0.0), coarse.width() + 1, coarse.height() + 2);
+  for (int y = 0; y < coarse.height(); ++y)
+    for (int x = 0; x < coarse.width(); ++x) ASSERT_EQ(moved.state({x + 1, y + 2}), coarse.state({x, y})) << x << ", " << y;
+  EXPECT_EQ(moved.state({0, 0}), CellState::Unknown);
+  // Turned a quarter about the origin into a grid wide enough: the walls are still there, turned.
+  const OccupancyGrid turned = pool(g, 0.1, core::Transform2(coarse.height() - 1.0, 0.0, M_PI / 2), coarse.height(), coarse.width());
+  EXPECT_EQ(turned.count(CellState::Occupied), coarse.count(CellState::Occupied));
+  EXPECT_EQ(turned.state({coarse.height() - 1 - 10, 20}), coarse.state({20, 10}));
+  // Cells finer than the grid's would leave holes between its cells: refused.
+  EXPECT_THROW(pool(g, 0.025, core::Transform2::identity(), 10, 10), Error);
+}
+
 TEST(Resample, ANonPositiveResolutionIsRefused) {
   const OccupancyGrid g = scanned_room(0.05);
   EXPECT_THROW(resample(g, 0.0), Error);
