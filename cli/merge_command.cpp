@@ -54,12 +54,12 @@ struct PixelPlacement {
   double scale = 1.0;
 };
 
-// `cells` takes the cells of `merged` (the input as merged: `original`, resampled to the first
-// input's resolution when its own differs) into the first input's cells. A pixel (u, v) of
-// `original` is the cell (u, H - 1 - v), whose centre lies s (u, H - 1 - v) + c (1, 1) in
-// `merged`'s cells (same origin; s = its cell size / the first's, c = (s - 1) / 2), which is the
-// pixel s (u, v) + o of `merged`; the rigid placement of `merged`'s pixels then gives
-// s R p + (R o + t).
+// `cells` takes the cells of `merged` (the input seen through the first input's cells: `original`
+// itself, or resampled when its resolution differs; merging::merge_maps gives its transforms so)
+// into the first input's cells. A pixel (u, v) of `original` is the cell (u, H - 1 - v), whose
+// centre lies s (u, H - 1 - v) + c (1, 1) in `merged`'s cells (same origin; s = its cell size / the
+// first's, c = (s - 1) / 2), which is the pixel s (u, v) + o of `merged`; the rigid placement of
+// `merged`'s pixels then gives s R p + (R o + t).
 PixelPlacement to_first_pixels(const core::Transform2& cells, const mapping::OccupancyGrid& first,
                                const mapping::OccupancyGrid& merged, const mapping::OccupancyGrid& original) {
   const core::Transform2 rigid = merging::flip_rows(cells, first.height(), merged.height());
