@@ -86,6 +86,27 @@ OccupancyGrid coarsen(const OccupancyGrid& fine, int factor) {
 
 namespace {
 
+// The cells pooled into one larger cell, and the rule that makes them one (coarsen, resample,
+// pool): Occupied when any is (their largest log-odds), Free when at least half are Free (the mean
+// log-odds of those), Unknown (0) otherwise. Cells are added in the order of the old grid's rows.
+struct Pooled {
+  int cells = 0, free_cells = 0;
+  float free_sum = 0.0f, most = -std::numeric_limits<float>::infinity();
+
+  void add(float v, float free) {
+    ++cells;
+    most = std::max(most, v);
+    if (v < free) {
+      ++free_cells;
+      free_sum += v;
+    }
+  }
+  float log_odds(float occupied) const {
+    if (most > occupied) return most;
+    return cells > 0 && 2 * free_cells >= cells ? free_sum / float(free_cells) : 0.0f;
+  }
+};
+
 // For each new cell along one axis, the old cells whose centres lie inside it, [first, end); the
 // old cell holding its centre when none does. `ratio` = new cell size / old cell size.
 std::vector<std::pair<int, int>> covered_cells(int old_count, int new_count, double ratio) {
@@ -125,23 +146,12 @@ OccupancyGrid resample(const OccupancyGrid& grid, double resolution) {
     const auto [y0, y1] = rows[static_cast<std::size_t>(ny)];
     for (int nx = 0; nx < nw; ++nx) {
       const auto [x0, x1] = columns[static_cast<std::size_t>(nx)];
-      float most = -std::numeric_limits<float>::infinity(), free_sum = 0.0f;
-      int free_cells = 0;
+      Pooled cell;
       for (int y = y0; y < y1; ++y) {
         const float* row = l.data() + std::size_t(y) * std::size_t(w);
-        for (int x = x0; x < x1; ++x) {
-          const float v = row[x];
-          most = std::max(most, v);
-          if (v < free) {
-            ++free_cells;
-            free_sum += v;
-          }
-        }
+        for (int x = x0; x < x1; ++x) cell.add(row[x], free);
       }
-      const int cells = (y1 - y0) * (x1 - x0);
-      float v = 0.0f;
-      if (most > occupied) v = most;
-      else if (2 * free_cells >= cells) v = free_sum / float(free_cells);
+      const float v = cell.log_odds(occupied);
       if (v != 0.0f) out.set_log_odds({nx, ny}, v);
     }
   }
@@ -157,9 +167,7 @@ OccupancyGrid pool(const OccupancyGrid& grid, double resolution, const core::Tra
   OccupancyGrid out(GridGeometry(resolution, width, height, origin), grid.options());
   const float occupied = float(probability_to_log_odds(grid.options().occupied_threshold));
   const float free = float(probability_to_log_odds(grid.options().free_threshold));
-  const std::size_t n = std::size_t(width) * std::size_t(height);
-  std::vector<int> cells(n, 0), free_cells(n, 0);
-  std::vector<float> free_sum(n, 0.0f), most(n, -std::numeric_limits<float>::infinity());
+  std::vector<Pooled> cells(std::size_t(width) * std::size_t(height));
   // A cell p of grid has its centre at s p + c in resample(grid, resolution)'s cells.
   const double s = grid.resolution() / resolution, c = (s - 1.0) / 2.0;
   const Eigen::Matrix2d r = place.rotation_matrix() * s;
@@ -171,23 +179,12 @@ OccupancyGrid pool(const OccupancyGrid& grid, double resolution, const core::Tra
       const Eigen::Vector2d q = r * Eigen::Vector2d(x, y) + t;
       const int nx = int(std::floor(q.x() + 0.5)), ny = int(std::floor(q.y() + 0.5));
       if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-      const std::size_t k = std::size_t(ny) * std::size_t(width) + std::size_t(nx);
-      const float v = row[x];
-      ++cells[k];
-      most[k] = std::max(most[k], v);
-      if (v < free) {
-        ++free_cells[k];
-        free_sum[k] += v;
-      }
+      cells[std::size_t(ny) * std::size_t(width) + std::size_t(nx)].add(row[x], free);
     }
   }
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
-      const std::size_t k = std::size_t(y) * std::size_t(width) + std::size_t(x);
-      if (cells[k] == 0) continue;
-      float v = 0.0f;
-      if (most[k] > occupied) v = most[k];
-      else if (2 * free_cells[k] >= cells[k]) v = free_sum[k] / float(free_cells[k]);
+      const float v = cells[std::size_t(y) * std::size_t(width) + std::size_t(x)].log_odds(occupied);
       if (v != 0.0f) out.set_log_odds({x, y}, v);
     }
   }

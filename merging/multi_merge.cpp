@@ -18,12 +18,17 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
   out.method.assign(std::size_t(n), "");
   out.reason.assign(std::size_t(n), "");
   if (n == 0) return out;
-  std::vector<std::unique_ptr<KnownPart>> parts;
-  std::vector<std::unique_ptr<PreparedGrid>> prepared;
-  for (const auto* g : grids) {
-    parts.push_back(std::make_unique<KnownPart>(*g));
-    prepared.push_back(std::make_unique<PreparedGrid>(parts.back()->grid(), prepare_options(options)));
-  }
+  // Each map cut and prepared once, when a pair of one resolution first needs it (a pair of two
+  // resolutions aligns resampled copies instead).
+  const auto count = static_cast<std::size_t>(n);
+  std::vector<std::unique_ptr<KnownPart>> parts(count);
+  std::vector<std::unique_ptr<PreparedGrid>> prepared(count);
+  const auto prepare = [&](std::size_t i) {
+    if (!prepared[i]) {
+      parts[i] = std::make_unique<KnownPart>(*grids[i]);
+      prepared[i] = std::make_unique<PreparedGrid>(parts[i]->grid(), prepare_options(options));
+    }
+  };
   // Every pair's result in the first map's cells (each map seen through them: its own cells when it
   // has the first's resolution).
   const double first = grids[0]->resolution();
@@ -40,8 +45,14 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
     for (int j = i + 1; j < n; ++j) {
       const auto si = std::size_t(i), sj = std::size_t(j);
       const double ri = grids[si]->resolution(), rj = grids[sj]->resolution();
-      MergeResult r = ri == rj ? uncut(align_prepared(*prepared[si], *prepared[sj], options), *parts[si], *parts[sj])
-                               : align_across_resolutions(*grids[si], *grids[sj], options);
+      MergeResult r;
+      if (ri == rj) {
+        prepare(si);
+        prepare(sj);
+        r = uncut(align_prepared(*prepared[si], *prepared[sj], options), *parts[si], *parts[sj]);
+      } else {
+        r = align_across_resolutions(*grids[si], *grids[sj], options);
+      }
       out.pairs.push_back({i, j, in_first_cells(std::move(r), std::max(ri, rj))});
       if (progress) progress(int(out.pairs.size()), total);
     }
