@@ -2,6 +2,7 @@
 // map merging, path planning, sweeps, and coordination strategies written in Python. The Python
 // half (fleetmap/__init__.py) turns scenario dicts and files into the YAML text read here and wraps
 // the results; fleetmap/__init__.pyi documents both.
+#include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -19,6 +20,7 @@
 #include "io/map_io.h"
 #include "maps/builtin_maps.h"
 #include "merging/merge.h"
+#include "merging/multi_merge.h"
 #include "planning/free_space.h"
 #include "planning/planner.h"
 #include "sim/run_metrics.h"
@@ -320,12 +322,17 @@ PYBIND11_MODULE(_fleetmap, m) {
               throw InputError("resampled: resolution: expected " + core::expected_text(io::kResolutionRange) +
                                " metres per cell");
             }
+            const double cells = double(g.width()) * double(g.height()) * std::pow(g.resolution() / resolution, 2.0);
+            if (const auto limit = io::MapLoadOptions{}.max_cells; cells > double(limit)) {
+              throw InputError(fmt::format("resampled: {} m cells would make {:.0f} cells, over the limit of {}",
+                                           resolution, cells, limit));
+            }
             return mapping::resample(g, resolution);
           },
           py::arg("resolution"),
           "The map seen through cells of `resolution` metres (same origin and extent): a cell is occupied when "
-          "any cell of the old map inside it is, free when half of them are. Maps must share a resolution to be "
-          "merged: resample one to the other's.")
+          "any cell of the old map inside it is, free when half of them are (fleetmap merge fuses maps of other "
+          "resolutions so in the first map's cells).")
       .def("__repr__", [](const mapping::OccupancyGrid& g) {
         return "<fleetmap.Map " + std::to_string(g.width()) + " x " + std::to_string(g.height()) + " cells of " +
                std::to_string(g.resolution()) + " m>";
@@ -395,7 +402,8 @@ PYBIND11_MODULE(_fleetmap, m) {
             return py::make_tuple(r.transform.translation().x(), r.transform.translation().y(),
                                   r.transform.rotation());
           },
-          "(tx, ty, theta): b's cells into a's cells, a = R(theta) b + t (the best candidate even when not merged).")
+          "(tx, ty, theta): b's cells into a's cells, a = R(theta) b + t (the best candidate even when not merged); "
+          "for maps of two resolutions, b's cells seen through a's (b.resampled(a.resolution)).")
       .def("__repr__", [](const merging::MergeResult& r) {
         return std::string("<fleetmap.MergeResult ") + (r.merged ? "merged" : "not merged") +
                ", confidence " + std::to_string(r.confidence) + ">";
@@ -408,7 +416,10 @@ PYBIND11_MODULE(_fleetmap, m) {
         options.method = method;
         options.min_confidence = min_confidence;
         options.seed = seed;
-        return merging::align_maps(a, b, options);
+        if (a.resolution() == b.resolution()) return merging::align_maps(a, b, options);
+        // Two resolutions as `fleetmap merge` aligns them: through the coarser map's cells, the
+        // transform given in a's cells (b seen through them).
+        return merging::merge_maps({&a, &b}, options).pairs.front().result;
       },
       py::arg("a"), py::arg("b"), py::arg("method"), py::arg("min_confidence"), py::arg("seed"),
       py::call_guard<py::gil_scoped_release>());

@@ -190,8 +190,9 @@ def save_map(map: Map, path: PathLike) -> None:
 def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1) -> MergeResult:
     """Aligns map b to map a. The result's `transform` (tx, ty, theta) takes b's cells into a's
     cells; `confidence` is in [0, 1] and `merged` says whether it reached `min_confidence`.
-    The maps must have one resolution (InputError otherwise): `b.resampled(a.resolution)`, or
-    both resampled to the coarser one, which keeps the finer map's walls thin."""
+    Maps of two resolutions (robots mapping at 0.05 and 0.1 m) are aligned as `fleetmap merge`
+    aligns them, through the coarser map's cells; `transform` then takes the cells of b seen
+    through a's cells (`b.resampled(a.resolution)`) into a's cells."""
     return _fleetmap._merge_maps(a, b, method, min_confidence, seed)
 
 

@@ -42,7 +42,8 @@ class Map:
         """.yaml: map_server YAML plus a .pgm beside it; .png / .pgm: the image alone."""
     def resampled(self, resolution: float) -> "Map":
         """The map seen through cells of `resolution` metres (same origin and extent): a cell is
-        occupied when any old cell inside it is, free when half of them are."""
+        occupied when any old cell inside it is, free when half of them are. InputError over 64 million
+        cells."""
 
 class MergeResult:
     merged: bool
@@ -52,7 +53,8 @@ class MergeResult:
     reason: str
     @property
     def transform(self) -> Tuple[float, float, float]:
-        """(tx, ty, theta): b's cells into a's cells (the best candidate even when not merged)."""
+        """(tx, ty, theta): b's cells into a's cells (the best candidate even when not merged); for maps
+        of two resolutions, b's cells seen through a's (b.resampled(a.resolution))."""
 
 class PlanResult:
     planner: str

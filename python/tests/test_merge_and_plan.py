@@ -22,23 +22,29 @@ class MergeTest(unittest.TestCase):
         self.assertAlmostEqual(ty, 0.0, delta=0.5)
         self.assertAlmostEqual(theta, 0.0, delta=math.radians(0.5))
 
-    def test_maps_of_different_resolutions_are_refused_until_resampled(self):
+    def test_maps_of_different_resolutions_are_aligned_through_the_coarser_cells(self):
         office = fleetmap.load_map("office").image
         a = fleetmap.Map.from_image(office[:, :130].copy(), resolution=0.05)
-        b = fleetmap.Map.from_image(office[:, 70:].copy(), resolution=0.025)
-        with self.assertRaisesRegex(fleetmap.InputError, "0.05 m and 0.025 m; resample"):
-            fleetmap.merge_maps(a, b)
         coarse = fleetmap.Map.from_image(office[:, 70:].copy(), resolution=0.05).resampled(0.1)
         self.assertEqual((coarse.width, coarse.height), ((office.shape[1] - 70 + 1) // 2, (office.shape[0] + 1) // 2))
         self.assertAlmostEqual(coarse.resolution, 0.1)
-        # a seen through the same 0.1 m cells: b's cell x is a's x - 35.
+        # The transform takes the second map's cells seen through the first's into the first's:
+        # b's 0.05 m cell x is a's x + 70, and a's 0.1 m cell x is coarse's x - 35.
+        for first, second, expected_tx in ((a, coarse, 70.0), (coarse, a, -35.0)):
+            result = fleetmap.merge_maps(first, second)
+            self.assertTrue(result.merged, result.reason)
+            tx, ty, theta = result.transform
+            self.assertAlmostEqual(tx, expected_tx, delta=1.0)
+            self.assertAlmostEqual(ty, 0.0, delta=1.0)
+            self.assertAlmostEqual(theta, 0.0, delta=math.radians(0.5))
+        # Seen through one resolution, the same answer in 0.1 m cells.
         result = fleetmap.merge_maps(a.resampled(0.1), coarse)
         self.assertTrue(result.merged, result.reason)
-        tx, ty, theta = result.transform
-        self.assertAlmostEqual(tx, 35.0, delta=0.5)
-        self.assertAlmostEqual(ty, 0.0, delta=0.5)
+        self.assertAlmostEqual(result.transform[0], 35.0, delta=0.5)
         with self.assertRaisesRegex(fleetmap.InputError, "resampled: resolution"):
             a.resampled(0.0)
+        with self.assertRaisesRegex(fleetmap.InputError, "resampled: 0.001 m cells would make .* over the limit"):
+            a.resampled(0.001)
 
     def test_maps_with_nothing_in_common_are_not_merged(self):
         empty = np.full((60, 60), 205, np.uint8)

@@ -173,6 +173,28 @@ TEST(AlignAcrossResolutions, AFineMapIsPooledThroughTheCoarseMapsOwnCells) {
   EXPECT_TRUE(align_across_resolutions(office, office).transform.is_approx(core::Transform2::identity(), 0.05));
 }
 
+// Out of step, the cells of a small overlap disagree a little (acceptance 0.97), enough to refuse
+// an answer with a modest evidence although its walls agree: the refusal names the evidence, yet
+// the cells are what refuse it. The second pooling runs for it too.
+TEST(AlignAcrossResolutions, AnAnswerRefusedOnlyBecauseItsCellsDisagreeIsPooledAgain) {
+  const auto world = testing::source_map("unstructured");
+  const double r = world.resolution();
+  // The fine robot saw columns 0-119, the coarse robot columns 91 on through cells of 2 r: its cell
+  // X has its centre at fine cell 2 X + 91.5, which is X + 45.5 in the world's cells of 2 r.
+  const auto fine = crop_grid(world, 0, 0, 120, world.height());
+  const auto coarse = mapping::coarsen(crop_grid(world, 91, 0, world.width() - 91, world.height()), 2);
+  const core::Transform2 truth(45.5, 0.0, 0.0);
+  const MergeResult out_of_step = align_maps(mapping::resample(fine, 2 * r), coarse);
+  ASSERT_FALSE(out_of_step.merged);
+  EXPECT_NE(out_of_step.refusal, Refusal::CellsDisagree) << out_of_step.reason;
+  EXPECT_GE(out_of_step.quality.agreement, ConfidenceOptions{}.full_agreement);
+  EXPECT_LT(mean_displacement(out_of_step.transform, truth, coarse), 0.5);  // the answer, refused
+  const MergeResult pooled = align_across_resolutions(fine, coarse);
+  ASSERT_TRUE(pooled.merged) << pooled.reason;
+  EXPECT_LT(mean_displacement(pooled.transform, truth, coarse), 0.25);
+  EXPECT_GT(pooled.acceptance, 0.99);
+}
+
 TEST(AlignMaps, UnrelatedMapsLaidEdgeToEdgeAlongAWallAreRefused) {
   core::Random world_random(2000);
   SyntheticWorldOptions wo;
