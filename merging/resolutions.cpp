@@ -55,21 +55,16 @@ MergeResult align_across_resolutions(const mapping::OccupancyGrid& a, const mapp
   const mapping::OccupancyGrid coarse_a = a_finer ? mapping::resample(a, r) : a;
   const mapping::OccupancyGrid coarse_b = a_finer ? b : mapping::resample(b, r);
   const MergeResult first = align_maps(coarse_a, coarse_b, options);
-  // Only cells that disagree are what lattices half a cell apart cause: a wall drawn half a cell
-  // off still lies on the other map's wall, so the walls agree, but the cells beside it read free in
-  // one map and occupied in the other. So the second pooling runs when the cells refuse the answer:
-  // named as the reason, or with walls that agree fully (agreement factor 1) and a confidence that
-  // would reach min_confidence if the cells agreed. An answer refused for its walls stays refused:
-  // pooled where that answer puts it, a wrong answer's walls fit better too (real windows of two
-  // resolutions: a wrong placement, its walls agreeing 92%, went from 0.44 to 0.64 that way).
-  const auto& co = options.confidence;
-  const double acceptance_factor =
-      std::clamp((first.acceptance - co.zero_acceptance) / (co.full_acceptance - co.zero_acceptance), 0.0, 1.0);
-  const bool walls_agree = first.quality.agreement >= co.full_agreement;
-  const bool cells_refuse =
-      first.refusal == Refusal::CellsDisagree ||
-      (!first.merged && walls_agree && acceptance_factor > 0.0 &&
-       first.confidence >= options.min_confidence * acceptance_factor);
+  // Lattices half a cell apart lower every measure of a right answer a little: a wall drawn half a
+  // cell off still lies on the other map's wall, but the cells beside it read free in one map and
+  // occupied in the other (acceptance), and the walls fit less tightly (residual, so evidence). What
+  // they do not do is lay walls on the other map's free space. So the second pooling runs for every
+  // refused answer whose walls agree fully (agreement factor 1), and for one refused because its
+  // cells disagree. An answer refused for its walls stays refused: pooled where that answer puts
+  // it, a wrong answer's walls fit better too (real windows of two resolutions: a wrong placement,
+  // its walls agreeing 92%, went from 0.44 to 0.64 that way).
+  const bool walls_agree = first.quality.agreement >= options.confidence.full_agreement;
+  const bool cells_refuse = first.refusal == Refusal::CellsDisagree || (!first.merged && walls_agree);
   if (first.candidates == 0 || !cells_refuse) return first;
   Eigen::Vector2i offset;
   if (!a_finer) {

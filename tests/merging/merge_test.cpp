@@ -173,10 +173,10 @@ TEST(AlignAcrossResolutions, AFineMapIsPooledThroughTheCoarseMapsOwnCells) {
   EXPECT_TRUE(align_across_resolutions(office, office).transform.is_approx(core::Transform2::identity(), 0.05));
 }
 
-// Out of step, the cells of a small overlap disagree a little (acceptance 0.97), enough to refuse
-// an answer with a modest evidence although its walls agree: the refusal names the evidence, yet
-// the cells are what refuse it. The second pooling runs for it too.
-TEST(AlignAcrossResolutions, AnAnswerRefusedOnlyBecauseItsCellsDisagreeIsPooledAgain) {
+// Out of step, the cells of a small overlap disagree a little (acceptance 0.97) and its walls fit
+// less tightly, enough to refuse an answer of modest evidence although its walls agree: the refusal
+// names the evidence, yet the lattices are what refuse it. The second pooling runs for it too.
+TEST(AlignAcrossResolutions, ARefusedAnswerWhoseWallsAgreeIsPooledAgain) {
   const auto world = testing::source_map("unstructured");
   const double r = world.resolution();
   // The fine robot saw columns 0-119, the coarse robot columns 91 on through cells of 2 r: its cell
