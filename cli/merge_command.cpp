@@ -183,7 +183,7 @@ int run_merge(const MergeCommandOptions& o) {
       fused_grids.push_back(&g);
       continue;
     }
-    const double count = double(g.width()) * double(g.height()) * std::pow(g.resolution() / r0, 2.0);
+    const double count = mapping::resampled_cell_count(g, r0);
     if (count > double(load.max_cells)) {
       throw InputError(fmt::format("{}: its {} m cells seen through {}'s {} m cells would make {:.0f} cells, over the "
                                    "limit of {}; give a map of coarser cells first",

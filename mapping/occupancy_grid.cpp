@@ -125,17 +125,29 @@ std::vector<std::pair<int, int>> covered_cells(int old_count, int new_count, dou
   return ranges;
 }
 
-}  // namespace
+// resample's new extent along one axis of `old_count` cells: rounded up to whole cells; a sliver of
+// a millionth of a cell (the ratio's rounding) is none.
+double resampled_count(int old_count, double ratio) { return std::max(0.0, std::ceil(old_count / ratio - 1e-6)); }
 
-OccupancyGrid resample(const OccupancyGrid& grid, double resolution) {
+void check_resolution(double resolution) {
   if (!(resolution > 0.0) || !std::isfinite(resolution)) {
     throw Error("resample: resolution must be positive, got " + std::to_string(resolution));
   }
+}
+
+}  // namespace
+
+double resampled_cell_count(const OccupancyGrid& grid, double resolution) {
+  check_resolution(resolution);
+  const double ratio = resolution / grid.resolution();
+  return resampled_count(grid.width(), ratio) * resampled_count(grid.height(), ratio);
+}
+
+OccupancyGrid resample(const OccupancyGrid& grid, double resolution) {
+  check_resolution(resolution);
   const double ratio = resolution / grid.resolution();
   const int w = grid.width(), h = grid.height();
-  // Rounded up to whole cells; a sliver of a millionth of a cell (the ratio's rounding) is none.
-  const auto cells_for = [&](int old_count) { return std::max(0, int(std::ceil(old_count / ratio - 1e-6))); };
-  const int nw = cells_for(w), nh = cells_for(h);
+  const int nw = int(resampled_count(w, ratio)), nh = int(resampled_count(h, ratio));
   OccupancyGrid out(GridGeometry(resolution, nw, nh, grid.geometry().origin()), grid.options());
   if (w == 0 || h == 0) return out;
   const float occupied = float(probability_to_log_odds(grid.options().occupied_threshold));

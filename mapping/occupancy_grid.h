@@ -131,6 +131,9 @@ OccupancyGrid coarsen(const OccupancyGrid& fine, int factor);
 // finer resolution), the cell it lies in. A whole number of times coarser is coarsen's result
 // exactly. Throws fleetmap::Error unless resolution > 0.
 OccupancyGrid resample(const OccupancyGrid& grid, double resolution);
+// The cells resample(grid, resolution) would hold (width x height, as a double: it may exceed any
+// int), to refuse one too large before making it. Throws as resample.
+double resampled_cell_count(const OccupancyGrid& grid, double resolution);
 
 // `grid`'s cells pooled into a width x height grid of `resolution` cells (at least grid's) laid
 // anywhere: `place` takes the cells of resample(grid, resolution) (same origin; a cell's centre at

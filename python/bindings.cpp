@@ -322,7 +322,7 @@ PYBIND11_MODULE(_fleetmap, m) {
               throw InputError("resampled: resolution: expected " + core::expected_text(io::kResolutionRange) +
                                " metres per cell");
             }
-            const double cells = double(g.width()) * double(g.height()) * std::pow(g.resolution() / resolution, 2.0);
+            const double cells = mapping::resampled_cell_count(g, resolution);
             if (const auto limit = io::MapLoadOptions{}.max_cells; cells > double(limit)) {
               throw InputError(fmt::format("resampled: {} m cells would make {:.0f} cells, over the limit of {}",
                                            resolution, cells, limit));
@@ -416,9 +416,8 @@ PYBIND11_MODULE(_fleetmap, m) {
         options.method = method;
         options.min_confidence = min_confidence;
         options.seed = seed;
-        if (a.resolution() == b.resolution()) return merging::align_maps(a, b, options);
-        // Two resolutions as `fleetmap merge` aligns them: through the coarser map's cells, the
-        // transform given in a's cells (b seen through them).
+        // As `fleetmap merge` aligns them (align_maps for one resolution; for two, through the
+        // coarser map's cells, the transform given in a's cells).
         return merging::merge_maps({&a, &b}, options).pairs.front().result;
       },
       py::arg("a"), py::arg("b"), py::arg("method"), py::arg("min_confidence"), py::arg("seed"),

@@ -133,7 +133,7 @@ TEST(MergeCommand, MergesMapsOfDifferentResolutions) {
   EXPECT_DOUBLE_EQ(t["scale"].get<double>(), 0.5);
   // a's fine pixel q lies at the coarse pixel c with coarse_to_a(c) = q.
   const core::Transform2 a_to_b = b_to_a.inverse();
-  for (const Eigen::Vector2d q : {Eigen::Vector2d(0, 0), Eigen::Vector2d(pair.a.width() - 1.0, pair.a.height() - 1.0),
+  for (const Eigen::Vector2d& q : {Eigen::Vector2d(0, 0), Eigen::Vector2d(pair.a.width() - 1.0, pair.a.height() - 1.0),
                                   Eigen::Vector2d(0, pair.a.height() - 1.0)}) {
     const Eigen::Vector2d fine_b = a_to_b.apply(q);
     const Eigen::Vector2d want((fine_b.x() - 0.5) / 2, (fine_b.y() - pair.b.height() - 0.5 + 2 * coarse.height()) / 2);
