@@ -692,10 +692,10 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
     const double dd = merging::mean_displacement(*r.alternative, r.transform, p.b);
     o.detail = fmt::format("alternative: {:.1f} deg, {:.1f} cells;", dth, dd);
   }
-  o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};arms={};{}",
+  o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};arms={};open={};{}",
                          r.method, r.quality.agreement, r.acceptance, r.quality.constraint, r.distinctiveness,
                          r.quality.matched, r.quality.contradicted, r.quality.tested, r.quality.overlap_radius,
-                         acc.common(), acc.disagree, r.quality.residual_rms, r.quality.beyond_corner, r.quality.wall_ends, r.quality.junction_arms, r.reason);
+                         acc.common(), acc.disagree, r.quality.residual_rms, r.quality.beyond_corner, r.quality.wall_ends, r.quality.junction_arms, r.quality.open_space_walls, r.reason);
   return o;
 }
 

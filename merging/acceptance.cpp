@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "merging/grid_level.h"
@@ -66,6 +67,7 @@ struct Tally {
   std::vector<Eigen::Vector2d> positions;    // matched walls, in a's frame
   std::vector<Eigen::Matrix2d> structures;   // their local structure, in a's frame
   std::vector<Eigen::Vector2d> structure_positions;  // the matched walls that are not clutter
+  std::vector<Eigen::Vector2d> open_space;   // walls in the other map's open space, in a's frame
 };
 
 // Whether the wall cell `w` of `source` ends a straight wall there (a door jamb, the end of a
@@ -139,6 +141,9 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
       out.structures.push_back(ra * w.structure.cast<double>() * ra.transpose());
     } else if (!w.clutter && d >= options.contradiction_distance && target.is_free(x, y)) {
       ++out.contradicted;
+      // (The distances stop at the prepared maximum, at least open_space_distance: an interpolation
+      // between four capped cells may round a hair below it.)
+      if (!w.furniture && d >= float(options.open_space_distance) - 1e-3f) out.open_space.push_back(to_a.apply(p.cast<double>()));
     }
   }
   for (const auto& w : from.level(0).interior_points) {
@@ -147,6 +152,35 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
     if (x < 0 || y < 0 || x >= target.width() || y >= target.height() || !target.is_free(x, y)) continue;
     if (target.distance_at(p.x(), p.y(), 1e4f) >= options.contradiction_distance) ++out.contradicted;
   }
+}
+
+// The most points in one group of `points` whose nearest cells (rounded) are 8-neighbours, a chain
+// of them counting as one group.
+int largest_group(const std::vector<Eigen::Vector2d>& points) {
+  std::unordered_map<std::int64_t, int> cells;  // points per cell
+  const auto key = [](long x, long y) { return (std::int64_t(x) << 32) ^ std::int64_t(std::uint32_t(y)); };
+  for (const auto& p : points) ++cells[key(std::lround(p.x()), std::lround(p.y()))];
+  std::unordered_set<std::int64_t> seen;
+  std::vector<std::int64_t> stack;
+  int largest = 0;
+  for (const auto& [start, count] : cells) {
+    if (!seen.insert(start).second) continue;
+    int size = 0;
+    stack.assign(1, start);
+    while (!stack.empty()) {
+      const std::int64_t k = stack.back();
+      stack.pop_back();
+      size += cells.at(k);
+      const long x = long(k >> 32), y = long(std::int32_t(std::uint32_t(k & 0xffffffff)));
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const std::int64_t n = key(x + dx, y + dy);
+          if (cells.count(n) && seen.insert(n).second) stack.push_back(n);
+        }
+    }
+    largest = std::max(largest, size);
+  }
+  return largest;
 }
 
 // The points farther than `tolerance` from the straight lines that hold the most points, taken one
@@ -323,6 +357,7 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   q.contradicted = t.contradicted;
   q.score = t.matched - options.contradiction_weight * t.contradicted;
   q.agreement = t.matched + t.contradicted > 0 ? double(t.matched) / double(t.matched + t.contradicted) : 0.0;
+  q.open_space_walls = largest_group(t.open_space);
   if (options.shape) {
     std::vector<Line> lines;
     const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0, &lines);

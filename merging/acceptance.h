@@ -35,6 +35,10 @@ struct QualityOptions {
   // 3-10%. With a weight of 3 such a large rough fit outscored a small exact one (on the
   // benchmark of robot-built maps: 741 matched and 73 contradicting against 358 and 0).
   double contradiction_weight = 10.0;
+  // cells: a wall cell on the other map's free space at least this far from its walls stands in its
+  // open space (AlignmentQuality::open_space_walls). Drift lays walls a cell or three beside the
+  // other map's; a wall this far from any of them is a wall where the other map saw a room.
+  double open_space_distance = 6.0;
   // Count the shape of the common walls too (beyond_corner, wall_ends, junction_arms, beyond_room).
   // Off, they stay 0: enough for placements that are only compared by score and evidence (the
   // rivals of an answer), and a third of the time of a full evaluation.
@@ -50,6 +54,14 @@ struct AlignmentQuality {
                          // column), on the other map's free space far from its walls
   double score = 0.0;      // matched - contradiction_weight * contradicted
   double agreement = 0.0;  // matched / (matched + contradicted); 0 without either
+  // The largest group of wall cells of either map that stand in the other's open space (on its
+  // free cells, at least open_space_distance cells from its walls), 8-connected in a's cells, not
+  // counting obstacles standing alone (clutter, furniture: PrepareOptions::furniture_size_m): a
+  // stretch of the building's walls laid across a room or corridor the other map saw free. A
+  // closed door (free in the other map, between jambs both maps see) stands only its middle that
+  // far from the jambs; two copies of a repeated place laid on each other can put one map's end
+  // wall across the other's corridor.
+  int open_space_walls = 0;
   // Smallest eigenvalue of the information the matched walls give about (tx, ty, theta * radius):
   // how many wall cells' worth pin the weakest direction down. A straight wall alone, or one
   // round obstacle, leaves a direction free and gives ~0.

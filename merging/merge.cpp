@@ -273,6 +273,9 @@ void check_search_options(const MergeOptions& options) {
   at_least("first_level_iterations", options.first_level_iterations, 0);
   at_least("overlap.search_cells", options.overlap.search_cells, 1);
   at_least("sweep_search_cells", options.sweep_search_cells, 1);
+  if (!(options.confidence.zero_open_space > options.confidence.full_open_space))
+    throw InputError(fmt::format("merge options: confidence.zero_open_space ({}) must be greater than full_open_space ({})",
+                                 options.confidence.zero_open_space, options.confidence.full_open_space));
 }
 
 }  // namespace
@@ -319,7 +322,10 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   result.acceptance = omega[pick];
 
   const auto& co = options.confidence;
-  const double agree_factor = clamp01((best_q.agreement - co.zero_agreement) / (co.full_agreement - co.zero_agreement));
+  const double wall_agreement = clamp01((best_q.agreement - co.zero_agreement) / (co.full_agreement - co.zero_agreement));
+  const double open_space_factor =
+      clamp01((co.zero_open_space - best_q.open_space_walls) / (co.zero_open_space - co.full_open_space));
+  const double agree_factor = std::min(wall_agreement, open_space_factor);
   const auto acceptance_factor_of = [&](double omega) {
     return clamp01((omega - co.zero_acceptance) / (co.full_acceptance - co.zero_acceptance));
   };
@@ -465,6 +471,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
     // A named copy: a lambda may not capture a structured binding (clang 14).
     const double constraint = best_q.constraint;
     const auto [refusal, why] = [&]() -> std::pair<Refusal, const char*> {
+      if (open_space_factor < 0.5 && open_space_factor <= wall_agreement)
+        return {Refusal::WallsCross, "a wall of one map stands in the other's open space, where it saw a room or "
+                                     "corridor (two copies of a repeated place laid on each other)"};
       if (agree_factor < 0.5) return {Refusal::WallsCross, "the walls of one map cross the other's free space"};
       if (acceptance_factor < 0.5)
         return {Refusal::CellsDisagree, "the maps disagree on the cells they share (free in one, occupied in the other)"};
@@ -493,8 +502,10 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
 double needed_wall_distance(const MergeOptions& options) {
   // refine.cpp counts walls 2.5 cells off as outliers, acceptance.cpp cells within 1 of a wall,
   // the overlap search free cells beyond 1.5.
-  return std::max({options.quality.match_distance, options.quality.contradiction_distance,
-                   options.refinement.inlier_distance, 2.5}) + 1.5;
+  // and walls in open space are at least open_space_distance from the other map's.
+  return std::max(std::max({options.quality.match_distance, options.quality.contradiction_distance,
+                            options.refinement.inlier_distance, 2.5}) + 1.5,
+                  options.quality.open_space_distance);
 }
 
 PrepareOptions prepare_options(const MergeOptions& options) {

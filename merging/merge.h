@@ -111,6 +111,15 @@ struct ConfidenceOptions {
   // off at 0.52, where the right placement's walls agreed 86% and the answer's 92%; with scan
   // matching, 11.6 m off at 0.84, the drifted maps' right placement pinned more but rougher.
   double min_turned_share = 0.5;
+  // A wall in the other map's open space (AlignmentQuality::open_space_walls, the largest group): the
+  // agreement factor is at most 1 up to full_open_space wall cells and 0 from zero_open_space on,
+  // linear between. Right answers on the benchmark of robot-built maps and in the simulator: at
+  // most 15 (a thin wall one robot's grazing beams saw through); windows of real laser maps at
+  // most 3. Seen on a real laser map: a corridor whose wall has two identical pairs of niches 8 m
+  // apart, one pair in each map, merged niche on niche at 0.79-0.96 with the end wall of one map's
+  // corridor across the other's (28).
+  double full_open_space = 16.0;
+  double zero_open_space = 24.0;
 };
 
 // The confidences a threshold may be (the scenario's merging.min_confidence, merge --min-confidence).
@@ -230,7 +239,8 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
 
 // The PrepareOptions::max_wall_distance that `options` need: the largest wall distance they compare
 // (match, contradiction, refinement) and 1.5 cells more, since a distance read between cell
-// centres mixes four cells up to 1.42 cells apart in distance.
+// centres mixes four cells up to 1.42 cells apart in distance; and at least
+// QualityOptions::open_space_distance (a wall is that far or more: the capped distance tells).
 double needed_wall_distance(const MergeOptions& options);
 // options.prepare with max_wall_distance raised to needed_wall_distance(options) where it is less.
 PrepareOptions prepare_options(const MergeOptions& options);

@@ -15,9 +15,9 @@ namespace fleetmap::merging {
 
 namespace {
 
-// Clutter: occupied cells of components (joined across gaps of `gap` cells) whose bounding box is at
-// most `size` cells on its longer side.
-cv::Mat find_clutter(const cv::Mat& occupied, int gap, int size) {
+// Obstacles standing alone: for each of `sizes`, the occupied cells of components (joined across
+// gaps of `gap` cells) whose bounding box is at most that many cells on its longer side.
+std::vector<cv::Mat> find_standing(const cv::Mat& occupied, int gap, const std::vector<int>& sizes) {
   cv::Mat joined;  // a new matrix: dilating into a header of `occupied` would write into it
   if (gap > 0) cv::dilate(occupied, joined, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * gap + 1, 2 * gap + 1}));
   else joined = occupied;
@@ -39,25 +39,30 @@ cv::Mat find_clutter(const cv::Mat& occupied, int gap, int size) {
       x0[i] = std::min(x0[i], x), x1[i] = std::max(x1[i], x), y0[i] = std::min(y0[i], y), y1[i] = std::max(y1[i], y);
     }
   }
-  std::vector<std::uint8_t> small(boxes.size(), 0);
-  bool any = false;
+  std::vector<int> extent(boxes.size(), 0);
   for (std::size_t i = 1; i < boxes.size(); ++i) {
     if (x1[i] < 0) continue;
     const int width = std::min(x1[i] + gap, occupied.cols - 1) - std::max(x0[i] - gap, 0) + 1;
     const int height = std::min(y1[i] + gap, occupied.rows - 1) - std::max(y0[i] - gap, 0) + 1;
     // The dilation grew the box by `gap` on each side.
-    const int extent = std::max(width, height) - 2 * gap;
-    if (extent <= size) small[i] = 255, any = true;
+    extent[i] = std::max(width, height) - 2 * gap;
   }
-  cv::Mat clutter = cv::Mat::zeros(occupied.size(), CV_8U);
-  if (!any) return clutter;
-  for (int y = 0; y < occupied.rows; ++y) {
-    const int* l = labels.ptr<int>(y);
-    const auto* o = occupied.ptr<std::uint8_t>(y);
-    auto* c = clutter.ptr<std::uint8_t>(y);
-    for (int x = 0; x < occupied.cols; ++x) c[x] = o[x] ? small[std::size_t(l[x])] : 0;
+  std::vector<cv::Mat> masks;
+  for (const int size : sizes) {
+    std::vector<std::uint8_t> small(boxes.size(), 0);
+    bool any = false;
+    for (std::size_t i = 1; i < boxes.size(); ++i)
+      if (x1[i] >= 0 && extent[i] <= size) small[i] = 255, any = true;
+    cv::Mat mask = cv::Mat::zeros(occupied.size(), CV_8U);
+    for (int y = 0; any && y < occupied.rows; ++y) {
+      const int* l = labels.ptr<int>(y);
+      const auto* o = occupied.ptr<std::uint8_t>(y);
+      auto* c = mask.ptr<std::uint8_t>(y);
+      for (int x = 0; x < occupied.cols; ++x) c[x] = o[x] ? small[std::size_t(l[x])] : 0;
+    }
+    masks.push_back(std::move(mask));
   }
-  return clutter;
+  return masks;
 }
 
 // Clears the occupied components (8-connected) of fewer than `min_cells` cells; returns how many
@@ -273,8 +278,11 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
   known_cells_ -= remove_specks(base.occupied, options.min_obstacle_cells);
   const double resolution = grid.resolution() > 0.0 ? grid.resolution() : 0.05;
   // Gaps of two cells at least: a thin wall turned and resampled on another grid breaks every few cells.
-  base.clutter = find_clutter(base.occupied, std::max(2, int(std::lround(options.clutter_gap_m / resolution))),
-                              int(std::lround(options.clutter_size_m / resolution)));
+  std::vector<cv::Mat> standing =
+      find_standing(base.occupied, std::max(2, int(std::lround(options.clutter_gap_m / resolution))),
+                    {int(std::lround(options.clutter_size_m / resolution)), int(std::lround(options.furniture_size_m / resolution))});
+  base.clutter = std::move(standing[0]);
+  const cv::Mat furniture = std::move(standing[1]);
   std::vector<cv::Point> pts;  // level 0's wall cells
   finish_level(base, options, pts);
   levels_.push_back(std::move(base));
@@ -320,6 +328,7 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
     if (trace > 1e-9) w.structure = (Eigen::Matrix2d::Identity() - c / trace).cast<float>();
     w.normal = free_direction(l0.free, p.x, p.y);
     w.clutter = l0.clutter.at<std::uint8_t>(p.y, p.x) != 0;
+    w.furniture = furniture.at<std::uint8_t>(p.y, p.x) != 0;
     walls_.push_back(w);
   }
   set_sizes();

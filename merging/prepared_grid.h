@@ -27,6 +27,7 @@ struct WallPoint {
   Eigen::Matrix2f structure = Eigen::Matrix2f::Identity() * 0.5f;
   Eigen::Vector2f normal = Eigen::Vector2f::Zero();  // toward the side it was seen from (merging/grid_level.h)
   bool clutter = false;                              // part of a small obstacle (PrepareOptions::clutter_size_m)
+  bool furniture = false;                            // part of an obstacle standing alone (PrepareOptions::furniture_size_m)
 };
 
 struct PrepareOptions {
@@ -40,6 +41,11 @@ struct PrepareOptions {
   // at most clutter_size_m. Metres, from the grid's resolution.
   double clutter_size_m = 0.5;
   double clutter_gap_m = 0.1;
+  // Obstacles standing alone (joined the same way) up to this size: desks, cabinets, pillars. They
+  // match and contradict as walls do, but never stand in the other map's open space
+  // (AlignmentQuality::open_space_walls): furniture moves between two visits. (The end wall of a
+  // real corridor, with gaps at its corners, spanned 1.5-2 m: a wall, not furniture.)
+  double furniture_size_m = 1.2;
   // Distances to walls (GridLevel::wall_distance) are exact up to this many cells of each level and
   // this value beyond: the merge compares them with a few cells only, and a capped field costs a
   // third of a full distance transform. MergeOptions need at least needed_wall_distance(options).
