@@ -501,8 +501,8 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
 
 double needed_wall_distance(const MergeOptions& options) {
   // refine.cpp counts walls 2.5 cells off as outliers, acceptance.cpp cells within 1 of a wall,
-  // the overlap search free cells beyond 1.5.
-  // and walls in open space are at least open_space_distance from the other map's.
+  // the overlap search free cells beyond 1.5; and acceptance.cpp tells a wall in open space by a
+  // distance of open_space_distance or more, which the capped field must reach.
   return std::max(std::max({options.quality.match_distance, options.quality.contradiction_distance,
                             options.refinement.inlier_distance, 2.5}) + 1.5,
                   options.quality.open_space_distance);
