@@ -157,25 +157,26 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
 // The most points in one group of `points` whose nearest cells (rounded) are 8-neighbours, a chain
 // of them counting as one group.
 int largest_group(const std::vector<Eigen::Vector2d>& points) {
-  std::unordered_map<std::int64_t, int> cells;  // points per cell
+  std::unordered_map<std::int64_t, int> cells;  // points per cell; a cell leaves when its group is counted
   const auto key = [](long x, long y) { return (std::int64_t(x) << 32) ^ std::int64_t(std::uint32_t(y)); };
   for (const auto& p : points) ++cells[key(std::lround(p.x()), std::lround(p.y()))];
-  std::unordered_set<std::int64_t> seen;
-  std::vector<std::int64_t> stack;
   int largest = 0;
-  for (const auto& [start, count] : cells) {
-    if (!seen.insert(start).second) continue;
-    int size = 0;
-    stack.assign(1, start);
+  std::vector<std::pair<long, long>> stack;
+  while (!cells.empty()) {
+    const std::int64_t start = cells.begin()->first;
+    int size = cells.begin()->second;
+    cells.erase(cells.begin());
+    stack.assign(1, {long(start >> 32), long(std::int32_t(std::uint32_t(start & 0xffffffff)))});
     while (!stack.empty()) {
-      const std::int64_t k = stack.back();
+      const auto [x, y] = stack.back();
       stack.pop_back();
-      size += cells.at(k);
-      const long x = long(k >> 32), y = long(std::int32_t(std::uint32_t(k & 0xffffffff)));
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
-          const std::int64_t n = key(x + dx, y + dy);
-          if (cells.count(n) && seen.insert(n).second) stack.push_back(n);
+          const auto n = cells.find(key(x + dx, y + dy));
+          if (n == cells.end()) continue;
+          size += n->second;
+          cells.erase(n);
+          stack.push_back({x + dx, y + dy});
         }
     }
     largest = std::max(largest, size);
