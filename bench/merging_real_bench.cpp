@@ -38,7 +38,8 @@
 // two robots mapping at different cell sizes: the second window is seen through cells F times
 // larger, pooled on its own lattice (turned with the window and shifted by a random 0..F-1 cells),
 // and the pair aligned as `fleetmap merge` aligns maps of two resolutions
-// (merging::align_across_resolutions); errors are in the coarse cells.
+// (merging::align_across_resolutions); errors are in the coarse cells. --two-robots-mixed F does
+// the same to the second robot's window of each pair of two robots' maps.
 //
 // Times are the thread's CPU time per pair (alignment only; windows are cut outside the timing),
 // with OpenCV held to one thread.
@@ -92,6 +93,7 @@ struct Args {
   int unrelated = 200;       // pairs of windows of different plans
   int large_pairs = 4;       // 4000 x 4000 pairs (time)
   int two_robots = 10;       // 300 x 300 pairs per overlap with a and b from two robots' maps of one plan
+  int two_robots_mixed = 1;  // the second robot's window seen through cells this many times larger
   std::vector<std::string> real_maps;  // maps of the user's (real laser maps: PNG, PGM + YAML, or built-in names)
   int real_pairs = 10;       // pairs per real map and overlap
   int real_window = 300;     // their windows' side, cells
@@ -110,7 +112,7 @@ struct Args {
 
 constexpr const char* kUsage =
     "usage: fleetmap_bench_merging_real [--plans DIR] [--cache DIR] [--csv FILE] [--diagnose FILE] [--dump DIR] [--only K,...] [--pairs N]\n"
-    "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--overlaps 0.1,0.5,...]\n"
+    "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--two-robots-mixed F] [--overlaps 0.1,0.5,...]\n"
     "       [--real-maps MAP,...] [--real-pairs N] [--real-window CELLS] [--real-coarsen F] [--real-mixed F]\n"
     "       [--real-unrelated N]\n"
     "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
@@ -178,6 +180,12 @@ Args parse_args(int argc, char** argv) {
       const double f = number(v);
       if (!(f >= 1.0 && f <= 16.0 && f == std::floor(f))) usage("--real-mixed: '" + v + "' is not a whole number from 1 to 16");
       a.real_mixed = int(f);
+    }
+    else if (k == "--two-robots-mixed") {
+      const std::string v = value();
+      const double f = number(v);
+      if (!(f >= 1.0 && f <= 16.0 && f == std::floor(f))) usage("--two-robots-mixed: '" + v + "' is not a whole number from 1 to 16");
+      a.two_robots_mixed = int(f);
     }
     else if (k == "--real-unrelated") a.real_unrelated = int(number(value()));
     else if (k == "--method") a.method = value();
@@ -692,10 +700,11 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
     const double dd = merging::mean_displacement(*r.alternative, r.transform, p.b);
     o.detail = fmt::format("alternative: {:.1f} deg, {:.1f} cells;", dth, dd);
   }
-  o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};arms={};open={};{}",
+  o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};arms={};room={};parallel={};off={};openings={};hallend={};open={};{}",
                          r.method, r.quality.agreement, r.acceptance, r.quality.constraint, r.distinctiveness,
                          r.quality.matched, r.quality.contradicted, r.quality.tested, r.quality.overlap_radius,
-                         acc.common(), acc.disagree, r.quality.residual_rms, r.quality.beyond_corner, r.quality.wall_ends, r.quality.junction_arms, r.quality.open_space_walls, r.reason);
+                         acc.common(), acc.disagree, r.quality.residual_rms, r.quality.beyond_corner, r.quality.wall_ends, r.quality.junction_arms,
+                         r.quality.beyond_room, r.quality.parallel_lines, r.quality.off_room_sides, r.quality.common_openings, r.quality.beyond_end, r.quality.open_space_walls, r.reason);
   return o;
 }
 
@@ -851,13 +860,19 @@ std::string real_set(int window) { return "real" + std::to_string(window); }
 // align_across_resolutions's result). A coarse cell X
 // of b has its centre at b's fine cell f X + c + d (c = (f - 1) / 2, d the shift), and a's fine
 // cell p is a's coarse cell (p - c) / f: the truth R p + t becomes R X + (R (c + d) + t - c) / f.
-void mix_resolutions(merging::CropPair& pair, int f, core::Random& random) {
+void mix_resolutions(mapping::OccupancyGrid& b, std::initializer_list<core::Transform2*> b_to_a, int f,
+                     core::Random& random) {
   const int dx = random.uniform_int(0, f - 1), dy = random.uniform_int(0, f - 1);
-  const mapping::OccupancyGrid shifted = merging::crop_grid(pair.b, dx, dy, pair.b.width() - dx, pair.b.height() - dy);
-  pair.b = mapping::coarsen(shifted, f);
+  b = mapping::coarsen(merging::crop_grid(b, dx, dy, b.width() - dx, b.height() - dy), f);
   const Eigen::Vector2d c = Eigen::Vector2d::Constant((f - 1) / 2.0), d(dx, dy);
-  const Eigen::Matrix2d r = pair.b_to_a.rotation_matrix();
-  pair.b_to_a = core::Transform2((r * (c + d) + pair.b_to_a.translation() - c) / f, pair.b_to_a.rotation());
+  for (core::Transform2* t : b_to_a) {
+    const Eigen::Matrix2d r = t->rotation_matrix();
+    *t = core::Transform2((r * (c + d) + t->translation() - c) / f, t->rotation());
+  }
+}
+
+void mix_resolutions(merging::CropPair& pair, int f, core::Random& random) {
+  mix_resolutions(pair.b, {&pair.b_to_a}, f, random);
 }
 
 }  // namespace
@@ -945,11 +960,13 @@ int main(int argc, char** argv) {
             merging::CropPair c = merging::make_crop_pair(maps[i].map, crop, random);
             mapping::OccupancyGrid b = merging::resample_grid(second[i].map, c.b_to_source, crop.width, crop.height);
             clutter_pair(c.a, b, random);
-            const core::Transform2 reference = fit_near(c.a, b, c.b_to_a);
+            core::Transform2 reference = fit_near(c.a, b, c.b_to_a);
             // Farther than 1 m from the truth, the fit found another place: no reference for this window.
             if (merging::mean_displacement(reference, c.b_to_a, b) > 1.0 / b.resolution()) continue;
+            core::Transform2 truth = c.b_to_a;
+            if (args.two_robots_mixed > 1) mix_resolutions(b, {&truth, &reference}, args.two_robots_mixed, random);
             pairs.push_back(std::make_unique<Pair>(
-                Pair{"house300x2", maps[i].id, f, std::move(c.a), std::move(b), c.b_to_a, reference}));
+                Pair{"house300x2", maps[i].id, f, std::move(c.a), std::move(b), truth, reference}));
             break;
           } catch (const Error&) {
           }

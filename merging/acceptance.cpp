@@ -70,6 +70,13 @@ struct Tally {
   std::vector<Eigen::Vector2d> open_space;   // walls in the other map's open space, in a's frame
 };
 
+// Whether the cell nearest (x, y) is in the map and free.
+template <typename Scalar>
+bool free_cell(const GridLevel& g, Scalar x, Scalar y) {
+  const int cx = nearest_cell(x), cy = nearest_cell(y);
+  return cx >= 0 && cy >= 0 && cx < g.width() && cy < g.height() && g.is_free(cx, cy);
+}
+
 // Whether the wall cell `w` of `source` ends a straight wall there (a door jamb, the end of a
 // free-standing wall): along the wall, an opening on one side and the wall going on on the other,
 // and `target` shows the same at `p`, where r turns source's directions into target's. Two maps
@@ -83,10 +90,7 @@ bool matched_wall_end(const GridLevel& source, const GridLevel& target, const Wa
   const auto& ev = eig.eigenvalues();
   if (ev(1) < 4.0f * ev(0)) return false;  // not a straight piece of wall
   const Eigen::Vector2f u = eig.eigenvectors().col(1);
-  const auto free_at = [](const GridLevel& g, const Eigen::Vector2f& q) {
-    const int x = nearest_cell(q.x()), y = nearest_cell(q.y());
-    return x >= 0 && y >= 0 && x < g.width() && y < g.height() && g.is_free(x, y);
-  };
+  const auto free_at = [](const GridLevel& g, const Eigen::Vector2f& q) { return free_cell(g, q.x(), q.y()); };
   const auto wall_at = [](const GridLevel& g, const Eigen::Vector2f& q) {
     const int x = nearest_cell(q.x()), y = nearest_cell(q.y());
     return x >= 0 && y >= 0 && x < g.width() && y < g.height() && g.distance_at(q.x(), q.y(), 1e4f) <= 1.0f;
@@ -266,6 +270,72 @@ std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, do
   return left;
 }
 
+// The sides of a room among `lines` (`left` as beyond_lines gives it, `total` points before): lines
+// that hold `min_points` points or more, run along the strongest side or square to it (within 10
+// degrees), and lie at least `min_width` from a stronger parallel side. A weaker line closer than
+// that beside a side is a jog in that wall, a niche's back or a door's reveal, not the room's other
+// side; a line askew is a slanted wall, no side of a rectangle. Adds the points on the sides to
+// `on_sides`.
+std::vector<const Line*> room_sides(const std::vector<Line>& lines, const std::vector<int>& left, int total, int min_points,
+                                    double min_width, int& on_sides) {
+  const double parallel = std::cos(10.0 * std::numbers::pi / 180.0), square = std::sin(10.0 * std::numbers::pi / 180.0);
+  std::vector<const Line*> sides;
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    const int on = (l == 0 ? total : left[l - 1]) - left[l];
+    if (on < min_points) continue;
+    const Line& line = lines[l];
+    const bool detail = std::any_of(sides.begin(), sides.end(), [&](const Line* s) {
+      return std::abs(s->normal.dot(line.normal)) >= parallel && std::abs(s->normal.dot(line.on - s->on)) < min_width;
+    });
+    // A rectangular room's sides run along the strongest one or square to it.
+    const bool askew = !sides.empty() && std::abs(sides[0]->normal.dot(line.normal)) < parallel &&
+                       std::abs(sides[0]->normal.dot(line.normal)) > square;
+    if (detail || askew) continue;
+    sides.push_back(&line);
+    on_sides += on;
+  }
+  return sides;
+}
+
+// The most of `lines` that run parallel to one another (within 10 degrees).
+int most_parallel(const std::vector<const Line*>& lines) {
+  const double parallel = std::cos(10.0 * std::numbers::pi / 180.0);
+  int most = 0;
+  for (const Line* x : lines)
+    most = std::max(most, int(std::count_if(lines.begin(), lines.end(), [&](const Line* y) {
+                                return std::abs(x->normal.dot(y->normal)) >= parallel;
+                              })));
+  return most;
+}
+
+// Stretches of `line` at least `min_length` cells long between two of `points` on it (within
+// `tolerance`) where the cells on the line are free in both maps (b's cells by a_to_b); one cell in
+// ten may be otherwise (a speck of clutter).
+int openings_on(const std::vector<Eigen::Vector2d>& points, const Line& line, double tolerance, double min_length,
+                const GridLevel& a, const GridLevel& b, const core::Transform2& a_to_b) {
+  const Eigen::Vector2d u(-line.normal.y(), line.normal.x());
+  std::vector<double> along;
+  for (const auto& p : points)
+    if (std::abs(line.normal.dot(p - line.on)) <= tolerance) along.push_back(u.dot(p - line.on));
+  std::sort(along.begin(), along.end());
+  const auto free_at = [](const GridLevel& g, const Eigen::Vector2d& q) { return free_cell(g, q.x(), q.y()); };
+  int openings = 0;
+  for (std::size_t i = 1; i < along.size(); ++i) {
+    // The matched walls are one per 4 x 4 block: the stretch between two of them starts and ends
+    // up to 2 cells inside the walls.
+    const double from = along[i - 1] + 2.0, to = along[i] - 2.0;
+    if (to - from < min_length) continue;
+    int cells = 0, open = 0;
+    for (double s = from; s <= to; s += 1.0) {
+      const Eigen::Vector2d q = line.on + s * u;
+      ++cells;
+      open += free_at(a, q) && free_at(b, a_to_b.apply(q));
+    }
+    openings += 10 * open >= 9 * cells;
+  }
+  return openings;
+}
+
 // How many of the four half-lines from where the two lines meet carry at least `min_points`
 // points farther than `margin` from the meeting point (and within `tolerance` of the line): 2 for
 // an L (a room's corner), 3 for a T (a wall meeting another that goes on past it), 4 for a cross;
@@ -366,6 +436,20 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
     if (lines.size() >= 2) q.junction_arms = junction_arms(t.structure_positions, lines[0], lines[1], 2.0, 4.0, 3);
     q.wall_ends = t.wall_ends;
     q.beyond_room = left[3];
+    const int total = int(t.structure_positions.size());
+    // A side: a wall 16 cells long seen by both maps (8 blocks of 4 cells), a metre or more from
+    // the room's other side along it.
+    constexpr int kSideBlocks = 8;
+    constexpr double kRoomWidthM = 1.0;
+    int on_sides = 0;
+    const auto sides = room_sides(lines, left, total, kSideBlocks, kRoomWidthM / a.grid().resolution(), on_sides);
+    q.parallel_lines = most_parallel(sides);
+    q.off_room_sides = total - on_sides;
+    const double min_opening = options.min_opening_m / a.grid().resolution();
+    const core::Transform2 a_to_b = b_to_a.inverse();
+    for (std::size_t l = 0; l < lines.size(); ++l)
+      if ((l == 0 ? int(t.structure_positions.size()) : left[l - 1]) - left[l] >= 3)
+        q.common_openings += openings_on(t.structure_positions, lines[l], 2.0, min_opening, a.level(0), b.level(0), a_to_b);
     if (lines.size() >= 3) {
       const int across = closed_end(t.structure_positions, lines, 2.0);
       if (across >= 0) {

@@ -39,7 +39,11 @@ struct QualityOptions {
   // open space (AlignmentQuality::open_space_walls). Drift lays walls a cell or three beside the
   // other map's; a wall this far from any of them is a wall where the other map saw a room.
   double open_space_distance = 6.0;
-  // Count the shape of the common walls too (beyond_corner, wall_ends, junction_arms, beyond_room).
+  // metres: a stretch of a common wall's line free in both maps, between matched walls, at least
+  // this long is an opening both saw (AlignmentQuality::common_openings): a door is 0.6-1 m.
+  double min_opening_m = 0.5;
+  // Count the shape of the common walls too (beyond_corner, wall_ends, junction_arms, beyond_room,
+  // parallel_lines, off_room_sides, common_openings).
   // Off, they stay 0: enough for placements that are only compared by score and evidence (the
   // rivals of an answer), and a third of the time of a full evaluation.
   bool shape = true;
@@ -86,6 +90,19 @@ struct AlignmentQuality {
   // The same for the four lines that hold the most: 0 when the common walls are the sides of one
   // rectangular room (or fewer lines), which fits itself turned a half turn.
   int beyond_room = 0;
+  // Of those four lines, the ones that hold 8 blocks or more (a wall 16 cells long seen by both
+  // maps), run along or square to the strongest (within 10 degrees) and lie a metre or more from a
+  // stronger parallel one are sides of a room; the rest (jogs, niches, a door's reveal, slanted
+  // walls) are details on its walls. The most sides that run parallel (within 10
+  // degrees): at most 2 when the common walls are sides of one rectangular room; 3 or more when a
+  // wall runs beside a side (a step in the outline, a partition, the next room's wall).
+  int parallel_lines = 0;
+  // The blocks on none of those sides: details on the walls, walls beyond the room.
+  int off_room_sides = 0;
+  // Openings in those lines that both maps saw: stretches of a line at least min_opening_m long
+  // between matched walls on it, free in both maps (a door both looked through, where one wall ends
+  // and the next begins). Where along its walls a room is, which its size alone does not say.
+  int common_openings = 0;
   // When the three lines that hold the most matched walls are one end of a hall (two parallel walls
   // and one across them, the parallel walls' blocks on one side of it) and neither map saw past the
   // two parallel walls (at most 2% of its free cells more than 4 cells outside them): the blocks

@@ -449,6 +449,16 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   const bool one_room =
       co.min_turned_share > 0.0 && best_q.beyond_room <= co.zero_beyond_corner && turned >= co.min_turned_share;
   if (one_room) result.distinctiveness = 0.0;
+  // A bare room: the common walls are sides of one rectangular room (four long straight walls at
+  // most, no more than two of them parallel, nothing off them: no jog or niche), with no opening in
+  // them that both maps saw and no wall going on past a corner (a T). All they fix is the room's size, and a room of that size elsewhere, in this
+  // building or another, fits them as well; the rest of each map lies on the other's unknown.
+  // Seen on the benchmark of robot-built maps: windows of two different houses merged at 0.69 and
+  // 0.56, three sides of a room laid on a room of the other house as wide.
+  const bool bare_room = co.refuse_bare_room && best_q.off_room_sides <= co.zero_beyond_corner &&
+                         best_q.parallel_lines <= 2 && best_q.wall_ends == 0 && best_q.common_openings == 0 &&
+                         best_q.junction_arms < 3;
+  if (bare_room) result.distinctiveness = 0.0;
   // One end of a bare hall: the common walls are two parallel walls and one across them, nothing
   // else (no wall off those lines, no opening in them seen by both), and neither map saw past the
   // two parallel walls. The two maps may show the same end or the two ends of a longer hall, each
@@ -483,6 +493,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       if (hall_end)
         return {Refusal::HallEnd, "the common walls are one end of a bare hall (two parallel walls and one across), which the "
                                   "hall's other end fits as well: the maps may show its two ends"};
+      if (bare_room)
+        return {Refusal::OneRoom, "the common walls are sides of one bare rectangular room (no opening both maps saw, no wall "
+                                  "going on past a corner), which any room of that size fits as well"};
       if (result.distinctiveness < 0.5)
         return {Refusal::AnotherPlacement, "another placement fits nearly as well, or without the answer's contradictions (repeated or symmetric places)"};
       if (constraint < co.half_evidence)

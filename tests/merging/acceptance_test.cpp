@@ -109,5 +109,42 @@ TEST(AlignmentQuality, CountsTheArmsOfTheJunctionOfTheCommonWalls) {
   EXPECT_EQ(evaluate_alignment(pl, pl, core::Transform2::identity()).junction_arms, 2);
 }
 
+// One rectangular room, 5 x 4 m (walls 2 cells thick, unknown outside), laid on itself: two of its
+// four sides run parallel and nothing lies off them, so all its walls say is the room's size. A
+// niche in a side puts walls off the sides; a door that both maps see through is an opening they
+// share, which fixes where along that side the room is.
+TEST(AlignmentQuality, TellsTheSidesOfABareRoomFromWallsWithDetails) {
+  const auto room = [](bool niche, bool door) {
+    std::vector<std::string> rows(110, std::string(120, '?'));
+    const auto fill = [&](int x0, int x1, int r0, int r1, char c) {
+      for (int r = r0; r < r1; ++r) rows[std::size_t(r)].replace(std::size_t(x0), std::size_t(x1 - x0), std::size_t(x1 - x0), c);
+    };
+    fill(8, 112, 10, 94, '#');
+    fill(10, 110, 12, 92, '.');
+    if (niche) {  // 0.8 m wide, 0.3 m deep, in the bottom side
+      fill(48, 68, 92, 100, '#');
+      fill(50, 66, 92, 98, '.');
+    }
+    if (door) {  // 0.9 m wide in the top side, and the corridor behind it
+      fill(70, 88, 10, 12, '.');
+      fill(60, 100, 0, 10, '.');
+    }
+    return grid_from_text(rows);
+  };
+  const auto bare_room = room(false, false), with_niche = room(true, false), with_door = room(false, true);
+  const PreparedGrid bare(bare_room), niche(with_niche), door(with_door);
+  const auto at_identity = [](const PreparedGrid& g) { return evaluate_alignment(g, g, core::Transform2::identity()); };
+  const AlignmentQuality q_bare = at_identity(bare);
+  EXPECT_EQ(q_bare.parallel_lines, 2);
+  EXPECT_LE(q_bare.off_room_sides, 1);
+  EXPECT_EQ(q_bare.common_openings, 0);
+  const AlignmentQuality q_niche = at_identity(niche);
+  EXPECT_TRUE(q_niche.parallel_lines >= 3 || q_niche.off_room_sides >= 2)
+      << q_niche.parallel_lines << " parallel, " << q_niche.off_room_sides << " off the sides";
+  EXPECT_EQ(at_identity(door).common_openings, 1);
+  // Slid along the door's wall by 2 m, the door lies on the other map's wall: no common opening.
+  EXPECT_EQ(evaluate_alignment(door, door, core::Transform2(40.0, 0.0, 0.0)).common_openings, 0);
+}
+
 }  // namespace
 }  // namespace fleetmap::merging
