@@ -71,7 +71,8 @@ TEST(AlignmentQuality, WallsSeenFromOppositeSidesDoNotMatch) {
   std::vector<std::string> left(30, std::string(30, '?')), right = left;
   for (auto& r : left) r.replace(0, 15, std::string(14, '.') + "#");
   for (auto& r : right) r.replace(14, 16, "#" + std::string(15, '.'));
-  const PreparedGrid a(grid_from_text(left)), b(grid_from_text(right)), same(grid_from_text(left));
+  const auto left_map = grid_from_text(left), right_map = grid_from_text(right);  // outlive the prepared grids
+  const PreparedGrid a(left_map), b(right_map), same(left_map);
   const AlignmentQuality opposite = evaluate_alignment(a, b, core::Transform2::identity());
   const AlignmentQuality seen_alike = evaluate_alignment(a, same, core::Transform2::identity());
   EXPECT_GT(seen_alike.matched, 40);  // the 30-cell wall, from both maps
@@ -104,7 +105,8 @@ TEST(AlignmentQuality, CountsTheArmsOfTheJunctionOfTheCommonWalls) {
   for (int y = 11; y < 40; ++y) t[std::size_t(y)][25] = '#';
   std::vector<std::string> l = t;
   for (int y = 10; y < 40; ++y) l[std::size_t(y)].replace(0, 25, std::string(25, '?'));
-  const PreparedGrid pt(grid_from_text(t)), pl(grid_from_text(l));
+  const auto t_map = grid_from_text(t), l_map = grid_from_text(l);  // outlive the prepared grids
+  const PreparedGrid pt(t_map), pl(l_map);
   EXPECT_EQ(evaluate_alignment(pt, pt, core::Transform2::identity()).junction_arms, 3);
   EXPECT_EQ(evaluate_alignment(pl, pl, core::Transform2::identity()).junction_arms, 2);
 }

@@ -69,11 +69,12 @@ TEST(PreparedGrid, SpecksAreNoise) {
   std::vector<std::string> rows(20, std::string(20, '.'));
   rows[3][3] = '#';                             // a one-cell speck
   rows[10] = std::string(4, '.') + std::string(12, '#') + std::string(4, '.');  // a wall
-  const PreparedGrid p(grid_from_text(rows));
+  const auto p_map = grid_from_text(rows);  // outlives the prepared grid
+  const PreparedGrid p(p_map);
   EXPECT_EQ(p.walls().size(), 12u);
   PrepareOptions keep;
   keep.min_obstacle_cells = 1;
-  EXPECT_EQ(PreparedGrid(grid_from_text(rows), keep).walls().size(), 13u);
+  EXPECT_EQ(PreparedGrid(p_map, keep).walls().size(), 13u);
 }
 
 // Specks are the occupied components (8-connected) smaller than min_obstacle_cells, whatever their
@@ -133,7 +134,8 @@ TEST(PreparedGrid, SmallLoneObstaclesAreClutterAndNeverContradict) {
   EXPECT_FALSE(clutter_at(26, 28));
   // The same room without the chair: the chair lies on its clear free space.
   for (int r = 10; r < 13; ++r) rows[std::size_t(r)].replace(10, 3, "...");
-  const PreparedGrid empty(grid_from_text(rows));
+  const auto empty_map = grid_from_text(rows);  // outlives the prepared grid
+  const PreparedGrid empty(empty_map);
   const AlignmentQuality q = evaluate_alignment(empty, p, core::Transform2::identity());
   EXPECT_EQ(q.contradicted, 0);
   EXPECT_GT(q.matched, 60);
@@ -149,7 +151,8 @@ TEST(PreparedGrid, PyramidKeepsThinWalls) {
   for (auto& r : rows) r[31] = '#';  // a one-cell wall
   PrepareOptions o;
   o.min_level_size = 8;
-  const PreparedGrid p(grid_from_text(rows), o);
+  const auto p_map = grid_from_text(rows);  // outlives the prepared grid
+  const PreparedGrid p(p_map, o);
   ASSERT_GE(p.level_count(), 4);
   for (int k = 1; k < p.level_count(); ++k) {
     const GridLevel& l = p.level(k);
@@ -176,7 +179,8 @@ TEST(PreparedGrid, LevelTransformsRoundTripAndAgreeWithCellCentres) {
 TEST(PreparedGrid, WallStructureIsTheNormalOnAStraightWall) {
   std::vector<std::string> rows(21, std::string(21, '.'));
   rows[10] = std::string(21, '#');
-  const PreparedGrid p(grid_from_text(rows));
+  const auto p_map = grid_from_text(rows);  // outlives the prepared grid
+  const PreparedGrid p(p_map);
   for (const auto& w : p.walls()) {
     if (w.position.x() < 4 || w.position.x() > 16) continue;  // away from the ends
     EXPECT_NEAR(w.structure(1, 1), 1.0f, 1e-5) << w.position.transpose();  // normal is y
@@ -195,7 +199,8 @@ TEST(PreparedGrid, WallDistanceIsEuclideanAtEveryLevel) {
   PrepareOptions o;
   o.min_level_size = 12;
   o.max_wall_distance = 7.5;  // the map's far corners are farther
-  const PreparedGrid p(grid_from_text(rows), o);
+  const auto p_map = grid_from_text(rows);  // outlives the prepared grid
+  const PreparedGrid p(p_map, o);
   ASSERT_GE(p.level_count(), 2);
   for (int k = 0; k < 2; ++k) {
     const GridLevel& l = p.level(k);
@@ -219,7 +224,8 @@ TEST(PreparedGrid, ClutterAndSpecksAtTheMapsEdge) {
   for (int r = 0; r < 3; ++r) rows[std::size_t(r)].replace(0, 3, "###");  // a chair in the top-left corner
   rows[39] = std::string(40, '#');                                      // a wall along the bottom edge
   rows[20][39] = '#';                                                   // a one-cell speck on the right edge
-  const PreparedGrid p(grid_from_text(rows));
+  const auto p_map = grid_from_text(rows);  // outlives the prepared grid
+  const PreparedGrid p(p_map);
   const GridLevel& l0 = p.level(0);
   const auto at = [&](const cv::Mat& m, int x, int row) { return m.at<std::uint8_t>(39 - row, x) != 0; };
   EXPECT_TRUE(at(l0.clutter, 1, 1));
