@@ -270,6 +270,9 @@ std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, do
   return left;
 }
 
+// The points the line `l` of beyond_lines took (`left` as it gives it, `total` points before).
+int points_on(const std::vector<int>& left, int total, std::size_t l) { return (l == 0 ? total : left[l - 1]) - left[l]; }
+
 // The sides of a room among `lines` (`left` as beyond_lines gives it, `total` points before): lines
 // that hold `min_points` points or more, run along the strongest side or square to it (within 10
 // degrees), and lie at least `min_width` from a stronger parallel side. A weaker line closer than
@@ -281,7 +284,7 @@ std::vector<const Line*> room_sides(const std::vector<Line>& lines, const std::v
   const double parallel = std::cos(10.0 * std::numbers::pi / 180.0), square = std::sin(10.0 * std::numbers::pi / 180.0);
   std::vector<const Line*> sides;
   for (std::size_t l = 0; l < lines.size(); ++l) {
-    const int on = (l == 0 ? total : left[l - 1]) - left[l];
+    const int on = points_on(left, total, l);
     if (on < min_points) continue;
     const Line& line = lines[l];
     const bool detail = std::any_of(sides.begin(), sides.end(), [&](const Line* s) {
@@ -448,7 +451,7 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
     const double min_opening = options.min_opening_m / a.grid().resolution();
     const core::Transform2 a_to_b = b_to_a.inverse();
     for (std::size_t l = 0; l < lines.size(); ++l)
-      if ((l == 0 ? int(t.structure_positions.size()) : left[l - 1]) - left[l] >= 3)
+      if (points_on(left, total, l) >= 3)
         q.common_openings += openings_on(t.structure_positions, lines[l], 2.0, min_opening, a.level(0), b.level(0), a_to_b);
     if (lines.size() >= 3) {
       const int across = closed_end(t.structure_positions, lines, 2.0);

@@ -273,6 +273,10 @@ void check_search_options(const MergeOptions& options) {
   at_least("first_level_iterations", options.first_level_iterations, 0);
   at_least("overlap.search_cells", options.overlap.search_cells, 1);
   at_least("sweep_search_cells", options.sweep_search_cells, 1);
+  // A shorter stretch would count the gap between two neighbouring walls as a door.
+  if (!(options.quality.min_opening_m > 0.0))
+    throw InputError(fmt::format("merge options: quality.min_opening_m must be greater than 0 (got {})",
+                                 options.quality.min_opening_m));
   if (!(options.confidence.zero_open_space > options.confidence.full_open_space))
     throw InputError(fmt::format("merge options: confidence.zero_open_space ({}) must be greater than full_open_space ({})",
                                  options.confidence.zero_open_space, options.confidence.full_open_space));
@@ -451,8 +455,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   if (one_room) result.distinctiveness = 0.0;
   // A bare room: the common walls are sides of one rectangular room (four long straight walls at
   // most, no more than two of them parallel, nothing off them: no jog or niche), with no opening in
-  // them that both maps saw and no wall going on past a corner (a T). All they fix is the room's size, and a room of that size elsewhere, in this
-  // building or another, fits them as well; the rest of each map lies on the other's unknown.
+  // them that both maps saw and no wall going on past a corner (a T). All they fix is the room's
+  // size, and a room of that size elsewhere, in this building or another, fits them as well; the
+  // rest of each map lies on the other's unknown.
   // Seen on the benchmark of robot-built maps: windows of two different houses merged at 0.69 and
   // 0.56, three sides of a room laid on a room of the other house as wide.
   const bool bare_room = co.refuse_bare_room && best_q.off_room_sides <= co.zero_beyond_corner &&

@@ -859,7 +859,8 @@ TEST(AlignMaps, OptionsKeepingNoCandidateAreAnInputErrorNamingThem) {
            {[](MergeOptions& o) { o.coarse_candidates = -1; }, "coarse_candidates"},
            {[](MergeOptions& o) { o.first_level_iterations = -2; }, "first_level_iterations"},
            {[](MergeOptions& o) { o.overlap.search_cells = 0; }, "overlap.search_cells"},
-           {[](MergeOptions& o) { o.confidence.zero_open_space = o.confidence.full_open_space; }, "zero_open_space"}}) {
+           {[](MergeOptions& o) { o.confidence.zero_open_space = o.confidence.full_open_space; }, "zero_open_space"},
+           {[](MergeOptions& o) { o.quality.min_opening_m = 0.0; }, "min_opening_m"}}) {
     MergeOptions options;
     set(options);
     fleetmap::testing::expect_input_error([&] { align_maps(office, office, options); }, {"merge options", name});
