@@ -149,6 +149,14 @@ Args parse_args(int argc, char** argv) {
         usage(k + ": '" + v + "' is not a number");
       }
     };
+    // A cell-size factor: a whole number from 1 to `most`.
+    const auto factor = [&](int most) {
+      const std::string v = value();
+      const double f = number(v);
+      if (!(f >= 1.0 && f <= most && f == std::floor(f)))
+        usage(k + ": '" + v + "' is not a whole number from 1 to " + std::to_string(most));
+      return int(f);
+    };
     if (k == "--plans") a.plans = value();
     else if (k == "--cache") a.cache = value();
     else if (k == "--csv") a.csv = value();
@@ -169,24 +177,9 @@ Args parse_args(int argc, char** argv) {
       a.real_window = int(number(v));
       if (a.real_window < 50) usage("--real-window: '" + v + "' is under 50 cells");
     }
-    else if (k == "--real-coarsen") {
-      const std::string v = value();
-      const double f = number(v);
-      if (!(f >= 1.0 && f <= 64.0 && f == std::floor(f))) usage("--real-coarsen: '" + v + "' is not a whole number from 1 to 64");
-      a.real_coarsen = int(f);
-    }
-    else if (k == "--real-mixed") {
-      const std::string v = value();
-      const double f = number(v);
-      if (!(f >= 1.0 && f <= 16.0 && f == std::floor(f))) usage("--real-mixed: '" + v + "' is not a whole number from 1 to 16");
-      a.real_mixed = int(f);
-    }
-    else if (k == "--two-robots-mixed") {
-      const std::string v = value();
-      const double f = number(v);
-      if (!(f >= 1.0 && f <= 16.0 && f == std::floor(f))) usage("--two-robots-mixed: '" + v + "' is not a whole number from 1 to 16");
-      a.two_robots_mixed = int(f);
-    }
+    else if (k == "--real-coarsen") a.real_coarsen = factor(64);
+    else if (k == "--real-mixed") a.real_mixed = factor(16);
+    else if (k == "--two-robots-mixed") a.two_robots_mixed = factor(16);
     else if (k == "--real-unrelated") a.real_unrelated = int(number(value()));
     else if (k == "--method") a.method = value();
     else if (k == "--min-confidence") a.min_confidence = number(value());

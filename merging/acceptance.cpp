@@ -270,6 +270,9 @@ std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, do
   return left;
 }
 
+// Lines within 10 degrees of parallel (|n1 . n2| at least this), or of square (at most this).
+const double kParallel = std::cos(10.0 * std::numbers::pi / 180.0), kSquare = std::sin(10.0 * std::numbers::pi / 180.0);
+
 // The points the line `l` of beyond_lines took (`left` as it gives it, `total` points before).
 int points_on(const std::vector<int>& left, int total, std::size_t l) { return (l == 0 ? total : left[l - 1]) - left[l]; }
 
@@ -281,18 +284,17 @@ int points_on(const std::vector<int>& left, int total, std::size_t l) { return (
 // `on_sides`.
 std::vector<const Line*> room_sides(const std::vector<Line>& lines, const std::vector<int>& left, int total, int min_points,
                                     double min_width, int& on_sides) {
-  const double parallel = std::cos(10.0 * std::numbers::pi / 180.0), square = std::sin(10.0 * std::numbers::pi / 180.0);
   std::vector<const Line*> sides;
   for (std::size_t l = 0; l < lines.size(); ++l) {
     const int on = points_on(left, total, l);
     if (on < min_points) continue;
     const Line& line = lines[l];
     const bool detail = std::any_of(sides.begin(), sides.end(), [&](const Line* s) {
-      return std::abs(s->normal.dot(line.normal)) >= parallel && std::abs(s->normal.dot(line.on - s->on)) < min_width;
+      return std::abs(s->normal.dot(line.normal)) >= kParallel && std::abs(s->normal.dot(line.on - s->on)) < min_width;
     });
     // A rectangular room's sides run along the strongest one or square to it.
-    const bool askew = !sides.empty() && std::abs(sides[0]->normal.dot(line.normal)) < parallel &&
-                       std::abs(sides[0]->normal.dot(line.normal)) > square;
+    const bool askew = !sides.empty() && std::abs(sides[0]->normal.dot(line.normal)) < kParallel &&
+                       std::abs(sides[0]->normal.dot(line.normal)) > kSquare;
     if (detail || askew) continue;
     sides.push_back(&line);
     on_sides += on;
@@ -302,11 +304,10 @@ std::vector<const Line*> room_sides(const std::vector<Line>& lines, const std::v
 
 // The most of `lines` that run parallel to one another (within 10 degrees).
 int most_parallel(const std::vector<const Line*>& lines) {
-  const double parallel = std::cos(10.0 * std::numbers::pi / 180.0);
   int most = 0;
   for (const Line* x : lines)
     most = std::max(most, int(std::count_if(lines.begin(), lines.end(), [&](const Line* y) {
-                                return std::abs(x->normal.dot(y->normal)) >= parallel;
+                                return std::abs(x->normal.dot(y->normal)) >= kParallel;
                               })));
   return most;
 }
@@ -371,12 +372,11 @@ int junction_arms(const std::vector<Eigen::Vector2d>& points, const Line& l1, co
 // more than `tolerance` off it, and the points on the third between the other two. A U, whichever
 // order the Hough transform found its sides in.
 int closed_end(const std::vector<Eigen::Vector2d>& points, const std::vector<Line>& lines, double tolerance) {
-  const double parallel = std::cos(10.0 * std::numbers::pi / 180.0), square = std::sin(10.0 * std::numbers::pi / 180.0);
   for (int across = 0; across < 3; ++across) {
     const Line& c = lines[std::size_t(across)];
     const Line& s1 = lines[std::size_t((across + 1) % 3)];
     const Line& s2 = lines[std::size_t((across + 2) % 3)];
-    if (std::abs(s1.normal.dot(s2.normal)) < parallel || std::abs(c.normal.dot(s1.normal)) > square) continue;
+    if (std::abs(s1.normal.dot(s2.normal)) < kParallel || std::abs(c.normal.dot(s1.normal)) > kSquare) continue;
     const double side_offset = s1.normal.dot(s2.on - s1.on);  // s2 from s1, along s1's normal
     if (std::abs(side_offset) < 4.0 * tolerance) continue;  // one thick wall, not two
     int before = 0, beyond = 0, between = 0, outside = 0;
