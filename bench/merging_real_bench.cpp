@@ -103,6 +103,8 @@ struct Args {
   std::vector<double> overlaps = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9};
   std::string method = "auto";
   double min_confidence = merging::MergeOptions{}.min_confidence;
+  int coarse_candidates = merging::MergeOptions{}.coarse_candidates;
+  int fine_candidates = merging::MergeOptions{}.fine_candidates;
   bool peer = true;
   double clutter = 1.0;      // scales the clutter rates (0: none)
   double furniture = 0.0;    // one piece of furniture per this many m² of floor (0: the bare plans)
@@ -115,7 +117,7 @@ constexpr const char* kUsage =
     "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--two-robots-mixed F] [--overlaps 0.1,0.5,...]\n"
     "       [--real-maps MAP,...] [--real-pairs N] [--real-window CELLS] [--real-coarsen F] [--real-mixed F]\n"
     "       [--real-unrelated N]\n"
-    "       [--method auto] [--min-confidence C] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
+    "       [--method auto] [--min-confidence C] [--coarse-candidates N] [--fine-candidates N] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
 
 [[noreturn]] void usage(const std::string& problem) {
   std::cerr << "fleetmap_bench_merging_real: " << problem << "\n" << kUsage;
@@ -148,6 +150,14 @@ Args parse_args(int argc, char** argv) {
       } catch (const std::exception&) {
         usage(k + ": '" + v + "' is not a number");
       }
+    };
+    // A number of candidates: a whole number, at least `least`.
+    const auto count = [&](int least) {
+      const std::string v = value();
+      const double n = number(v);
+      if (!(n >= least && n <= 1000 && n == std::floor(n)))
+        usage(k + ": '" + v + "' is not a whole number from " + std::to_string(least) + " to 1000");
+      return int(n);
     };
     // A cell-size factor: a whole number from 1 to `most`.
     const auto factor = [&](int most) {
@@ -183,6 +193,8 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--real-unrelated") a.real_unrelated = int(number(value()));
     else if (k == "--method") a.method = value();
     else if (k == "--min-confidence") a.min_confidence = number(value());
+    else if (k == "--coarse-candidates") a.coarse_candidates = count(1);
+    else if (k == "--fine-candidates") a.fine_candidates = count(1);
     else if (k == "--no-peer") a.peer = false;
     else if (k == "--clutter") a.clutter = number(value());
     else if (k == "--furniture") {
@@ -878,6 +890,8 @@ int main(int argc, char** argv) {
     merging::MergeOptions options;
     options.method = args.method;
     options.min_confidence = args.min_confidence;
+    options.coarse_candidates = args.coarse_candidates;
+    options.fine_candidates = args.fine_candidates;
     merging::check_merge_method(options.method);
 
     // The user's maps first: a wrong path is told before the long part.

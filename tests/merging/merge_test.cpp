@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <optional>
+#include <string>
 #include <tuple>
 
 #include <opencv2/imgcodecs.hpp>
@@ -814,40 +815,63 @@ TEST(AlignMaps, WallsFittingCloserThanAFifthOfACellWeighAsAFifth) {
   EXPECT_NEAR(r.evidence, r.quality.constraint * std::log(chance_rms / 0.2), 1e-9 * r.evidence);
 }
 
-// A method's best proposal is refined to full resolution whatever a few steps at the coarse level
-// where it enters make of it: those steps rank candidates roughly, and only a few go on (seen on a
-// real laser map: the right candidate, the rotation sweep's first, ranked 33rd-40th of 73 at 8 x 8
-// cells, 8 went on, and the pair was refused). Here the truth enters a few cells and degrees off,
-// where its walls cross a's free space, behind another method's ten placements that lay b beside a.
-TEST(AlignMaps, AMethodsBestProposalGoesOnWhateverTheCoarseRanking) {
+// The truth of a furnished pair entering at a coarse level a few cells and degrees off, where its
+// walls cross a's free space (below `beside` placements that lay b beside a, score 0, and not
+// agreeing as a merged answer's walls must), decided with them; the truth's method is `method`,
+// the others' "beside" unless `method` is "beside" too, its proposal then the weakest of them.
+MergeResult decide_truth_behind(int beside, const std::string& method) {
   const CropPair pair = furnished_half_overlap_pair();
   const PreparedGrid a(pair.a), b(pair.b);
   MergeOptions options;
   options.first_level_iterations = 0;  // the entry level ranks the candidates as they come
   const int entry = std::min(a.level_count(), b.level_count()) - 1;
-  ASSERT_GE(entry, 2);  // a coarse level, where few go on (MergeOptions::coarse_candidates)
+  EXPECT_GE(entry, 2);  // a coarse level, where few go on (MergeOptions::coarse_candidates)
   const core::Transform2 off(pair.b_to_a.translation() + Eigen::Vector2d(16.0, 8.0),
                              pair.b_to_a.rotation() + core::deg2rad(3.0));
   std::vector<Hypothesis> candidates;
-  for (int i = 0; i < 10; ++i) {
-    candidates.push_back({core::Transform2(a.width() + 20.0 + 40.0 * i, 0.0, 0.0), 10.0 - i, entry, "beside"});
-  }
-  candidates.push_back({off, 1.0, entry, "truth"});
-  ASSERT_GT(int(candidates.size()) - 1, options.coarse_candidates);
+  for (int i = 0; i < beside; ++i)
+    candidates.push_back({core::Transform2(a.width() + 20.0 + 40.0 * i, 0.0, 0.0), 100.0 - i, entry, "beside"});
+  candidates.push_back({off, 1.0, entry, method});
   const LevelFit at_entry = refine_at_level(a, b, off, entry, [&] {
     RefineOptions r = options.refinement;
     r.iterations = 0;
     return r;
   }());
-  // Below the placements beside a (score 0), and not agreeing as a merged answer's walls must.
-  ASSERT_LT(at_entry.score, 0.0);
-  ASSERT_LT(at_entry.inliers, options.confidence.zero_agreement * (at_entry.inliers + at_entry.outliers));
-  const MergeResult r = decide(a, b, candidates, options);
+  EXPECT_LT(at_entry.score, 0.0);
+  EXPECT_LT(at_entry.inliers, options.confidence.zero_agreement * (at_entry.inliers + at_entry.outliers));
+  MergeResult r = decide(a, b, candidates, options);
+  if (r.merged) {
+    const TransformError e = transform_error(r.transform, pair.b_to_a, pair.overlap_centre_b);
+    EXPECT_LT(e.rotation_deg, kMaxRotationDeg);
+    EXPECT_LT(e.translation_cells, kMaxTranslationCells);
+  }
+  return r;
+}
+
+// A method's best proposal is refined to full resolution whatever a few steps at the coarse level
+// where it enters make of it: those steps rank candidates roughly, and only a few go on (seen on a
+// real laser map: the right candidate, the rotation sweep's first, ranked 33rd-40th of 73 at 8 x 8
+// cells, 8 went on, and the pair was refused). Here it ranks last, behind more placements of another
+// method than go on.
+TEST(AlignMaps, AMethodsBestProposalGoesOnWhateverTheCoarseRanking) {
+  const int beside = MergeOptions{}.coarse_candidates + 2;
+  const MergeResult r = decide_truth_behind(beside, "truth");
   ASSERT_TRUE(r.merged) << r.reason;
   EXPECT_EQ(r.method, "truth");
-  const TransformError e = transform_error(r.transform, pair.b_to_a, pair.overlap_centre_b);
-  EXPECT_LT(e.rotation_deg, kMaxRotationDeg);
-  EXPECT_LT(e.translation_cells, kMaxTranslationCells);
+}
+
+// Of one method's proposals, twelve go on from the coarse level where they enter, not eight: on
+// 4 x 4 cells a large right fit with a few walls on the other map's free space ranks below small
+// exact fits (seen on real laser maps: the truth, refined from the spectral search's second
+// candidate, ranked tenth, 55 walls in and 3 out against 34 in and none, and the pair was refused;
+// a corridor's right placement ranked ninth). Here the truth, not its method's best, ranks
+// eleventh; behind twelve it is lost.
+TEST(AlignMaps, TheEleventhCandidateOnCoarseCellsGoesOn) {
+  ASSERT_GE(MergeOptions{}.coarse_candidates, 11);
+  const MergeResult r = decide_truth_behind(10, "beside");
+  ASSERT_TRUE(r.merged) << r.reason;
+  EXPECT_EQ(r.method, "beside");
+  EXPECT_FALSE(decide_truth_behind(MergeOptions{}.coarse_candidates, "beside").merged);
 }
 
 // Options that would leave no candidate to decide on are an input error naming the option, not a
