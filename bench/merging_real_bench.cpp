@@ -151,21 +151,13 @@ Args parse_args(int argc, char** argv) {
         usage(k + ": '" + v + "' is not a number");
       }
     };
-    // A number of candidates: a whole number, at least `least`.
-    const auto count = [&](int least) {
+    // A whole number from `least` to `most` (a cell-size factor, a number of candidates).
+    const auto whole = [&](int least, int most) {
       const std::string v = value();
       const double n = number(v);
-      if (!(n >= least && n <= 1000 && n == std::floor(n)))
-        usage(k + ": '" + v + "' is not a whole number from " + std::to_string(least) + " to 1000");
+      if (!(n >= least && n <= most && n == std::floor(n)))
+        usage(k + ": '" + v + "' is not a whole number from " + std::to_string(least) + " to " + std::to_string(most));
       return int(n);
-    };
-    // A cell-size factor: a whole number from 1 to `most`.
-    const auto factor = [&](int most) {
-      const std::string v = value();
-      const double f = number(v);
-      if (!(f >= 1.0 && f <= most && f == std::floor(f)))
-        usage(k + ": '" + v + "' is not a whole number from 1 to " + std::to_string(most));
-      return int(f);
     };
     if (k == "--plans") a.plans = value();
     else if (k == "--cache") a.cache = value();
@@ -187,14 +179,14 @@ Args parse_args(int argc, char** argv) {
       a.real_window = int(number(v));
       if (a.real_window < 50) usage("--real-window: '" + v + "' is under 50 cells");
     }
-    else if (k == "--real-coarsen") a.real_coarsen = factor(64);
-    else if (k == "--real-mixed") a.real_mixed = factor(16);
-    else if (k == "--two-robots-mixed") a.two_robots_mixed = factor(16);
+    else if (k == "--real-coarsen") a.real_coarsen = whole(1, 64);
+    else if (k == "--real-mixed") a.real_mixed = whole(1, 16);
+    else if (k == "--two-robots-mixed") a.two_robots_mixed = whole(1, 16);
     else if (k == "--real-unrelated") a.real_unrelated = int(number(value()));
     else if (k == "--method") a.method = value();
     else if (k == "--min-confidence") a.min_confidence = number(value());
-    else if (k == "--coarse-candidates") a.coarse_candidates = count(1);
-    else if (k == "--fine-candidates") a.fine_candidates = count(1);
+    else if (k == "--coarse-candidates") a.coarse_candidates = whole(1, 1000);
+    else if (k == "--fine-candidates") a.fine_candidates = whole(1, 1000);
     else if (k == "--no-peer") a.peer = false;
     else if (k == "--clutter") a.clutter = number(value());
     else if (k == "--furniture") {
