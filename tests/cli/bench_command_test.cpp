@@ -28,7 +28,7 @@ std::string sweep_flags(int seeds) {
          " --steps 300";
 }
 const std::string kSweep = sweep_flags(2);
-constexpr int kRuns = 16;
+constexpr int kSweepRuns = 16;
 
 struct BenchDir {
   TempDir dir;
@@ -53,7 +53,7 @@ TEST(BenchCommand, TinySweepWritesEveryOutputAndItsSummaryMatchesItsRows) {
     EXPECT_TRUE(std::filesystem::exists(b / "out" / f)) << f;
   }
   const CsvTable results = read_csv(b / "out" / "results.csv");
-  ASSERT_EQ(int(results.rows.size()), kRuns);
+  ASSERT_EQ(int(results.rows.size()), kSweepRuns);
   std::set<std::string> keys;
   int reached = 0;
   for (const auto& row : results.rows) {
@@ -72,8 +72,8 @@ TEST(BenchCommand, TinySweepWritesEveryOutputAndItsSummaryMatchesItsRows) {
     EXPECT_LE(number(row.at("lower_bound_steps")), number(row.at("steps_to_99")));
     EXPECT_NEAR(number(row.at("efficiency")), number(row.at("lower_bound_steps")) / number(row.at("steps_to_99")), 1e-6);
   }
-  EXPECT_EQ(int(keys.size()), kRuns);
-  EXPECT_GE(reached, kRuns / 2);
+  EXPECT_EQ(int(keys.size()), kSweepRuns);
+  EXPECT_GE(reached, kSweepRuns / 2);
 
   // summary.csv, recomputed here from results.csv: mean, sample sd and the t interval over seeds.
   const CsvTable summary = read_csv(b / "out" / "summary.csv");
@@ -151,7 +151,7 @@ TEST(BenchCommand, SameRowsWhateverTheNumberOfJobs) {
   ASSERT_EQ(b.bench(kSweep + " --jobs 1 --out one").exit_code, 0);
   ASSERT_EQ(b.bench(kSweep + " --jobs 2 --out two").exit_code, 0);
   const auto one = rows_without_wall_time(b / "one" / "results.csv");
-  EXPECT_EQ(one.size(), std::size_t(kRuns + 1));
+  EXPECT_EQ(one.size(), std::size_t(kSweepRuns + 1));
   EXPECT_EQ(one, rows_without_wall_time(b / "two" / "results.csv"));
   EXPECT_EQ(slurp(b / "one" / "summary.csv"), slurp(b / "two" / "summary.csv"));
   EXPECT_EQ(slurp(b / "one" / "summary.md"), slurp(b / "two" / "summary.md"));
@@ -235,7 +235,7 @@ TEST(BenchCommand, ShardsCombineIntoTheFullRun) {
     total += int(rows.size()) - 1;
     for (std::size_t i = 1; i < rows.size(); ++i) EXPECT_TRUE(seen.insert(rows[i]).second) << "in two shards: " << rows[i];
   }
-  EXPECT_EQ(total, kRuns);
+  EXPECT_EQ(total, kSweepRuns);
   const auto c = b.bench("--combine s1 s2 s3 --out all");
   ASSERT_EQ(c.exit_code, 0) << c.err;
   EXPECT_NE(c.out.find("combined 16 runs from 3 folders"), std::string::npos) << c.out;

@@ -46,7 +46,7 @@ TEST_P(GoldenRuns, MetricsAreTheKeptOnes) {
   EXPECT_EQ(metrics, kept) << "metrics of `fleetmap explore " << args << "` changed; compare " << golden;
 }
 
-const GoldenRun kRuns[] = {
+const GoldenRun kGoldenRuns[] = {
     {"office_directional", "--map office --robots 4 --steps 150"},
     {"cave_coordinated_comm10", "--map cave --robots 3 --strategy coordinated --comm-range 10 --steps 150 --seed 2"},
     {"maze_market_odometry", "--map maze --robots 3 --strategy market --localization odometry --steps 120"},
@@ -59,7 +59,7 @@ const GoldenRun kRuns[] = {
     {"office_astar_paths", "--map office --robots 2 --path-planner astar --steps 80"},
 };
 
-INSTANTIATE_TEST_SUITE_P(KeptRuns, GoldenRuns, ::testing::ValuesIn(kRuns),
+INSTANTIATE_TEST_SUITE_P(KeptRuns, GoldenRuns, ::testing::ValuesIn(kGoldenRuns),
                          [](const ::testing::TestParamInfo<GoldenRun>& info) { return info.param.name; });
 
 }  // namespace

@@ -100,7 +100,9 @@ TEST(KilledRun, LeavesNoTruncatedFile) {
   for (const auto& entry : fs::directory_iterator(out)) {
     const std::string name = entry.path().filename().string();
     EXPECT_FALSE(is_temporary(name)) << name;
-    if (name != "outputs.txt") EXPECT_NE(listed.find("\n" + name + "\n"), std::string::npos) << name << " not listed";
+    if (name != "outputs.txt") {
+      EXPECT_NE(listed.find("\n" + name + "\n"), std::string::npos) << name << " not listed";
+    }
   }
 }
 

@@ -11,7 +11,7 @@
 namespace fleetmap::exploration {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNoPath = std::numeric_limits<double>::infinity();
 
 // Robots and targets as points; costs are straight-line distances.
 TourProblem euclidean(const std::vector<Eigen::Vector2d>& robots, const std::vector<Eigen::Vector2d>& targets) {
@@ -91,7 +91,7 @@ TEST(TourPlanner, EveryReachableTargetOnceByARobotThatReachesIt) {
     std::bernoulli_distribution lost(0.3);
     for (Eigen::Index r = 0; r < p.start_cost.rows(); ++r)
       for (Eigen::Index t = 0; t < p.start_cost.cols(); ++t)
-        if (lost(rng)) p.start_cost(r, t) = kInf;
+        if (lost(rng)) p.start_cost(r, t) = kNoPath;
     const Tours tours = plan_tours(p);
     ASSERT_EQ(tours.size(), std::size_t(n));
     std::multiset<int> seen;
@@ -102,7 +102,7 @@ TEST(TourPlanner, EveryReachableTargetOnceByARobotThatReachesIt) {
       }
     }
     for (int t = 0; t < m; ++t) {
-      const bool reachable = (p.start_cost.col(t).array() < kInf).any();
+      const bool reachable = (p.start_cost.col(t).array() < kNoPath).any();
       EXPECT_EQ(seen.count(t), reachable ? 1u : 0u) << "trial " << trial << " target " << t;
     }
   }
@@ -223,7 +223,7 @@ TEST(TourPlanner, LatencyToursVisitEveryReachableTargetOnceAndBeatGreedy) {
     std::bernoulli_distribution lost(0.3);
     for (Eigen::Index r = 0; r < p.start_cost.rows(); ++r)
       for (Eigen::Index t = 0; t < p.start_cost.cols(); ++t)
-        if (lost(rng)) p.start_cost(r, t) = kInf;
+        if (lost(rng)) p.start_cost(r, t) = kNoPath;
     std::vector<double> w(static_cast<std::size_t>(m));
     for (double& x : w) x = weight(rng);
     const Tours tours = plan_latency_tours(p, w);
@@ -236,7 +236,7 @@ TEST(TourPlanner, LatencyToursVisitEveryReachableTargetOnceAndBeatGreedy) {
       }
     }
     for (int t = 0; t < m; ++t) {
-      const bool reachable = (p.start_cost.col(t).array() < kInf).any();
+      const bool reachable = (p.start_cost.col(t).array() < kNoPath).any();
       EXPECT_EQ(seen.count(t), reachable ? 1u : 0u) << "trial " << trial << " target " << t;
     }
     // Given its own answer as the previous tours, it keeps them; from the greedy tours it never

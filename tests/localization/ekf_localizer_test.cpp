@@ -16,6 +16,7 @@ namespace {
 
 using testing::ring_world;
 using testing::simulate;
+using testing::counter;
 
 // Noise large enough that the linearisation is exercised, small enough for an EKF to be right.
 LocalizerOptions noisy_options() {
@@ -154,14 +155,6 @@ TEST(Ekf, NearestNeighbourAssociationFindsTheIdentitiesTheSensorWouldGive) {
                                      [](const auto& c) { return c.first == "rejected_associations"; });
   ASSERT_NE(rejected, counters.end());
   EXPECT_EQ(rejected->second, 0.0);
-}
-
-double counter(const Localizer& l, const std::string& name) {
-  for (const auto& [key, value] : l.counters()) {
-    if (key == name) return value;
-  }
-  ADD_FAILURE() << "no counter " << name;
-  return -1.0;
 }
 
 TEST(Ekf, RejectsAndCountsReadingsOutsideTheGateOrWithUnknownIds) {

@@ -19,8 +19,9 @@ namespace {
 
 using testing::ring_world;
 using testing::simulate;
+using testing::counter;
 
-LocalizerOptions noisy_options() {
+LocalizerOptions slam_options() {
   LocalizerOptions o;
   o.process_noise_xy = 0.03;
   o.process_noise_theta = 0.005;
@@ -36,14 +37,6 @@ std::unique_ptr<Localizer> make_slam(const LocalizerOptions& o) {
   c.initial_pose = testing::loop_start();
   c.options = o;
   return make_localizer("ekf-slam", c);
-}
-
-double counter(const Localizer& l, const std::string& name) {
-  for (const auto& [key, value] : l.counters()) {
-    if (key == name) return value;
-  }
-  ADD_FAILURE() << "no counter " << name;
-  return -1.0;
 }
 
 const Landmark* nearest(const testing::SimWorld& w, const Eigen::Vector2d& p) {
@@ -88,7 +81,7 @@ TEST(EkfSlam, WithoutNoiseStaysOnTheTruthAndMapsTheLandmarksExactly) {
 // D'Alfonso et al. eq. (4)-(5): a landmark enters at g(x_{k|k-1}, y_k) with covariance
 // G_pose P_{k|k-1} G_pose^T + G_y V G_y^T.
 TEST(EkfSlam, AddsALandmarkByTheAugmentationOfDAlfonso) {
-  LocalizerOptions o = noisy_options();
+  LocalizerOptions o = slam_options();
   o.initial_xy = 0.2;
   o.initial_theta = 0.05;
   auto slam = make_slam(o);
@@ -120,7 +113,7 @@ TEST(EkfSlam, AddsALandmarkByTheAugmentationOfDAlfonso) {
 TEST(EkfSlam, LandmarkEstimatesHoldTheTruthWithinTheirThreeSigmaEllipses) {
   const auto world = ring_world();
   for (bool known : {true, false}) {
-    LocalizerOptions o = noisy_options();
+    LocalizerOptions o = slam_options();
     o.known_associations = known;
     int total = 0, inside = 0;
     double worst = 0.0;
@@ -144,7 +137,7 @@ TEST(EkfSlam, LandmarkEstimatesHoldTheTruthWithinTheirThreeSigmaEllipses) {
 
 TEST(EkfSlam, UnknownAssociationsGiveOneLandmarkPerTrueLandmark) {
   const auto world = ring_world();
-  LocalizerOptions o = noisy_options();
+  LocalizerOptions o = slam_options();
   o.known_associations = false;
   auto slam = make_slam(o);
   core::Random rng(8);
@@ -172,7 +165,7 @@ TEST(EkfSlam, UnknownAssociationsGiveOneLandmarkPerTrueLandmark) {
 // With slam_forget_after_steps, landmarks left behind leave the state; seen again, they return.
 TEST(EkfSlam, TheStateShrinksWhenLandmarksAreNotSeenForLong) {
   const auto world = ring_world();
-  LocalizerOptions o = noisy_options();
+  LocalizerOptions o = slam_options();
   o.slam_forget_after_steps = 5;
   auto slam = make_slam(o);
   core::Random rng(4);
@@ -205,7 +198,7 @@ TEST(EkfSlam, TheStateShrinksWhenLandmarksAreNotSeenForLong) {
 }
 
 TEST(EkfSlam, RobotDetectionsUpdateThePoseWhenEnabled) {
-  LocalizerOptions o = noisy_options();
+  LocalizerOptions o = slam_options();
   o.initial_xy = 0.5;
   o.use_robot_detections = true;
   auto slam = make_slam(o);

@@ -25,7 +25,7 @@ testing::SimWorld dense_world() {
   return w;
 }
 
-LocalizerOptions noisy_options() {
+LocalizerOptions fastslam_options() {
   LocalizerOptions o;
   o.process_noise_xy = 0.03;
   o.process_noise_theta = 0.005;
@@ -86,7 +86,7 @@ double map_rms(const std::vector<Landmark>& map) {
 
 // Without noise every particle stays on the truth and maps every landmark where it is.
 TEST(FastSlam2, WithoutNoiseStaysOnTheTruthAndMapsTheLandmarksExactly) {
-  LocalizerOptions o = noisy_options();
+  LocalizerOptions o = fastslam_options();
   o.process_noise_xy = o.process_noise_theta = o.range_noise = o.bearing_noise = 0.0;
   const Outcome r = run(o, 1, 120);
   EXPECT_LT(r.mean_error_slam, 1e-6);
@@ -98,7 +98,7 @@ TEST(FastSlam2, WithoutNoiseStaysOnTheTruthAndMapsTheLandmarksExactly) {
 // about the noise of one reading (0.1 m range, 0.02 rad bearing at up to 12 m: up to 0.25 m), the
 // landmarks converge to within that too, and both maps hold every landmark.
 TEST(FastSlam2, BeatsOdometryAndItsParticleMapsConverge) {
-  const LocalizerOptions o = noisy_options();
+  const LocalizerOptions o = fastslam_options();
   double slam = 0.0, odometry = 0.0, rms_best = 0.0, rms_combined = 0.0;
   long resamples = 0;
   const int runs = 4;
@@ -127,7 +127,7 @@ TEST(FastSlam2, BeatsOdometryAndItsParticleMapsConverge) {
 // many particles grows overconfident as resampling thins the particles' diversity (Bailey,
 // Nieto & Nebot 2006); README gives the measured value.
 TEST(FastSlam2, PoseErrorStaysCloseToEkfSlamsOnTheSameReadings) {
-  LocalizerOptions o = noisy_options();
+  LocalizerOptions o = fastslam_options();
   o.fastslam_particles = 50;
   const auto world = dense_world();
   double mean_fastslam = 0.0, mean_ekf = 0.0, worst = 0.0;
@@ -162,7 +162,7 @@ TEST(FastSlam2, PoseErrorStaysCloseToEkfSlamsOnTheSameReadings) {
 // Without the sensor's ids, each particle associates by Mahalanobis distance and still finds one
 // landmark per true landmark.
 TEST(FastSlam2, UnknownAssociationsGiveOneLandmarkPerTrueLandmark) {
-  LocalizerOptions o = noisy_options();
+  LocalizerOptions o = fastslam_options();
   o.known_associations = false;
   LocalizerContext c;
   c.initial_pose = testing::loop_start();
@@ -187,7 +187,7 @@ TEST(FastSlam2, UnknownAssociationsGiveOneLandmarkPerTrueLandmark) {
 
 // Moving the filter into another frame moves its pose and map rigidly.
 TEST(FastSlam2, ChangeFrameMovesThePoseAndTheMap) {
-  const LocalizerOptions o = noisy_options();
+  const LocalizerOptions o = fastslam_options();
   FastSlam2 filter = make_filter(o, 3);
   core::Random rng(5);
   core::Pose2 truth = testing::loop_start();

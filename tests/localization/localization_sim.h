@@ -9,7 +9,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "core/angle.h"
@@ -108,6 +110,14 @@ inline Trace simulate(Localizer& localizer, const SimWorld& world, const Localiz
     record();
   }
   return t;
+}
+
+// The localizer's counter `name`; NaN when it has none, so that every check on it fails.
+inline double counter(const Localizer& l, const std::string& name) {
+  for (const auto& [key, value] : l.counters()) {
+    if (key == name) return value;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace fleetmap::localization::testing

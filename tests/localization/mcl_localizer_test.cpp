@@ -19,7 +19,7 @@ using testing::asymmetric_room;
 using testing::scan_at;
 
 constexpr double kMotionNoiseXy = 0.005, kMotionNoiseTheta = 0.003;  // per step, in the truth and the model
-constexpr double kRangeNoise = 0.02;
+constexpr double kMclRangeNoise = 0.02;
 
 // Drives straight at 0.3 m/s, and turns in place while a wall is within 1 m ahead.
 Odometry wander(const mapping::OccupancyGrid& room, const core::Pose2& truth) {
@@ -42,7 +42,7 @@ LocalizerContext context(const std::shared_ptr<const mapping::OccupancyGrid>& ma
   c.seed = seed;
   c.options.process_noise_xy = kMotionNoiseXy;
   c.options.process_noise_theta = kMotionNoiseTheta;
-  c.options.range_noise = kRangeNoise;
+  c.options.range_noise = kMclRangeNoise;
   c.options.initial_xy = 0.05;
   c.options.mcl_particles = particles;
   return c;
@@ -73,7 +73,7 @@ TEST(MclLocalizer, ConvergesFromAUniformBeliefInANonSymmetricRoom) {
       const Odometry u = wander(*room, truth);
       truth = move(truth, u, rng);
       mcl->predict(u);
-      mcl->update_scan(scan_at(*room, truth, kRangeNoise, rng, 90, 8.0), *room);
+      mcl->update_scan(scan_at(*room, truth, kMclRangeNoise, rng, 90, 8.0), *room);
       if (localized(*mcl, truth)) {
         if (first_localized < 0) first_localized = k;
       } else {
@@ -107,8 +107,8 @@ LostRun lost_robot_run(std::uint64_t seed, bool collaborate) {
     guide_truth = move(guide_truth, b, rng);
     lost->predict(a);
     guide->predict(b);
-    lost->update_scan(scan_at(*room, lost_truth, kRangeNoise, rng, 60, kMaxRange), *room);
-    guide->update_scan(scan_at(*room, guide_truth, kRangeNoise, rng, 60, kMaxRange), *room);
+    lost->update_scan(scan_at(*room, lost_truth, kMclRangeNoise, rng, 60, kMaxRange), *room);
+    guide->update_scan(scan_at(*room, guide_truth, kMclRangeNoise, rng, 60, kMaxRange), *room);
     const Eigen::Vector2d d = lost_truth.position() - guide_truth.position();
     if (collaborate && d.norm() < 5.0 && mapping::line_of_sight(*room, guide_truth.position(), lost_truth.position())) {
       DetectedBy det;

@@ -16,7 +16,7 @@
 namespace fleetmap::localization {
 namespace {
 
-Eigen::Matrix3d p0() { return Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.0175 * 0.0175).asDiagonal(); }
+Eigen::Matrix3d initial_pose_covariance() { return Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.0175 * 0.0175).asDiagonal(); }
 
 // Exact readings inside an axis-aligned rectangle [0, w] x [0, h].
 std::optional<double> rectangle_range(const core::Pose2& pose, double angle, double w, double h, double max_range) {
@@ -64,15 +64,15 @@ const std::vector<double> kFiveSensors = {-std::numbers::pi / 2, -std::numbers::
 
 TEST(PolynomialSlam, ThresholdsFollowTheCovarianceUpToKP0) {
   PolynomialSlamOptions o;
-  const SlamThresholds at_p0 = slam_thresholds(p0(), p0(), o);
+  const SlamThresholds at_p0 = slam_thresholds(initial_pose_covariance(), initial_pose_covariance(), o);
   EXPECT_NEAR(at_p0.factor, 1.0 / 150.0, 1e-12);
   EXPECT_NEAR(at_p0.rho, 0.08 + 0.16 / 150.0, 1e-12);
   EXPECT_NEAR(at_p0.sigma, 0.1 + 0.2 / 150.0, 1e-12);
   EXPECT_FALSE(at_p0.diverging);
-  const SlamThresholds half = slam_thresholds(75.0 * p0(), p0(), o);
+  const SlamThresholds half = slam_thresholds(75.0 * initial_pose_covariance(), initial_pose_covariance(), o);
   EXPECT_NEAR(half.rho, 0.16, 1e-12);
   EXPECT_NEAR(half.sigma, 0.2, 1e-12);
-  const SlamThresholds beyond = slam_thresholds(200.0 * p0(), p0(), o);
+  const SlamThresholds beyond = slam_thresholds(200.0 * initial_pose_covariance(), initial_pose_covariance(), o);
   EXPECT_TRUE(beyond.diverging);
   EXPECT_DOUBLE_EQ(beyond.rho, 0.24);
   EXPECT_DOUBLE_EQ(beyond.sigma, 0.3);
@@ -85,7 +85,7 @@ TEST(PolynomialSlam, NoiseFreeRobotMapsARectangleAndStaysWhereItIs) {
   o.range_noise = 0.005;
   o.cluster_tolerance = 0.001;
   const core::Pose2 start(1.5, 1.2, 0.3);
-  PolynomialSlam slam(start, p0(), Eigen::Matrix3d::Zero(), o);
+  PolynomialSlam slam(start, initial_pose_covariance(), Eigen::Matrix3d::Zero(), o);
   core::Pose2 truth = start;
   for (int k = 0; k < 300; ++k) {
     if (k > 0) {
@@ -111,7 +111,7 @@ TEST(PolynomialSlam, NoiseFreeRobotMapsARectangleAndStaysWhereItIs) {
 // A filter at the origin facing +x2 that has mapped the wall x2 = 2 over x1 in [-0.5, 0.5] from
 // eleven exact readings (one cluster of epsilon_Z + 1 points).
 PolynomialSlam facing_a_wall(const PolynomialSlamOptions& o) {
-  PolynomialSlam slam(core::Pose2(0.0, 0.0, std::numbers::pi / 2), p0(), Eigen::Matrix3d::Zero(), o);
+  PolynomialSlam slam(core::Pose2(0.0, 0.0, std::numbers::pi / 2), initial_pose_covariance(), Eigen::Matrix3d::Zero(), o);
   std::vector<double> angles;
   std::vector<std::optional<double>> ranges;
   for (int i = -5; i <= 5; ++i) {
@@ -154,7 +154,7 @@ TEST(PolynomialSlam, BadlyApproximatedPointsRefitTheirPolynomial) {
 
 TEST(PolynomialSlam, FarPointsFormClustersThatBecomePolynomials) {
   PolynomialSlamOptions o;
-  PolynomialSlam slam(core::Pose2(), p0(), Eigen::Matrix3d::Zero(), o);
+  PolynomialSlam slam(core::Pose2(), initial_pose_covariance(), Eigen::Matrix3d::Zero(), o);
   // Ten points of a wall: one cluster, no polynomial yet; the eleventh makes one.
   std::vector<double> angles;
   std::vector<std::optional<double>> ranges;
@@ -280,7 +280,7 @@ TEST(PolynomialSlam, ChangeFrameMovesPoseMapAndCovarianceTogether) {
   // its pose and covariance move rigidly, and it keeps localizing in the new frame.
   PolynomialSlamOptions o;
   const core::Pose2 start(1.5, 1.2, 0.3);
-  PolynomialSlam slam(start, p0(), Eigen::Matrix3d::Zero(), o);
+  PolynomialSlam slam(start, initial_pose_covariance(), Eigen::Matrix3d::Zero(), o);
   core::Random rng(11);
   core::Pose2 truth = start;
   const auto drive = [&](int steps, const core::Transform2& frame) {
@@ -338,7 +338,7 @@ TEST(PolynomialSlam, AShortNoisyPieceOfStraightWallBecomesALine) {
     PolynomialSlamOptions o;
     o.lowest_order = lowest_order;
     o.cluster_tolerance = 0.1;
-    PolynomialSlam slam(core::Pose2(0.0, 0.0, std::numbers::pi / 2), p0(), Eigen::Matrix3d::Zero(), o);
+    PolynomialSlam slam(core::Pose2(0.0, 0.0, std::numbers::pi / 2), initial_pose_covariance(), Eigen::Matrix3d::Zero(), o);
     core::Random rng(3);
     std::vector<double> angles;
     std::vector<std::optional<double>> ranges;
@@ -487,7 +487,7 @@ TEST(PolynomialSlam, OptionsAreValidated) {
   fleetmap::testing::expect_input_error([&] { validate(o); }, {"epsilon_m"});
   o = {};
   o.cluster_tolerance = -1.0;
-  fleetmap::testing::expect_input_error([&] { PolynomialSlam(core::Pose2(), p0(), p0(), o); }, {"cluster_tolerance"});
+  fleetmap::testing::expect_input_error([&] { PolynomialSlam(core::Pose2(), initial_pose_covariance(), initial_pose_covariance(), o); }, {"cluster_tolerance"});
   o = {};
   o.min_merge_length = -0.1;
   fleetmap::testing::expect_input_error([&] { validate(o); }, {"min_merge_length"});
@@ -514,7 +514,7 @@ TEST(PolynomialSlam, PointsBunchedAlongABeamMakeALineNotACurveBentAlongIt) {
   for (int seed = 0; seed < seeds; ++seed) {
     core::Random rng = core::Random(17).fork(std::uint64_t(seed));
     const core::Pose2 start(0.0, -1.5, beam);
-    PolynomialSlam slam(start, p0(), Eigen::Matrix3d::Zero(), o);
+    PolynomialSlam slam(start, initial_pose_covariance(), Eigen::Matrix3d::Zero(), o);
     core::Pose2 truth = start;
     const auto read = [&](double angle) -> std::optional<double> {
       const double c = std::cos(truth.theta + angle);
@@ -556,7 +556,7 @@ double along_wall_variance_ratio(bool first_estimate_jacobians, std::uint64_t se
   o.first_estimate_jacobians = first_estimate_jacobians;
   core::Random rng = core::Random(23).fork(seed);
   const core::Pose2 start(0.0, 0.0, std::numbers::pi / 2);
-  PolynomialSlam slam(start, p0(), Eigen::Matrix3d::Zero(), o);
+  PolynomialSlam slam(start, initial_pose_covariance(), Eigen::Matrix3d::Zero(), o);
   core::Pose2 truth = start;
   const std::vector<double> angles = {-std::numbers::pi / 2, -std::numbers::pi / 4, -3 * std::numbers::pi / 4};
   double lowest = std::numeric_limits<double>::infinity();
@@ -571,7 +571,7 @@ double along_wall_variance_ratio(bool first_estimate_jacobians, std::uint64_t se
     slam.update(angles, ranges);
     lowest = std::min(lowest, slam.pose_covariance()(1, 1));
   }
-  return lowest / p0()(1, 1);
+  return lowest / initial_pose_covariance()(1, 1);
 }
 
 TEST(PolynomialSlam, FirstEstimateJacobiansKeepThePositionAlongASingleWallUnobservable) {

@@ -17,7 +17,7 @@ namespace {
 using testing::asymmetric_room;
 using testing::scan_at;
 
-constexpr double kRangeNoise = 0.01;  // m
+constexpr double kScanRangeNoise = 0.01;  // m
 
 TEST(LikelihoodField, IsHighestOnWallsAndFallsWithDistance) {
   const auto room = asymmetric_room();
@@ -42,14 +42,14 @@ TEST(ScanMatcher, RecoversAKnownSmallPoseOffsetOnASyntheticRoom) {
   core::Random map_rng(70);
   for (const core::Pose2 p : {core::Pose2(1.0, 1.0, 0.0), core::Pose2(5.0, 1.0, 1.0), core::Pose2(8.5, 1.0, 2.0),
                               core::Pose2(5.0, 5.5, 3.0), core::Pose2(1.0, 6.0, -1.0), core::Pose2(5.0, 3.5, 0.5)}) {
-    mapping::insert_scan(map, p, scan_at(room, p, kRangeNoise, map_rng));
+    mapping::insert_scan(map, p, scan_at(room, p, kScanRangeNoise, map_rng));
   }
   const auto field = LikelihoodField::of_grid(map, window_around(room.geometry(), {5.0, 3.5}, 20.0));
   core::Random rng(7);
   int checked = 0;
   for (const core::Pose2 truth : {core::Pose2(2.0, 1.5, 0.3), core::Pose2(5.5, 4.0, -2.0), core::Pose2(8.0, 2.0, 1.2)}) {
     for (const core::Pose2 offset : {core::Pose2(0.15, -0.10, 0.05), core::Pose2(-0.2, 0.12, -0.08)}) {
-      const auto scan = scan_at(room, truth, kRangeNoise, rng);
+      const auto scan = scan_at(room, truth, kScanRangeNoise, rng);
       const core::Pose2 guess(truth.x + offset.x, truth.y + offset.y, truth.theta + offset.theta);
       ScanMatcherOptions o;
       o.field.max_range_m = scan.max_range;
@@ -74,7 +74,7 @@ TEST(ScanMatcher, DoesNotMatchWithoutMapOrPoints) {
   const mapping::OccupancyGrid empty(room.geometry());
   const auto field = LikelihoodField::of_grid(empty, window_around(room.geometry(), {5.0, 3.5}, 20.0));
   core::Random rng(1);
-  const auto scan = scan_at(room, {5.0, 3.0, 0.0}, kRangeNoise, rng);
+  const auto scan = scan_at(room, {5.0, 3.0, 0.0}, kScanRangeNoise, rng);
   const ScanMatch m = match_scan(field, scan_end_points(scan, 2), {5.1, 3.0, 0.0}, {});
   EXPECT_FALSE(m.matched);
   EXPECT_EQ(m.pose, core::Pose2(5.1, 3.0, 0.0));
@@ -88,14 +88,14 @@ TEST(ScanMatchingLocalizer, CorrectsBiasedOdometryOnItsOwnMap) {
   core::Random rng(3);
   LocalizerContext c;
   c.initial_pose = {1.5, 1.5, 0.0};
-  c.options.range_noise = kRangeNoise;
+  c.options.range_noise = kScanRangeNoise;
   c.options.process_noise_xy = 0.01;  // the odometry's error per step, as the model knows it
   c.options.process_noise_theta = 0.005;
   auto sm = make_localizer("scan-matching", c);
   auto odo = make_localizer("odometry", c);
   mapping::OccupancyGrid own(room.geometry());
   core::Pose2 truth = c.initial_pose;
-  const auto first = scan_at(room, truth, kRangeNoise, rng);
+  const auto first = scan_at(room, truth, kScanRangeNoise, rng);
   sm->update_scan(first, own);
   mapping::insert_scan(own, sm->pose(), first);
   for (int k = 0; k < 30; ++k) {
@@ -104,7 +104,7 @@ TEST(ScanMatchingLocalizer, CorrectsBiasedOdometryOnItsOwnMap) {
     const Odometry reported{0.095, driven.omega + 0.003, 1.0};
     sm->predict(reported);
     odo->predict(reported);
-    const auto scan = scan_at(room, truth, kRangeNoise, rng);
+    const auto scan = scan_at(room, truth, kScanRangeNoise, rng);
     sm->update_scan(scan, own);
     mapping::insert_scan(own, sm->pose(), scan);
   }
