@@ -6,10 +6,10 @@
 // every landmark within the sensor range is read each step, with its id when the options say
 // associations are known. It is written independently of localization/ekf_models.
 #include <Eigen/Core>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -112,12 +112,13 @@ inline Trace simulate(Localizer& localizer, const SimWorld& world, const Localiz
   return t;
 }
 
-// The localizer's counter `name`; NaN when it has none, so that every check on it fails.
+// The localizer's counter `name`; a test failure naming it when the localizer has none.
 inline double counter(const Localizer& l, const std::string& name) {
   for (const auto& [key, value] : l.counters()) {
     if (key == name) return value;
   }
-  return std::numeric_limits<double>::quiet_NaN();
+  ADD_FAILURE() << "no counter " << name;
+  return -1.0;
 }
 
 }  // namespace fleetmap::localization::testing
