@@ -697,11 +697,11 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
     const double dd = merging::mean_displacement(*r.alternative, r.transform, p.b);
     o.detail = fmt::format("alternative: {:.1f} deg, {:.1f} cells;", dth, dd);
   }
-  o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};arms={};room={};parallel={};off={};openings={};hallend={};open={};{}",
+  o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};arms={};room={};parallel={};off={};openings={};hallend={};open={};outside={:.3f};details={};{}",
                          r.method, r.quality.agreement, r.acceptance, r.quality.constraint, r.distinctiveness,
                          r.quality.matched, r.quality.contradicted, r.quality.tested, r.quality.overlap_radius,
                          acc.common(), acc.disagree, r.quality.residual_rms, r.quality.beyond_corner, r.quality.wall_ends, r.quality.junction_arms,
-                         r.quality.beyond_room, r.quality.parallel_lines, r.quality.off_room_sides, r.quality.common_openings, r.quality.beyond_end, r.quality.open_space_walls, r.reason);
+                         r.quality.beyond_room, r.quality.parallel_lines, r.quality.off_room_sides, r.quality.common_openings, r.quality.beyond_end, r.quality.open_space_walls, r.quality.outside_room, r.quality.room_details, r.reason);
   return o;
 }
 

@@ -398,23 +398,63 @@ int closed_end(const std::vector<Eigen::Vector2d>& points, const std::vector<Lin
   return -1;
 }
 
-// The share of a map's free cells (every second row and column) that lie outside the strip
-// between the two parallel lines s1 and s2 by more than `margin`: what the map saw past a hall's
-// side walls. `to_a` places the map's cells in the frame of the lines.
-double free_outside_strip(const GridLevel& g, const core::Transform2& to_a, const Line& s1, const Line& s2, double margin) {
-  const double width = std::abs(s1.normal.dot(s2.on - s1.on));
-  // A cell is inside when its distance from the strip's centre line, along s1's normal, is at most
-  // half the width plus the margin.
-  const Eigen::Vector2d& n = s1.normal;
-  const double centre = 0.5 * (n.dot(s1.on) + n.dot(s2.on)), reach = 0.5 * width + margin;
+// The share of a map's free cells (every second row and column) for which `outside` holds, given
+// the cell's place in a's cells (`to_a` places the map's cells there).
+template <typename Outside>
+double free_share(const GridLevel& g, const core::Transform2& to_a, Outside outside) {
   long total = 0, out = 0;
   for (int y = 0; y < g.height(); y += 2)
     for (int x = 0; x < g.width(); x += 2) {
       if (!g.is_free(x, y)) continue;
       ++total;
-      out += std::abs(n.dot(to_a.apply(Eigen::Vector2d(x, y))) - centre) > reach;
+      out += outside(to_a.apply(Eigen::Vector2d(x, y)));
     }
   return total > 0 ? double(out) / double(total) : 0.0;
+}
+
+// The share of a map's free cells that lie outside the strip between the two parallel lines s1 and
+// s2 by more than `margin`: what the map saw past a hall's side walls.
+double free_outside_strip(const GridLevel& g, const core::Transform2& to_a, const Line& s1, const Line& s2, double margin) {
+  const double width = std::abs(s1.normal.dot(s2.on - s1.on));
+  // A cell is outside when its distance from the strip's centre line, along s1's normal, is more
+  // than half the width plus the margin.
+  const Eigen::Vector2d& n = s1.normal;
+  const double centre = 0.5 * (n.dot(s1.on) + n.dot(s2.on)), reach = 0.5 * width + margin;
+  return free_share(g, to_a, [&](const Eigen::Vector2d& p) { return std::abs(n.dot(p) - centre) > reach; });
+}
+
+// The share of a map's free cells more than `margin` beyond one of a room's `sides`, on the side
+// away from the room (the centroid of `walls`, the matched walls on them): what the map saw outside
+// the room.
+double free_beyond_sides(const GridLevel& g, const core::Transform2& to_a, const std::vector<const Line*>& sides,
+                         const std::vector<Eigen::Vector2d>& walls, double margin) {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& p : walls) centre += p;
+  centre /= double(std::max<std::size_t>(walls.size(), 1));
+  return free_share(g, to_a, [&](const Eigen::Vector2d& p) {
+    return std::any_of(sides.begin(), sides.end(), [&](const Line* l) {
+      const double room_side = l->normal.dot(centre - l->on), cell_side = l->normal.dot(p - l->on);
+      return (room_side >= 0.0) != (cell_side >= 0.0) && std::abs(cell_side) > margin;
+    });
+  });
+}
+
+// The matched walls inside a room, more than `margin` in from the outline of all of them (their
+// extent along the sides' two directions): a partition's end, a pillar, furniture, which pin where
+// in the room the other map lies. The outline's own blocks (a thick wall's second face, ragged
+// corners, a short side) are not counted.
+int details_inside(const std::vector<Eigen::Vector2d>& walls, const std::vector<const Line*>& sides, double margin) {
+  if (walls.empty() || sides.empty()) return 0;
+  const Eigen::Vector2d n1 = sides[0]->normal, n2(-n1.y(), n1.x());
+  double lo1 = n1.dot(walls[0]), hi1 = lo1, lo2 = n2.dot(walls[0]), hi2 = lo2;
+  for (const auto& p : walls) {
+    lo1 = std::min(lo1, n1.dot(p)), hi1 = std::max(hi1, n1.dot(p));
+    lo2 = std::min(lo2, n2.dot(p)), hi2 = std::max(hi2, n2.dot(p));
+  }
+  return int(std::count_if(walls.begin(), walls.end(), [&](const Eigen::Vector2d& p) {
+    const double u = n1.dot(p), v = n2.dot(p);
+    return u - lo1 > margin && hi1 - u > margin && v - lo2 > margin && hi2 - v > margin;
+  }));
 }
 
 }  // namespace
@@ -448,6 +488,12 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
     const auto sides = room_sides(lines, left, total, kSideBlocks, kRoomWidthM / a.grid().resolution(), on_sides);
     q.parallel_lines = most_parallel(sides);
     q.off_room_sides = total - on_sides;
+    if (sides.size() >= 3 && q.parallel_lines <= 2) {
+      constexpr double kMargin = 4.0;
+      q.outside_room = std::min(free_beyond_sides(a.level(0), core::Transform2::identity(), sides, t.structure_positions, kMargin),
+                                free_beyond_sides(b.level(0), b_to_a, sides, t.structure_positions, kMargin));
+      q.room_details = details_inside(t.structure_positions, sides, 0.5 * kRoomWidthM / a.grid().resolution());
+    }
     const double min_opening = options.min_opening_m / a.grid().resolution();
     const core::Transform2 a_to_b = b_to_a.inverse();
     for (std::size_t l = 0; l < lines.size(); ++l)

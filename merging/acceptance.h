@@ -99,6 +99,13 @@ struct AlignmentQuality {
   int parallel_lines = 0;
   // The blocks on none of those sides: details on the walls, walls beyond the room.
   int off_room_sides = 0;
+  // When there are 3 sides or more, at most 2 of them parallel: the least share of either map's
+  // free cells more than 4 cells beyond one of the sides, away from the room (1 otherwise). At
+  // most 2% when one map saw that room and nothing else, so that its walls tell only the room's size.
+  double outside_room = 1.0;
+  // And the matched walls half a metre or more inside the outline of all of them (a partition's
+  // end, a pillar, furniture): details that pin where in the room the other map lies.
+  int room_details = 0;
   // Openings in those lines that both maps saw: stretches of a line at least min_opening_m long
   // between matched walls on it, free in both maps (a door both looked through, where one wall ends
   // and the next begins). Where along its walls a room is, which its size alone does not say.

@@ -112,9 +112,12 @@ struct ConfidenceOptions {
   // matching, 11.6 m off at 0.84, the drifted maps' right placement pinned more but rougher.
   double min_turned_share = 0.5;
   // Refuse an answer whose common walls are sides of one bare rectangular room
-  // (AlignmentQuality::off_room_sides at most zero_beyond_corner, parallel_lines at most 2, no
+  // (AlignmentQuality::off_room_sides at most zero_beyond_corner, or outside_room at most
+  // most_outside_room and room_details at most zero_beyond_corner; parallel_lines at most 2, no
   // wall_ends or common_openings, junction_arms below 3): they fix the room's size and nothing else.
   bool refuse_bare_room = true;
+  // One map saw the room alone: at most this share of its free cells lies beyond the room's sides.
+  double most_outside_room = 0.02;
   // A wall in the other map's open space (AlignmentQuality::open_space_walls, the largest group): the
   // agreement factor is at most 1 up to full_open_space wall cells and 0 from zero_open_space on,
   // linear between. Right answers on the benchmark of robot-built maps and in the simulator: at

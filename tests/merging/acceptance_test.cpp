@@ -148,5 +148,45 @@ TEST(AlignmentQuality, TellsTheSidesOfABareRoomFromWallsWithDetails) {
   EXPECT_EQ(evaluate_alignment(door, door, core::Transform2(40.0, 0.0, 0.0)).common_openings, 0);
 }
 
+// One room, 5 x 4 m, seen from inside: alone, or with the corridor behind its top wall seen through
+// a window, or with a partition 1.5 m long standing out from its bottom wall. A map that saw the room alone has no free cells beyond its sides,
+// so its walls tell only the room's size; the partition, reaching more than half a metre in from the walls, says
+// where in the room the other map lies. Ragged corners (a block of wall standing out at each) are
+// part of the outline, no detail.
+TEST(AlignmentQuality, TellsARoomSeenAloneAndTheDetailsInsideIt) {
+  const auto room = [](bool corridor, bool partition, bool ragged) {
+    std::vector<std::string> rows(110, std::string(120, '?'));
+    const auto fill = [&](int x0, int x1, int r0, int r1, char c) {
+      for (int r = r0; r < r1; ++r) rows[std::size_t(r)].replace(std::size_t(x0), std::size_t(x1 - x0), std::size_t(x1 - x0), c);
+    };
+    fill(8, 112, 10, 94, '#');
+    fill(10, 110, 12, 92, '.');
+    if (corridor) {  // seen through a window in the top wall (glass: no opening on the wall's line)
+      fill(20, 100, 0, 9, '.');
+      fill(20, 100, 9, 10, '#');
+    }
+    if (partition) fill(58, 60, 62, 92, '#');
+    if (ragged)
+      for (const auto& [x, r] : {std::pair(10, 12), std::pair(106, 12), std::pair(10, 88), std::pair(106, 88)}) fill(x, x + 4, r, r + 4, '#');
+    return grid_from_text(rows);
+  };
+  const auto alone_map = room(false, false, true), corridor_map = room(true, false, true), partition_map = room(false, true, true);
+  const PreparedGrid alone(alone_map), corridor(corridor_map), partition(partition_map);
+  const auto at_identity = [](const PreparedGrid& a, const PreparedGrid& b) {
+    return evaluate_alignment(a, b, core::Transform2::identity());
+  };
+  const AlignmentQuality q_alone = at_identity(alone, alone);
+  EXPECT_EQ(q_alone.parallel_lines, 2);
+  EXPECT_LE(q_alone.outside_room, 0.02);
+  EXPECT_LE(q_alone.room_details, 1);
+  EXPECT_GE(q_alone.off_room_sides, 2);  // the ragged corners: not a bare room by its sides alone
+  // One of the two maps saw only the room: that is enough.
+  EXPECT_LE(at_identity(alone, corridor).outside_room, 0.02);
+  EXPECT_LE(at_identity(corridor, alone).outside_room, 0.02);
+  EXPECT_GT(at_identity(corridor, corridor).outside_room, 0.02);
+  EXPECT_GE(at_identity(partition, partition).room_details, 2);
+  EXPECT_LE(at_identity(partition, partition).outside_room, 0.02);
+}
+
 }  // namespace
 }  // namespace fleetmap::merging

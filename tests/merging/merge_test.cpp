@@ -332,6 +332,24 @@ TEST(AlignAcrossResolutions, ThreeSidesOfARoomLaidOnAnotherHousesRoomAreRefused)
   }
 }
 
+// The same when one window is a bare room and nothing else, four matched blocks off its sides (its
+// ragged corners and a short fourth side, the 0.025 m map seen through 0.05 m cells): the other
+// house's room fits it as well (merged at 0.72 before the window's "nothing else" was asked).
+TEST(AlignAcrossResolutions, ABareRoomSeenAloneIsRefusedWhateverItsRaggedCorners) {
+  const auto a = load_houseexpo_map("unrelated_1bc09701bb48_room_window.png", 0.05);
+  const auto b = load_houseexpo_map("unrelated_6815f907d9ce_room_window.png", 0.025);
+  const MergeResult r = align_across_resolutions(a, b);
+  EXPECT_FALSE(r.merged) << "confidence " << r.confidence;
+  EXPECT_EQ(r.refusal, Refusal::OneRoom) << r.reason;
+  EXPECT_GE(r.quality.off_room_sides, 2);  // not refused for the sides alone
+  EXPECT_LE(r.quality.outside_room, 0.02);
+  EXPECT_LE(r.quality.room_details, 1);
+  MergeOptions without;
+  without.confidence.refuse_bare_room = false;
+  const MergeResult merged = align_across_resolutions(a, b, without);
+  EXPECT_TRUE(merged.merged) << merged.reason;
+}
+
 // One end of the bare hall seen from two places (a U: the left wall and parts of the top and
 // bottom ones), optionally with a short wall standing out from the end wall that both see. The truth
 // is b's cells into the hall's (a's) cells.
