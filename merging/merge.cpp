@@ -419,8 +419,15 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   // unknown, cannot tell them apart.
   // What tells the common walls from any corner of a bare room: matched walls off the corner's two
   // lines, matched openings in its walls, and a T or cross junction (a wall going on past the
-  // corner in both maps), which counts as a full set of blocks beyond.
-  const double beyond = best_q.beyond_corner + best_q.wall_ends + (best_q.junction_arms >= 3 ? co.full_beyond_corner : 0.0);
+  // corner in both maps), which counts as a full set of blocks beyond. But a T and nothing else
+  // (fewer than a full set of blocks off its two lines, no wall end, no opening both saw) is one
+  // more corner: every inner wall meets an outer one in a T, and any such junction, in this
+  // building or another, fits it as well (seen on the benchmark of robot-built maps: windows of
+  // two different houses merged at 0.52, an inner wall meeting the outer wall laid on another).
+  const bool lone_t = co.refuse_lone_t && best_q.junction_arms == 3 && best_q.beyond_corner < co.full_beyond_corner &&
+                      best_q.wall_ends == 0 && best_q.common_openings == 0;
+  const double beyond = best_q.beyond_corner + best_q.wall_ends +
+                        (best_q.junction_arms >= 3 && !lone_t ? co.full_beyond_corner : 0.0);
   if (options.probe_symmetries && beyond > 0 &&
       agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence) {
     std::tie(result.distinctiveness, result.alternative) =
@@ -498,6 +505,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       if (agree_factor < 0.5) return {Refusal::WallsCross, "the walls of one map cross the other's free space"};
       if (acceptance_factor < 0.5)
         return {Refusal::CellsDisagree, "the maps disagree on the cells they share (free in one, occupied in the other)"};
+      if (corner_factor < 0.5 && lone_t)
+        return {Refusal::OneCorner, "the common walls are one T (a wall meeting another that goes on past it) and nothing "
+                                    "else, which any other such junction fits as well"};
       if (corner_factor < 0.5)
         return {Refusal::OneCorner, "the common walls are one corner (two straight walls), which fits any other corner of a bare room as well"};
       if (one_room) return {Refusal::OneRoom, "the common walls are the sides of one rectangular room, which fits itself turned as well"};

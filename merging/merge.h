@@ -68,7 +68,7 @@ namespace fleetmap::merging {
 //   it, in both maps): two maps whose common walls are one corner of a bare room fit any other
 //   corner as well, and nothing in either map can tell (seen on a real plan: two corners of a
 //   large hall, turned a quarter); an opening in one of the walls pins the corner along them, and
-//   a bare room has no T.
+//   a bare room has no T. A T with nothing else is one more corner (ConfidenceOptions::refuse_lone_t).
 // - one rectangular room (ConfidenceOptions::min_turned_share): its sides are four lines, and the
 //   room turned a half turn fits them too; when the answer's common walls are such four lines and
 //   the probes find a turned placement free of contradictions with at least that share of the
@@ -116,6 +116,11 @@ struct ConfidenceOptions {
   // most_outside_room and room_details at most zero_beyond_corner; parallel_lines at most 2, no
   // wall_ends or common_openings, junction_arms below 3): they fix the room's size and nothing else.
   bool refuse_bare_room = true;
+  // A T junction and nothing else (AlignmentQuality::junction_arms 3, fewer than full_beyond_corner
+  // blocks off its two lines, no wall_ends or common_openings) counts as one corner: every inner
+  // wall meets an outer one in a T, and any such junction fits it as well. Off, a T counts as a full
+  // set of blocks beyond the corner, as a cross always does.
+  bool refuse_lone_t = true;
   // One map saw the room alone: at most this share of its free cells lies beyond the room's sides.
   double most_outside_room = 0.02;
   // A wall in the other map's open space (AlignmentQuality::open_space_walls, the largest group): the

@@ -485,15 +485,38 @@ TEST(AlignMaps, OneCornerWithMatchingDoorOpeningsIsMergedRight) {
 }
 
 // A benchmark pair sharing three tenths of the known cells (plan 95144b9b8ec8): the common walls
-// lie on two lines, the outer wall and an inner wall meeting it, but the outer wall goes on past
-// the meeting point in both maps: a T, which no corner of a bare room fits (refused before as
-// "one corner", confidence 0).
-TEST(AlignMaps, WallsMeetingInATAreNotOneCorner) {
+// lie on two lines, the outer wall and an inner wall meeting it, and the outer wall goes on past
+// the meeting point in both maps: a T, which no corner of a bare room fits, but any other inner
+// wall meeting an outer one does, in this house or another (the next test). Nothing else pins it:
+// refused as one T; counted as a full set of blocks beyond the corner (refuse_lone_t off), the
+// same answer is merged, and it is right.
+TEST(AlignMaps, ATAndNothingElseIsOneMoreCorner) {
   const auto p = robot_map_pair("robot_map_95144b9b8ec8_overlap30", 0.05, 278.749, 388.854, 149.357);
   const MergeResult r = align_maps(p.a, p.b);
-  ASSERT_TRUE(r.merged) << r.reason;
-  EXPECT_GE(r.quality.junction_arms, 3);
-  EXPECT_LT(mean_displacement(r.transform, p.truth, p.b), 1.0);
+  EXPECT_FALSE(r.merged) << "confidence " << r.confidence;
+  EXPECT_EQ(r.refusal, Refusal::OneCorner);
+  EXPECT_NE(r.reason.find("one T"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.quality.junction_arms, 3);
+  MergeOptions counted;
+  counted.confidence.refuse_lone_t = false;
+  const MergeResult merged = align_maps(p.a, p.b, counted);
+  ASSERT_TRUE(merged.merged) << merged.reason;
+  EXPECT_LT(mean_displacement(merged.transform, p.truth, p.b), 1.0);
+}
+
+// Windows of two different bare houses (4e7034e3b1d9 at 0.05 m, 18ba005a3e80 at 0.025 m; an
+// unrelated pair of the benchmark of robot-built maps): b is one room, a thick wall and a strip of
+// the next room; the answer lays the thick wall and the outer wall it meets on a T of a's outer
+// wall, nothing else in common. Merged at 0.52 while a T counted as a full set of blocks beyond
+// the corner; refused now.
+TEST(AlignAcrossResolutions, ATOfAnotherHouseIsNotMerged) {
+  const auto a = load_houseexpo_map("unrelated_4e7034e3b1d9_t_window.png", 0.05);
+  const auto b = load_houseexpo_map("unrelated_18ba005a3e80_t_window.png", 0.025);
+  const MergeResult r = align_across_resolutions(a, b);
+  EXPECT_FALSE(r.merged) << "confidence " << r.confidence << " transform " << r.transform;
+  MergeOptions counted;
+  counted.confidence.refuse_lone_t = false;
+  EXPECT_TRUE(align_across_resolutions(a, b, counted).merged) << "the T alone no longer what refuses it";
 }
 
 // A tenth of the known cells in common (plan 08d4ecc49835): walls that fit to 0.3 cells give an
