@@ -56,9 +56,13 @@ namespace fleetmap::merging {
 //   its cells agree with a's (its score times the acceptance factor below at its own omega): a
 //   placement that lays free cells on occupied ones could not be merged and is no rival.
 //   A rival cleaner than the answer's rate predicts (z <= -3) at whose own rate the answer's
-//   contradictions are implausible (z >= 4) makes the distinctiveness 0: the maps cannot disagree
+//   contradictions are implausible (z >= 4), both over all their walls and over the part of b
+//   that the rival lays on a's known cells, makes the distinctiveness 0: the maps cannot disagree
 //   as the answer says and agree as the rival says, and a higher score does not tell which of two
-//   placements that both fit many walls is right (a corridor slid by a row of door niches).
+//   placements that both fit many walls is right (a corridor slid by a row of door niches). Where
+//   the answer is as clean as the rival on the rival's own part of b (drifted maps contradict
+//   their right placement elsewhere), the rival says nothing against it, unless the answer lays a
+//   wall group in a's open space (ConfidenceOptions::rival_cleaner_where_it_lies).
 // - corner factor: the matched walls off the two straight lines that hold most of them
 //   (AlignmentQuality::beyond_corner), 0 up to zero_beyond_corner, 1 from full_beyond_corner on
 //   (4 x 4 blocks of wall, counted in both maps: a door jamb seen by both is two), plus the
@@ -121,6 +125,15 @@ struct ConfidenceOptions {
   // wall meets an outer one in a T, and any such junction fits it as well. Off, a T counts as a full
   // set of blocks beyond the corner, as a cross always does.
   bool refuse_lone_t = true;
+  // A rival cleaner than the answer (above) is asked to be cleaner on its own part of b too: the
+  // answer judged on the cells of b that the rival lays on a's known cells. Where the answer is as
+  // clean there, the rival says nothing against it (two robots' maps that drifted apart contradict
+  // their right placement in other places, and one corner of b laid elsewhere is clean). Not for
+  // an answer with a wall group in a's open space (AlignmentQuality::open_space_walls at least
+  // full_open_space): that is how a slid placement looks (a corridor slid by a row of door niches,
+  // the end wall of one map across the other's corridor, 18 cells), and then the rival stands.
+  // Off, a rival cleaner over all the walls is enough.
+  bool rival_cleaner_where_it_lies = true;
   // One map saw the room alone: at most this share of its free cells lies beyond the room's sides.
   double most_outside_room = 0.02;
   // A wall in the other map's open space (AlignmentQuality::open_space_walls, the largest group): the

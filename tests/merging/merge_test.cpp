@@ -622,6 +622,76 @@ TEST(AlignMaps, ARivalWithoutTheAnswersContradictionsIsNotOutscoredIntoAWrongMer
   EXPECT_EQ(r.refusal, Refusal::AnotherPlacement) << r.reason;
 }
 
+// The corridor with its row of niches every 18 m again, seen by two robots that share 9 m of it:
+// the second robot's map ends at a wall across the corridor, the first saw a box standing in the
+// corridor 6 m before the shared part. Slid back by one row of niches, the second map lays more
+// than twice the truth's walls on the first; its contradictions are the box on the second map's
+// free floor and the end wall across the first map's corridor (18 cells in open space). On the
+// part of the second map that the truth lays on the first, the slid placement is as clean as the
+// truth (niche on niche): judged there alone, the truth would say nothing against it, and it would
+// be merged 18 m off (at 0.58, measured without the open-space condition). A placement that lays a
+// wall group in open space is how a slid one looks: the truth, cleaner over all the walls, stands,
+// and the answer is refused (seen on a real laser map: a corridor slid by its door niches at 0.51,
+// the end wall 18 cells in open space).
+TEST(AlignMaps, ARivalCleanerOnlyOverAllTheWallsStandsAgainstAnAnswerWithAWallInOpenSpace) {
+  using mapping::CellState;
+  mapping::OccupancyGrid world(core::GridGeometry(0.05, 1400, 70));
+  const auto fill = [&](mapping::OccupancyGrid& g, int x0, int x1, int y0, int y1, CellState s) { fill_cells(g, x0, x1, y0, y1, s); };
+  fill(world, 0, 1400, 10, 42, CellState::Occupied);
+  fill(world, 0, 1400, 12, 40, CellState::Free);  // the corridor, walls two cells thick
+  for (int block = 0; block < 1400; block += 360) {  // the same irregular row of niches every 18 m
+    for (int x : {20, 90, 200, 250, 310}) {
+      if (block + x + 14 > 1400) continue;
+      fill(world, block + x - 2, block + x + 14, 40, 52, CellState::Occupied);
+      fill(world, block + x, block + x + 12, 40, 50, CellState::Free);
+    }
+  }
+  fill(world, 300, 312, 18, 30, CellState::Occupied);  // the box only the first robot saw
+  mapping::OccupancyGrid second = world;
+  fill(second, 890, 892, 12, 40, CellState::Occupied);  // the wall where the second map's corridor ends
+  fill(second, 892, 1400, 0, 70, CellState::Unknown);
+  const mapping::OccupancyGrid a = crop_grid(world, 0, 0, 600, 70), b = crop_grid(second, 420, 0, 480, 70);
+  const core::Transform2 truth(420.0, 0.0, 0.0), slid(60.0, 0.0, 0.0);
+  MergeOptions options;
+  const PrepareOptions prepare = prepare_options(options);
+  const PreparedGrid pa(a, prepare), pb(b, prepare);
+  const AlignmentQuality q_truth = evaluate_alignment(pa, pb, truth, options.quality);
+  const AlignmentQuality q_slid = evaluate_alignment(pa, pb, slid, options.quality);
+  ASSERT_GT(q_slid.score, q_truth.score);  // the score alone would pick the slid placement
+  ASSERT_EQ(q_truth.contradicted, 0);
+  ASSERT_GE(q_slid.open_space_walls, options.confidence.full_open_space);  // the end wall across a's corridor
+  // On the truth's part of b (the 180 columns it lays on a, and 3 more), the slid placement is clean.
+  const PreparedGrid part(crop_grid(b, 0, 0, 183, 70), prepare);
+  EXPECT_EQ(evaluate_alignment(pa, part, slid, options.quality).contradicted, 0);
+  const MergeResult r = decide(pa, pb, {{truth, 1.0, 0, "test"}, {slid, 2.0, 0, "test"}}, options);
+  EXPECT_TRUE(!r.merged || mean_displacement(r.transform, truth, b) < 2.0)
+      << "merged " << mean_displacement(r.transform, truth, b) << " cells off at confidence " << r.confidence;
+  EXPECT_EQ(r.refusal, Refusal::AnotherPlacement) << r.reason;
+}
+
+// Two robots' maps of plan 68a295672614 (scan matching, 300 x 300 windows with nine tenths of the
+// known cells in common; the truth is the windows' transform, up to each map's drift). The right
+// placement lays 1778 walls on walls and 108 on free space, drift spread over the house; a
+// placement turned a half turn lays one corner of b on a, 320 walls, none on free space. That
+// clean rival made the distinctiveness 0 (the maps cannot disagree as the answer says and agree as
+// the rival says). But the answer lays that same corner of b on a without contradiction too: the
+// rival is cleaner only where the answer is clean as well, and says nothing against it. Merged,
+// within the drift of the truth; refused at 0 before.
+TEST(AlignMaps, TwoRobotsDriftedMapsAreNotRefusedForARivalCleanOnlyWhereTheAnswerIsClean) {
+  const auto p = robot_map_pair("two_robots_68a295672614_overlap90", 0.05, 128.795, -41.455, 33.348);
+  const MergeResult r = align_maps(p.a, p.b);
+  ASSERT_TRUE(r.merged) << r.reason;
+  EXPECT_GT(r.quality.contradicted, 50);  // drifted: the rate that made the rival look cleaner
+  // The maps drifted apart: their best fit lies 3.8 cells from the windows' transform; the rival 324.
+  EXPECT_LT(mean_displacement(r.transform, p.truth, p.b), 10.0);
+  // A rival cleaner over all the walls alone makes the distinctiveness 0, as it did before.
+  MergeOptions anywhere;
+  anywhere.confidence.rival_cleaner_where_it_lies = false;
+  const MergeResult refused = align_maps(p.a, p.b, anywhere);
+  EXPECT_FALSE(refused.merged);
+  EXPECT_EQ(refused.refusal, Refusal::AnotherPlacement) << refused.reason;
+}
+
 // A corridor 2 m wide with two identical groups of niches 8.2 m apart, closed by an end wall 1.5 m
 // past the second group. The first robot saw the second group and the end; the second the first
 // group and the corridor around it. Niche on niche the walls agree 96% and pin the placement
