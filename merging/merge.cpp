@@ -390,7 +390,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       // answer with a wall group in a's open space, the mark of a slid placement (the corridor
       // above lays the end wall of one map's corridor across the other's: 18 cells in open space,
       // and on the rival's part of b it is as clean as the rival, 240 walls and 1 on free space;
-      // drifted maps' right placements, 2-7 cells).
+      // drifted maps' right placements, 2-7 cells). Such an answer yields to a clean rival even
+      // when its contradictions are as few as the least rate expects: they stand together in
+      // open space, where noise does not put walls.
       if (!cleaner && z <= -3.0) {
         const double rival_rate = contradiction_rate(q);
         const auto implausible = [&](const AlignmentQuality& answer_q) {
@@ -404,8 +406,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
           return implausible(evaluate_alignment(a, part, answer_on_part, fit_only));
         };
         const bool slid_look = best.open_space_walls >= co.full_open_space;
-        if (implausible(best) && acceptance_factor_of(acceptance_index(a.level(0), from.level(0), t).omega()) >= 0.5 &&
-            (!co.rival_cleaner_where_it_lies || slid_look || implausible_where_it_lies()))
+        const bool acceptable = acceptance_factor_of(acceptance_index(a.level(0), from.level(0), t).omega()) >= 0.5;
+        if (acceptable && slid_look && co.slid_answer_yields) cleaner = t;
+        else if (acceptable && implausible(best) && (!co.rival_cleaner_where_it_lies || slid_look || implausible_where_it_lies()))
           cleaner = t;
       }
       double plausible = q.score * clamp01((4.0 - z) / 2.0);

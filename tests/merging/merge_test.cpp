@@ -622,51 +622,87 @@ TEST(AlignMaps, ARivalWithoutTheAnswersContradictionsIsNotOutscoredIntoAWrongMer
   EXPECT_EQ(r.refusal, Refusal::AnotherPlacement) << r.reason;
 }
 
-// The corridor with its row of niches every 18 m again, seen by two robots that share 9 m of it:
-// the second robot's map ends at a wall across the corridor, the first saw a box standing in the
-// corridor 6 m before the shared part. Slid back by one row of niches, the second map lays more
-// than twice the truth's walls on the first; its contradictions are the box on the second map's
-// free floor and the end wall across the first map's corridor (18 cells in open space). On the
-// part of the second map that the truth lays on the first, the slid placement is as clean as the
-// truth (niche on niche): judged there alone, the truth would say nothing against it, and it would
-// be merged 18 m off (at 0.58, measured without the open-space condition). A placement that lays a
-// wall group in open space is how a slid one looks: the truth, cleaner over all the walls, stands,
-// and the answer is refused (seen on a real laser map: a corridor slid by its door niches at 0.51,
-// the end wall 18 cells in open space).
-TEST(AlignMaps, ARivalCleanerOnlyOverAllTheWallsStandsAgainstAnAnswerWithAWallInOpenSpace) {
+// The corridor with its row of niches every 18 m again (the test above), seen by two robots: the
+// first map 30 m of it, the second 24 m starting `start` cells along, ending at a wall across the
+// corridor; with `box`, the first saw a box standing in the corridor 15 m along. Slid back by one
+// row of niches, the second map lays more walls on the first than the truth does, its end wall
+// across the first map's corridor (18 cells in open space).
+struct NicheCorridorPair {
+  mapping::OccupancyGrid a, b;
+  core::Transform2 truth, slid;
+};
+NicheCorridorPair niche_corridor_pair(int start, bool box) {
   using mapping::CellState;
   mapping::OccupancyGrid world(core::GridGeometry(0.05, 1400, 70));
-  const auto fill = [&](mapping::OccupancyGrid& g, int x0, int x1, int y0, int y1, CellState s) { fill_cells(g, x0, x1, y0, y1, s); };
-  fill(world, 0, 1400, 10, 42, CellState::Occupied);
-  fill(world, 0, 1400, 12, 40, CellState::Free);  // the corridor, walls two cells thick
+  fill_cells(world, 0, 1400, 10, 42, CellState::Occupied);
+  fill_cells(world, 0, 1400, 12, 40, CellState::Free);  // the corridor, walls two cells thick
   for (int block = 0; block < 1400; block += 360) {  // the same irregular row of niches every 18 m
     for (int x : {20, 90, 200, 250, 310}) {
       if (block + x + 14 > 1400) continue;
-      fill(world, block + x - 2, block + x + 14, 40, 52, CellState::Occupied);
-      fill(world, block + x, block + x + 12, 40, 50, CellState::Free);
+      fill_cells(world, block + x - 2, block + x + 14, 40, 52, CellState::Occupied);
+      fill_cells(world, block + x, block + x + 12, 40, 50, CellState::Free);
     }
   }
-  fill(world, 300, 312, 18, 30, CellState::Occupied);  // the box only the first robot saw
+  if (box) fill_cells(world, 300, 312, 18, 30, CellState::Occupied);  // only the first robot saw it
   mapping::OccupancyGrid second = world;
-  fill(second, 890, 892, 12, 40, CellState::Occupied);  // the wall where the second map's corridor ends
-  fill(second, 892, 1400, 0, 70, CellState::Unknown);
-  const mapping::OccupancyGrid a = crop_grid(world, 0, 0, 600, 70), b = crop_grid(second, 420, 0, 480, 70);
-  const core::Transform2 truth(420.0, 0.0, 0.0), slid(60.0, 0.0, 0.0);
+  fill_cells(second, start + 470, start + 472, 12, 40, CellState::Occupied);  // the second map's corridor ends
+  fill_cells(second, start + 472, 1400, 0, 70, CellState::Unknown);
+  return {crop_grid(world, 0, 0, 600, 70), crop_grid(second, start, 0, 480, 70), core::Transform2(start, 0.0, 0.0),
+          core::Transform2(start - 360, 0.0, 0.0)};
+}
+
+// Sharing 9 m, with the box: the slid placement's contradictions (the box on the second map's free floor, the
+// end wall) are implausible at the truth's rate, but on the part of the second map that the truth
+// lays on the first it is as clean as the truth (niche on niche): judged there alone, the truth
+// would say nothing against it, and it would be merged 18 m off (at 0.58, measured without the
+// open-space condition). A placement that lays a wall group in open space is how a slid one
+// looks: the truth, cleaner over all the walls, stands, and the answer is refused (seen on a real
+// laser map: a corridor slid by its door niches at 0.51, the end wall 18 cells in open space).
+TEST(AlignMaps, ARivalCleanerOnlyOverAllTheWallsStandsAgainstAnAnswerWithAWallInOpenSpace) {
+  const NicheCorridorPair p = niche_corridor_pair(420, true);
   MergeOptions options;
   const PrepareOptions prepare = prepare_options(options);
-  const PreparedGrid pa(a, prepare), pb(b, prepare);
-  const AlignmentQuality q_truth = evaluate_alignment(pa, pb, truth, options.quality);
-  const AlignmentQuality q_slid = evaluate_alignment(pa, pb, slid, options.quality);
+  const PreparedGrid pa(p.a, prepare), pb(p.b, prepare);
+  const AlignmentQuality q_truth = evaluate_alignment(pa, pb, p.truth, options.quality);
+  const AlignmentQuality q_slid = evaluate_alignment(pa, pb, p.slid, options.quality);
   ASSERT_GT(q_slid.score, q_truth.score);  // the score alone would pick the slid placement
   ASSERT_EQ(q_truth.contradicted, 0);
   ASSERT_GE(q_slid.open_space_walls, options.confidence.full_open_space);  // the end wall across a's corridor
   // On the truth's part of b (the 180 columns it lays on a, and 3 more), the slid placement is clean.
-  const PreparedGrid part(crop_grid(b, 0, 0, 183, 70), prepare);
-  EXPECT_EQ(evaluate_alignment(pa, part, slid, options.quality).contradicted, 0);
-  const MergeResult r = decide(pa, pb, {{truth, 1.0, 0, "test"}, {slid, 2.0, 0, "test"}}, options);
-  EXPECT_TRUE(!r.merged || mean_displacement(r.transform, truth, b) < 2.0)
-      << "merged " << mean_displacement(r.transform, truth, b) << " cells off at confidence " << r.confidence;
+  const PreparedGrid part(crop_grid(p.b, 0, 0, 183, 70), prepare);
+  EXPECT_EQ(evaluate_alignment(pa, part, p.slid, options.quality).contradicted, 0);
+  for (const bool yields : {true, false}) {  // refused by the older rule too: the contradictions are implausible
+    options.confidence.slid_answer_yields = yields;
+    const MergeResult r = decide(pa, pb, {{p.truth, 1.0, 0, "test"}, {p.slid, 2.0, 0, "test"}}, options);
+    EXPECT_TRUE(!r.merged || mean_displacement(r.transform, p.truth, p.b) < 2.0)
+        << "merged " << mean_displacement(r.transform, p.truth, p.b) << " cells off at confidence " << r.confidence;
+    EXPECT_EQ(r.refusal, Refusal::AnotherPlacement) << r.reason;
+  }
+}
+
+// Sharing 12 m, without the box: the slid placement's only contradictions are its end wall across
+// the first map's corridor, 24 of its 2190 walls: about as many as the least rate the maps' noise is allowed
+// (0.5%) predicts, so they are not implausible at the truth's rate, and the truth, clean, was no
+// rival: merged 18 m off at 0.67. But they stand together in the other map's open space, where
+// noise does not put walls: an answer with such a group yields to a placement without its
+// contradictions. Refused.
+TEST(AlignMaps, AnAnswerWithAWallInOpenSpaceYieldsToACleanRival) {
+  const NicheCorridorPair p = niche_corridor_pair(360, false);
+  MergeOptions options;
+  const PrepareOptions prepare = prepare_options(options);
+  const PreparedGrid pa(p.a, prepare), pb(p.b, prepare);
+  const AlignmentQuality q_slid = evaluate_alignment(pa, pb, p.slid, options.quality);
+  ASSERT_GE(q_slid.open_space_walls, options.confidence.full_open_space);
+  ASSERT_LT(q_slid.open_space_walls, options.confidence.zero_open_space);  // the wall agreement alone lets it through
+  ASSERT_EQ(evaluate_alignment(pa, pb, p.truth, options.quality).contradicted, 0);
+  const MergeResult r = decide(pa, pb, {{p.truth, 1.0, 0, "test"}, {p.slid, 2.0, 0, "test"}}, options);
+  EXPECT_TRUE(!r.merged || mean_displacement(r.transform, p.truth, p.b) < 2.0)
+      << "merged " << mean_displacement(r.transform, p.truth, p.b) << " cells off at confidence " << r.confidence;
   EXPECT_EQ(r.refusal, Refusal::AnotherPlacement) << r.reason;
+  options.confidence.slid_answer_yields = false;
+  const MergeResult before = decide(pa, pb, {{p.truth, 1.0, 0, "test"}, {p.slid, 2.0, 0, "test"}}, options);
+  ASSERT_TRUE(before.merged) << before.reason;
+  EXPECT_GT(mean_displacement(before.transform, p.truth, p.b), 300.0);
 }
 
 // Two robots' maps of plan 68a295672614 (scan matching, 300 x 300 windows with nine tenths of the
