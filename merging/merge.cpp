@@ -395,12 +395,13 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
       // open space, where noise does not put walls.
       if (!cleaner && z <= -3.0) {
         const double rival_rate = contradiction_rate(q);
+        const core::Transform2& rival = t;  // (a structured binding, which clang's lambdas cannot capture)
         const auto implausible = [&](const AlignmentQuality& answer_q) {
           return contradiction_z(answer_q.contradicted, answer_q.matched + answer_q.contradicted, rival_rate) >= 4.0;
         };
         const auto implausible_where_it_lies = [&] {
           Eigen::Vector2i origin;
-          const PreparedGrid part = prepared_part(from, common_mask(a, from, t, 3), options.prepare, origin);
+          const PreparedGrid part = prepared_part(from, common_mask(a, from, rival, 3), options.prepare, origin);
           const core::Transform2 answer_on_part(answer.translation() + answer.rotation_matrix() * origin.cast<double>(),
                                                 answer.rotation());
           return implausible(evaluate_alignment(a, part, answer_on_part, fit_only));
