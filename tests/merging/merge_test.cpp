@@ -630,6 +630,11 @@ TEST(AlignMaps, ARivalWithoutTheAnswersContradictionsIsNotOutscoredIntoAWrongMer
 struct NicheCorridorPair {
   mapping::OccupancyGrid a, b;
   core::Transform2 truth, slid;
+  PreparedGrid pa{a, prepare_options(MergeOptions{})}, pb{b, prepare_options(MergeOptions{})};
+  // The decision between the two placements.
+  MergeResult decide_between(const MergeOptions& options) const {
+    return decide(pa, pb, {{truth, 1.0, 0, "test"}, {slid, 2.0, 0, "test"}}, options);
+  }
 };
 NicheCorridorPair niche_corridor_pair(int start, bool box) {
   using mapping::CellState;
@@ -651,9 +656,9 @@ NicheCorridorPair niche_corridor_pair(int start, bool box) {
           core::Transform2(start - 360, 0.0, 0.0)};
 }
 
-// Sharing 9 m, with the box: the slid placement's contradictions (the box on the second map's free floor, the
-// end wall) are implausible at the truth's rate, but on the part of the second map that the truth
-// lays on the first it is as clean as the truth (niche on niche): judged there alone, the truth
+// Sharing 9 m, with the box: the slid placement's contradictions (the box on the second map's free
+// floor, the end wall) are implausible at the truth's rate, but on the part of the second map that
+// the truth lays on the first it is as clean as the truth (niche on niche): judged there alone, the truth
 // would say nothing against it, and it would be merged 18 m off (at 0.58, measured without the
 // open-space condition). A placement that lays a wall group in open space is how a slid one
 // looks: the truth, cleaner over all the walls, stands, and the answer is refused (seen on a real
@@ -661,19 +666,17 @@ NicheCorridorPair niche_corridor_pair(int start, bool box) {
 TEST(AlignMaps, ARivalCleanerOnlyOverAllTheWallsStandsAgainstAnAnswerWithAWallInOpenSpace) {
   const NicheCorridorPair p = niche_corridor_pair(420, true);
   MergeOptions options;
-  const PrepareOptions prepare = prepare_options(options);
-  const PreparedGrid pa(p.a, prepare), pb(p.b, prepare);
-  const AlignmentQuality q_truth = evaluate_alignment(pa, pb, p.truth, options.quality);
-  const AlignmentQuality q_slid = evaluate_alignment(pa, pb, p.slid, options.quality);
+  const AlignmentQuality q_truth = evaluate_alignment(p.pa, p.pb, p.truth, options.quality);
+  const AlignmentQuality q_slid = evaluate_alignment(p.pa, p.pb, p.slid, options.quality);
   ASSERT_GT(q_slid.score, q_truth.score);  // the score alone would pick the slid placement
   ASSERT_EQ(q_truth.contradicted, 0);
   ASSERT_GE(q_slid.open_space_walls, options.confidence.full_open_space);  // the end wall across a's corridor
   // On the truth's part of b (the 180 columns it lays on a, and 3 more), the slid placement is clean.
-  const PreparedGrid part(crop_grid(p.b, 0, 0, 183, 70), prepare);
-  EXPECT_EQ(evaluate_alignment(pa, part, p.slid, options.quality).contradicted, 0);
+  const PreparedGrid part(crop_grid(p.b, 0, 0, 183, 70), prepare_options(options));
+  EXPECT_EQ(evaluate_alignment(p.pa, part, p.slid, options.quality).contradicted, 0);
   for (const bool yields : {true, false}) {  // refused by the older rule too: the contradictions are implausible
     options.confidence.slid_answer_yields = yields;
-    const MergeResult r = decide(pa, pb, {{p.truth, 1.0, 0, "test"}, {p.slid, 2.0, 0, "test"}}, options);
+    const MergeResult r = p.decide_between(options);
     EXPECT_TRUE(!r.merged || mean_displacement(r.transform, p.truth, p.b) < 2.0)
         << "merged " << mean_displacement(r.transform, p.truth, p.b) << " cells off at confidence " << r.confidence;
     EXPECT_EQ(r.refusal, Refusal::AnotherPlacement) << r.reason;
@@ -681,26 +684,24 @@ TEST(AlignMaps, ARivalCleanerOnlyOverAllTheWallsStandsAgainstAnAnswerWithAWallIn
 }
 
 // Sharing 12 m, without the box: the slid placement's only contradictions are its end wall across
-// the first map's corridor, 24 of its 2190 walls: about as many as the least rate the maps' noise is allowed
-// (0.5%) predicts, so they are not implausible at the truth's rate, and the truth, clean, was no
-// rival: merged 18 m off at 0.67. But they stand together in the other map's open space, where
+// the first map's corridor, 24 of its 2190 walls: about as many as the least rate the maps' noise
+// is allowed (0.5%) predicts, so they are not implausible at the truth's rate, and the truth,
+// clean, was no rival: merged 18 m off at 0.67. But they stand together in the other map's open space, where
 // noise does not put walls: an answer with such a group yields to a placement without its
 // contradictions. Refused.
 TEST(AlignMaps, AnAnswerWithAWallInOpenSpaceYieldsToACleanRival) {
   const NicheCorridorPair p = niche_corridor_pair(360, false);
   MergeOptions options;
-  const PrepareOptions prepare = prepare_options(options);
-  const PreparedGrid pa(p.a, prepare), pb(p.b, prepare);
-  const AlignmentQuality q_slid = evaluate_alignment(pa, pb, p.slid, options.quality);
+  const AlignmentQuality q_slid = evaluate_alignment(p.pa, p.pb, p.slid, options.quality);
   ASSERT_GE(q_slid.open_space_walls, options.confidence.full_open_space);
   ASSERT_LT(q_slid.open_space_walls, options.confidence.zero_open_space);  // the wall agreement alone lets it through
-  ASSERT_EQ(evaluate_alignment(pa, pb, p.truth, options.quality).contradicted, 0);
-  const MergeResult r = decide(pa, pb, {{p.truth, 1.0, 0, "test"}, {p.slid, 2.0, 0, "test"}}, options);
+  ASSERT_EQ(evaluate_alignment(p.pa, p.pb, p.truth, options.quality).contradicted, 0);
+  const MergeResult r = p.decide_between(options);
   EXPECT_TRUE(!r.merged || mean_displacement(r.transform, p.truth, p.b) < 2.0)
       << "merged " << mean_displacement(r.transform, p.truth, p.b) << " cells off at confidence " << r.confidence;
   EXPECT_EQ(r.refusal, Refusal::AnotherPlacement) << r.reason;
   options.confidence.slid_answer_yields = false;
-  const MergeResult before = decide(pa, pb, {{p.truth, 1.0, 0, "test"}, {p.slid, 2.0, 0, "test"}}, options);
+  const MergeResult before = p.decide_between(options);
   ASSERT_TRUE(before.merged) << before.reason;
   EXPECT_GT(mean_displacement(before.transform, p.truth, p.b), 300.0);
 }
