@@ -649,20 +649,25 @@ struct Pair {
   std::optional<core::Transform2> reference;
 };
 
-// The fit of b to a next to `start`: fleetmap's refinement from there, coarse to fine from cells of
-// 4 x 4 fine cells, and its score (matched walls less ten times the walls on free space).
-std::pair<core::Transform2, double> fit_near(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
-                                             const core::Transform2& start) {
+// The fits of b to a next to each of `starts`: fleetmap's refinement from there, coarse to fine from
+// cells of 4 x 4 fine cells, and their scores (matched walls less ten times the walls on free
+// space). The two maps are prepared once for all the starts.
+std::vector<std::pair<core::Transform2, double>> fits_near(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b,
+                                                           const std::vector<core::Transform2>& starts) {
   const merging::KnownPart ka(a), kb(b);
   const merging::PrepareOptions prepare = merging::prepare_options(merging::MergeOptions{});
   const merging::PreparedGrid pa(ka.grid(), prepare), pb(kb.grid(), prepare);
   const Eigen::Vector2d oa = ka.origin().cast<double>(), ob = kb.origin().cast<double>();
-  // In the cuts' cells: cut_a = T (cut_b + ob) + t - oa.
-  const core::Transform2 cut(start.translation() + start.rotation_matrix() * ob - oa, start.rotation());
-  merging::MergeResult r;
-  r.transform = merging::refine_alignment(pa, pb, cut, 2).b_to_a;
-  const double score = merging::evaluate_alignment(pa, pb, r.transform).score;
-  return {merging::uncut(r, ka, kb).transform, score};
+  std::vector<std::pair<core::Transform2, double>> out;
+  for (const core::Transform2& start : starts) {
+    // In the cuts' cells: cut_a = T (cut_b + ob) + t - oa.
+    const core::Transform2 cut(start.translation() + start.rotation_matrix() * ob - oa, start.rotation());
+    merging::MergeResult r;
+    r.transform = merging::refine_alignment(pa, pb, cut, 2).b_to_a;
+    const double score = merging::evaluate_alignment(pa, pb, r.transform).score;
+    out.emplace_back(merging::uncut(r, ka, kb).transform, score);
+  }
+  return out;
 }
 
 // Where a robot's window of a plan lies on the same window of the plan itself (both in the window's
@@ -1016,8 +1021,7 @@ int main(int argc, char** argv) {
             const core::Transform2 anchored = drift_a.inverse() * c.b_to_a * drift_b;
             std::optional<core::Transform2> found;
             double found_score = 0.0;
-            for (const core::Transform2& start : {anchored, c.b_to_a}) {
-              const auto [fit, score] = fit_near(c.a, b, start);
+            for (const auto& [fit, score] : fits_near(c.a, b, {anchored, c.b_to_a})) {
               if (merging::mean_displacement(fit, anchored, b) > metre) continue;
               if (!found || score > found_score) found = fit, found_score = score;
             }
