@@ -77,7 +77,8 @@ struct AlignmentQuality {
   // straight lines that hold the most of them: 0 when all the common walls are one corner (two
   // walls), which fits any other corner of a bare room as well.
   int beyond_corner = 0;
-  // Matched wall ends (4 x 4 blocks of either map): a straight wall that stops with free space
+  // Matched wall ends (4 x 4 blocks of either map, one for a block any of whose matched cells ends
+  // a wall): a straight wall that stops with free space
   // beyond it on its line and on both sides of the line (an opening one sees through: a door jamb,
   // the end of a free-standing wall; not where the view ends), in both maps at the same place. On
   // the lines, but it fixes where along them the maps meet.

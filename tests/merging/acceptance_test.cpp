@@ -95,6 +95,20 @@ TEST(AlignmentQuality, CountsDoorJambsSeenByBothMapsAtOnePlace) {
   EXPECT_EQ(evaluate_alignment(c, c, core::Transform2::identity()).wall_ends, 0);
 }
 
+// A wall that ends in the open (a free-standing partition, a door jamb) seen by both maps: its end
+// is counted wherever it falls in the 4 x 4 blocks in which matched walls are sampled (seen on the
+// benchmark of robot-built maps: a partition's end both maps saw, not counted, and the pair refused
+// as one T).
+TEST(AlignmentQuality, CountsAWallEndWhereverItFallsInItsBlock) {
+  for (int end = 28; end < 32; ++end) {
+    std::vector<std::string> rows(30, std::string(60, '.'));
+    rows[15].replace(0, std::size_t(end) + 1, std::string(std::size_t(end) + 1, '#'));
+    const auto map = grid_from_text(rows);
+    const PreparedGrid a(map), b(map);
+    EXPECT_GE(evaluate_alignment(a, b, core::Transform2::identity()).wall_ends, 1) << "wall ending at x = " << end;
+  }
+}
+
 // Where the two lines holding most of the matched walls meet: an L (a room's corner: two walls
 // ending there, unknown beyond) has two arms, a T (a wall going on past the one that meets it) has
 // three. A bare room has no T, so the T tells the place from the room's other corners.
