@@ -359,6 +359,9 @@ int main(int argc, char** argv) try {
   if (!args.lost && args.only.empty()) lost.clear();
   std::ofstream out;
   if (!args.out.empty()) {
+    std::error_code ec;
+    if (fs::equivalent(args.out, args.csv, ec))
+      throw std::runtime_error(fmt::format("{}: --out would overwrite an input of the judge", args.out.string()));
     out.open(args.out);
     if (!out) throw std::runtime_error(fmt::format("{}: cannot write", args.out.string()));
     out << "pair,set,source,overlap,merged_right,truth_score,rival_score,rival_share,determinable,rival_x,rival_y,rival_deg,rival_cells\n";
