@@ -68,6 +68,7 @@ struct Tally {
   std::vector<Eigen::Vector2d> positions;    // matched walls, in a's frame
   std::vector<Eigen::Matrix2d> structures;   // their local structure, in a's frame
   std::vector<Eigen::Vector2d> structure_positions;  // the matched walls that are not clutter
+  std::vector<Eigen::Vector2d> structure_normals;    // ... the side each was seen from, in a's frame (or zero)
   std::vector<Eigen::Vector2d> open_space;   // walls in the other map's open space, in a's frame
 };
 
@@ -148,7 +149,10 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
       }
       if (!out.blocks.insert(key).second) continue;
       out.positions.push_back(to_a.apply(p.cast<double>()));
-      if (!w.clutter) out.structure_positions.push_back(out.positions.back());
+      if (!w.clutter) {
+        out.structure_positions.push_back(out.positions.back());
+        out.structure_normals.push_back(ra * w.normal.cast<double>());
+      }
       out.structures.push_back(ra * w.structure.cast<double>() * ra.transpose());
     } else if (!w.clutter && d >= options.contradiction_distance && target.is_free(x, y)) {
       ++out.contradicted;
@@ -197,13 +201,18 @@ int largest_group(const std::vector<Eigen::Vector2d>& points) {
 
 // The points farther than `tolerance` from the straight lines that hold the most points, taken one
 // after another: element l after l + 1 lines. A Hough transform (1 degree, 1 cell) picks each line,
-// a total least squares fit to the points within 2 tolerances of it places it.
+// a total least squares fit to the points within 2 tolerances of it places it. With `normals` (the
+// side each point was seen from), a line that is one face of a wall (its points seen from one
+// side) also holds the points within `face_band` of it but those seen from the other side: a
+// wall's face spreads across its line by the laser's noise and the wall's roughness, while its
+// other face, seen from the other side, is a detail beyond it.
 struct Line {
   Eigen::Vector2d normal, on;
 };
 
 std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, double tolerance,
-                              std::vector<Line>* fitted = nullptr) {
+                              std::vector<Line>* fitted = nullptr, std::vector<Eigen::Vector2d> normals = {},
+                              double face_band = 0.0) {
   constexpr int kAngles = 180;
   std::vector<int> left, bins, counts;
   std::vector<double> xs, ys;
@@ -271,7 +280,33 @@ std::vector<int> beyond_lines(std::vector<Eigen::Vector2d> points, int lines, do
       on = c;
     }
     if (fitted) fitted->push_back({n, on});
-    std::erase_if(points, [&](const Eigen::Vector2d& p) { return std::abs(n.dot(p - on)) <= tolerance; });
+    // The side the line's own points were seen from: +1 or -1 when nearly all from one, else 0.
+    int side = 0;
+    if (normals.size() == points.size() && face_band > tolerance) {
+      int plus = 0, minus = 0;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        if (std::abs(n.dot(points[i] - on)) > tolerance) continue;
+        const double s = n.dot(normals[i]);
+        plus += s > 0.5, minus += s < -0.5;
+      }
+      constexpr double kOneSide = 0.9;
+      if (plus >= kOneSide * (plus + minus) && plus > 0) side = 1;
+      else if (minus >= kOneSide * (plus + minus) && minus > 0) side = -1;
+    }
+    const auto on_line = [&](std::size_t i) {
+      const double d = std::abs(n.dot(points[i] - on));
+      // A point seen from no single side (free on several) is no other face either.
+      return d <= tolerance || (side != 0 && d <= face_band && side * n.dot(normals[i]) > -0.5);
+    };
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (on_line(i)) continue;
+      points[kept] = points[i];
+      if (!normals.empty()) normals[kept] = normals[i];
+      ++kept;
+    }
+    points.resize(kept);
+    if (!normals.empty()) normals.resize(kept);
     left.push_back(int(points.size()));
   }
   return left;
@@ -481,7 +516,8 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   q.open_space_walls = largest_group(t.open_space);
   if (options.shape) {
     std::vector<Line> lines;
-    const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0, &lines);
+    const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0, &lines, t.structure_normals,
+                                               options.face_band_m / a.grid().resolution());
     q.beyond_corner = left[1];
     if (lines.size() >= 2) q.junction_arms = junction_arms(t.structure_positions, lines[0], lines[1], 2.0, 4.0, 3);
     q.wall_ends = t.wall_ends;

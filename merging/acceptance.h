@@ -42,6 +42,13 @@ struct QualityOptions {
   // metres: a stretch of a common wall's line free in both maps, between matched walls, at least
   // this long is an opening both saw (AlignmentQuality::common_openings): a door is 0.6-1 m.
   double min_opening_m = 0.5;
+  // metres: a line of the common walls (the shape below) holds the matched walls within 2 cells of
+  // it, and when it is one face of a wall, those seen from the same side within this distance: a
+  // face spreads across its line by the laser's noise and the wall's roughness, which are metres,
+  // not cells (seen on the benchmark of robot-built maps: at 2.5 cm a noisy wall's face spread over
+  // five cells, and its edges counted as seven blocks beyond one corner of a bare hall, merged
+  // with another corner of it). The wall's other face, seen from the other side, stays a detail.
+  double face_band_m = 0.1;
   // Count the shape of the common walls too (beyond_corner, wall_ends, junction_arms, beyond_room,
   // parallel_lines, off_room_sides, common_openings).
   // Off, they stay 0: enough for placements that are only compared by score and evidence (the

@@ -65,6 +65,17 @@ std::vector<cv::Mat> find_standing(const cv::Mat& occupied, int gap, const std::
   return masks;
 }
 
+// Marks free the unknown cells that touch both a free and an occupied cell (8-neighbourhood);
+// returns how many. See PrepareOptions::close_seams.
+int close_seams(const cv::Mat& occupied, cv::Mat& free) {
+  cv::Mat free_near, occupied_near;
+  cv::dilate(free, free_near, cv::Mat::ones(3, 3, CV_8U));
+  cv::dilate(occupied, occupied_near, cv::Mat::ones(3, 3, CV_8U));
+  const cv::Mat seam = free_near & occupied_near & ~(free | occupied);
+  free |= seam;
+  return cv::countNonZero(seam);
+}
+
 // Clears the occupied components (8-connected) of fewer than `min_cells` cells; returns how many
 // cells it cleared. Components of one or two cells are told by their neighbours alone (no occupied
 // neighbour; or one, which has no other), without labelling every component of a large map.
@@ -276,6 +287,7 @@ PreparedGrid::PreparedGrid(const mapping::OccupancyGrid& grid, const PrepareOpti
   }
   known_cells_ = cv::countNonZero(base.occupied) + cv::countNonZero(base.free);
   known_cells_ -= remove_specks(base.occupied, options.min_obstacle_cells);
+  if (options.close_seams) known_cells_ += close_seams(base.occupied, base.free);
   const double resolution = grid.resolution() > 0.0 ? grid.resolution() : 0.05;
   // Gaps of two cells at least: a thin wall turned and resampled on another grid breaks every few cells.
   std::vector<cv::Mat> standing =

@@ -34,6 +34,14 @@ struct PrepareOptions {
   // Occupied specks smaller than this (8-connected cells) are noise: left out as unknown. Both
   // robots see a real obstacle; a speck seen by one only would count against a right alignment.
   int min_obstacle_cells = 3;
+  // An unknown cell between a wall and free space (touching both) is free: the laser crossed it to
+  // the wall, and the map's thresholds left it unknown (map_server reads cells of middling
+  // probability as unknown; a real laser map at 2.5 cm often has such a seam along its walls).
+  // Without free space beside it an occupied cell is no wall to align: seen on a real map,
+  // 62% of the wall cells stood behind such a one-cell seam, and corridors sharing 30-50% of two
+  // windows were refused for too little evidence. One cell only: a wider gap is what the robot
+  // did not see.
+  bool close_seams = true;
   int min_level_size = 24;         // stop the pyramid when the larger side would drop below this
   int max_refine_points = 3000;    // wall points kept per level for refinement (evenly subsampled)
   // Clutter: obstacles whose occupied cells, joined across gaps of up to clutter_gap_m (at least 2

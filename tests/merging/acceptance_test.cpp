@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "core/random.h"
+
 #include "tests/merging/merging_test_support.h"
 
 namespace fleetmap::merging {
@@ -106,6 +110,40 @@ TEST(AlignmentQuality, CountsAWallEndWhereverItFallsInItsBlock) {
     const auto map = grid_from_text(rows);
     const PreparedGrid a(map), b(map);
     EXPECT_GE(evaluate_alignment(a, b, core::Transform2::identity()).wall_ends, 1) << "wall ending at x = " << end;
+  }
+}
+
+// One corner of a bare room at 2.5 cm, laid on itself: a straight bottom wall, and a left wall whose
+// face is ragged, the first free cell of each row 3 cells either side of its line (a noisy laser at
+// fine cells). The ragged face is one wall: nothing lies beyond the corner's two lines. A niche
+// 15 cm deep in that wall is a detail off them, at 2.5 cm cells as at 5 cm.
+TEST(AlignmentQuality, ARaggedWallFaceIsOneWallAndANicheADetail) {
+  for (const double resolution : {0.025, 0.05}) {
+    for (const bool niche : {false, true}) {
+      const int w = 160, h = 160, wall = 20, floor_y = 20;
+      const int depth = int(std::lround(0.15 / resolution));  // the niche's depth, in cells
+      mapping::OccupancyGrid g(core::GridGeometry(resolution, w, h));
+      core::Random random(7);
+      for (int y = floor_y - 6; y < h; ++y) {
+        // The first free cell of the row: the face, ragged at 2.5 cm, set back in the niche.
+        int face = wall + (resolution < 0.04 ? random.uniform_int(-3, 3) : 0);
+        if (niche && y >= 80 && y < 100) face -= depth;
+        for (int x = wall - 12; x < w; ++x) {
+          const bool occupied = y < floor_y || x < face;
+          g.set_state({x, y}, occupied ? mapping::CellState::Occupied : mapping::CellState::Free);
+        }
+      }
+      const PreparedGrid p(g);
+      const AlignmentQuality q = evaluate_alignment(p, p, core::Transform2::identity());
+      SCOPED_TRACE(::testing::Message() << resolution << " m cells, " << (niche ? "a niche" : "no niche"));
+      if (niche) EXPECT_GE(q.beyond_corner, 2);
+      else EXPECT_EQ(q.beyond_corner, 0);
+      if (!niche && resolution < 0.04) {
+        QualityOptions cells_only;
+        cells_only.face_band_m = 0.0;  // a line holds the walls within 2 cells only
+        EXPECT_GE(evaluate_alignment(p, p, core::Transform2::identity(), cells_only).beyond_corner, 2);
+      }
+    }
   }
 }
 

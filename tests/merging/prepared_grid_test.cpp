@@ -65,6 +65,29 @@ TEST(PreparedGrid, MaskedPartIsTheSourcesDataMovedByTheCutsOrigin) {
   EXPECT_EQ(part.level_count() <= source.level_count(), true);
 }
 
+// A real laser map often leaves the cells just in front of a wall unknown (middling probability,
+// read as unknown by map_server's thresholds): a one-cell seam between the wall and the free space.
+// Closed, the wall is a wall to align; a gap of two cells is what the robot did not see, and stays.
+TEST(PreparedGrid, AOneCellUnknownSeamBeforeAWallIsFreeSpace) {
+  std::vector<std::string> rows(12, std::string(20, ' '));
+  rows[2] = std::string(20, '#');  // a wall behind a one-cell seam (row 3)
+  for (int r = 4; r < 8; ++r) rows[std::size_t(r)] = std::string(20, '.');
+  rows[10] = std::string(20, '#');  // a second wall, behind a two-cell gap (rows 8 and 9)
+  const auto g = grid_from_text(rows);
+  const PreparedGrid closed(g);
+  EXPECT_EQ(closed.walls().size(), 20u);  // the first wall only
+  const int seam_y = 12 - 1 - 3, gap_y = 12 - 1 - 8;  // cell rows count from the bottom
+  for (int x = 0; x < 20; ++x) {
+    EXPECT_TRUE(closed.level(0).is_free(x, seam_y)) << x;
+    EXPECT_FALSE(closed.level(0).known(x, gap_y)) << x;
+  }
+  PrepareOptions as_read;
+  as_read.close_seams = false;
+  const PreparedGrid open(g, as_read);
+  EXPECT_EQ(open.walls().size(), 0u);
+  EXPECT_EQ(closed.known_cells(), open.known_cells() + 20);
+}
+
 TEST(PreparedGrid, SpecksAreNoise) {
   std::vector<std::string> rows(20, std::string(20, '.'));
   rows[3][3] = '#';                             // a one-cell speck
