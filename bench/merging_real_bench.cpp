@@ -647,6 +647,10 @@ struct Pair {
   // maps the best fit of the two maps next to the truth corrected by each map's drift (each map is
   // off the world by its own drift, up to a metre; drift_on_plan).
   std::optional<core::Transform2> reference;
+  // Unrelated pairs: where each window lies on its own map (a's and b's cells into their maps'), so
+  // that a merge says where it puts b's map on a's: the same place for several windows is a part
+  // the two maps share, not a chance fit.
+  std::optional<std::pair<core::Transform2, core::Transform2>> windows_on_maps;
 };
 
 // The fits of b to a next to each of `starts`: fleetmap's refinement from there, coarse to fine from
@@ -740,6 +744,13 @@ Outcome run_fleetmap(const Pair& p, const merging::MergeOptions& options) {
     const double dth = core::rad2deg(core::normalize_angle(r.alternative->rotation() - r.transform.rotation()));
     const double dd = merging::mean_displacement(*r.alternative, r.transform, p.b);
     o.detail = fmt::format("alternative: {:.1f} deg, {:.1f} cells;", dth, dd);
+  }
+  if (r.merged && p.windows_on_maps && !mixed) {
+    // b's map into a's map: a's window onto its map, the answer, b's window from its map.
+    const auto& [a_on_map, b_on_map] = *p.windows_on_maps;
+    const core::Transform2 maps = a_on_map * r.transform * b_on_map.inverse();
+    o.detail += fmt::format("maps: {:.1f} {:.1f} {:.1f} deg;", maps.translation().x(), maps.translation().y(),
+                            core::rad2deg(maps.rotation()));
   }
   o.detail += fmt::format("{};agree={:.3f};accept={:.3f};constraint={:.1f};distinct={:.3f};matched={};contra={};tested={};radius={:.1f};common={};dis={};sigma={:.3f};corner={};ends={};arms={};room={};parallel={};off={};openings={};hallend={};open={};outside={:.3f};details={};{}",
                          r.method, r.quality.agreement, r.acceptance, r.quality.constraint, r.distinctiveness,
@@ -1096,7 +1107,8 @@ int main(int argc, char** argv) {
             mix_resolutions(cj, args.real_mixed, random);
           }
           pairs.push_back(std::make_unique<Pair>(Pair{"unrelated", real[i].first + "/" + real[j].first, 0.0, std::move(ci.a),
-                                                      std::move(cj.b), std::nullopt, {}}));
+                                                      std::move(cj.b), std::nullopt, {},
+                                                      std::pair(ci.a_to_source, cj.b_to_source)}));
         } catch (const Error&) {
         }
       }
