@@ -9,11 +9,12 @@
 
 namespace fleetmap::core {
 
-Transform2::Transform2(double tx, double ty, double theta)
-    : t_(tx, ty), theta_(normalize_angle(theta)) {}
+Transform2::Transform2(double tx, double ty, double theta) : Transform2(Eigen::Vector2d(tx, ty), theta) {}
 
-Transform2::Transform2(const Eigen::Vector2d& t, double theta)
-    : t_(t), theta_(normalize_angle(theta)) {}
+Transform2::Transform2(const Eigen::Vector2d& t, double theta) : Transform2(t, normalize_angle(theta), true) {}
+
+Transform2::Transform2(const Eigen::Vector2d& t, double theta, bool)
+    : t_(t), theta_(theta), cos_(std::cos(theta)), sin_(std::sin(theta)) {}
 
 Transform2 Transform2::from_matrix(const Eigen::Matrix3d& m) {
   const Eigen::Matrix2d r = m.topLeftCorner<2, 2>();
@@ -27,13 +28,6 @@ Transform2 Transform2::from_matrix(const Eigen::Matrix3d& m) {
   return {Eigen::Vector2d(m(0, 2), m(1, 2)), std::atan2(r(1, 0), r(0, 0))};
 }
 
-Eigen::Matrix2d Transform2::rotation_matrix() const {
-  const double c = std::cos(theta_), s = std::sin(theta_);
-  Eigen::Matrix2d r;
-  r << c, -s, s, c;
-  return r;
-}
-
 Eigen::Matrix3d Transform2::matrix() const {
   Eigen::Matrix3d m = Eigen::Matrix3d::Identity();
   m.topLeftCorner<2, 2>() = rotation_matrix();
@@ -44,10 +38,6 @@ Eigen::Matrix3d Transform2::matrix() const {
 Transform2 Transform2::inverse() const {
   const Eigen::Matrix2d rt = rotation_matrix().transpose();
   return {-(rt * t_), -theta_};
-}
-
-Eigen::Vector2d Transform2::apply(const Eigen::Vector2d& p) const {
-  return rotation_matrix() * p + t_;
 }
 
 Transform2 Transform2::operator*(const Transform2& other) const {

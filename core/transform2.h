@@ -20,19 +20,32 @@ class Transform2 {
 
   const Eigen::Vector2d& translation() const { return t_; }
   double rotation() const { return theta_; }
-  Eigen::Matrix2d rotation_matrix() const;
+  Eigen::Matrix2d rotation_matrix() const {
+    Eigen::Matrix2d r;
+    r << cos_, -sin_, sin_, cos_;
+    return r;
+  }
   Eigen::Matrix3d matrix() const;
 
   Transform2 inverse() const;
-  Eigen::Vector2d apply(const Eigen::Vector2d& p) const;
+  // R(theta) p + t, the sums in the order of the matrix product rotation_matrix() * p + t.
+  Eigen::Vector2d apply(const Eigen::Vector2d& p) const {
+    return {cos_ * p.x() - sin_ * p.y() + t_.x(), sin_ * p.x() + cos_ * p.y() + t_.y()};
+  }
   Eigen::Vector2d operator*(const Eigen::Vector2d& p) const { return apply(p); }
   Transform2 operator*(const Transform2& other) const;
 
   bool is_approx(const Transform2& other, double tol = 1e-9) const;
 
  private:
+  Transform2(const Eigen::Vector2d& t, double theta, bool normalized);
+
   Eigen::Vector2d t_ = Eigen::Vector2d::Zero();
   double theta_ = 0.0;  // in (-pi, pi]
+  // cos and sin of theta_, computed once: apply() runs per cell in fusion and per point in the
+  // searches, and a sine and cosine per call were a sixth of `fleetmap merge`'s time on
+  // 1000 x 1000 maps.
+  double cos_ = 1.0, sin_ = 0.0;
 };
 
 // Where a robot is: position (metres) and heading (radians, in (-pi, pi]) in some frame.
