@@ -11,10 +11,8 @@ namespace fleetmap::core {
 
 Transform2::Transform2(double tx, double ty, double theta) : Transform2(Eigen::Vector2d(tx, ty), theta) {}
 
-Transform2::Transform2(const Eigen::Vector2d& t, double theta) : Transform2(t, normalize_angle(theta), true) {}
-
-Transform2::Transform2(const Eigen::Vector2d& t, double theta, bool)
-    : t_(t), theta_(theta), cos_(std::cos(theta)), sin_(std::sin(theta)) {}
+Transform2::Transform2(const Eigen::Vector2d& t, double theta)
+    : t_(t), theta_(normalize_angle(theta)), cos_(std::cos(theta_)), sin_(std::sin(theta_)) {}
 
 Transform2 Transform2::from_matrix(const Eigen::Matrix3d& m) {
   const Eigen::Matrix2d r = m.topLeftCorner<2, 2>();

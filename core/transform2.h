@@ -38,8 +38,6 @@ class Transform2 {
   bool is_approx(const Transform2& other, double tol = 1e-9) const;
 
  private:
-  Transform2(const Eigen::Vector2d& t, double theta, bool normalized);
-
   Eigen::Vector2d t_ = Eigen::Vector2d::Zero();
   double theta_ = 0.0;  // in (-pi, pi]
   // cos and sin of theta_, computed once: apply() runs per cell in fusion and per point in the
