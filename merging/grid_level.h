@@ -23,6 +23,11 @@ struct GridLevel {
   int factor = 1;              // fine cells per cell of this level, along each axis
   cv::Mat occupied;            // CV_8U mask
   cv::Mat free;                // CV_8U mask
+  // CV_8U, per cell: kKnown (occupied or free), kFree, kFreeNear (a free cell in the 3 x 3 block
+  // around it, cut at the level's edges). One read answers what the per-point paths ask (known,
+  // free, seen from the same side) instead of one read of each mask, or nine.
+  cv::Mat cells;
+  static constexpr std::uint8_t kKnown = 1, kFree = 2, kFreeNear = 4;
   cv::Mat walls;               // occupied cells with a free 8-neighbour
   // CV_32F: distance in cells from each cell centre to the nearest wall cell, at most
   // PrepareOptions::max_wall_distance (that value where the walls are farther).
@@ -44,8 +49,9 @@ struct GridLevel {
 
   int width() const { return occupied.cols; }
   int height() const { return occupied.rows; }
-  bool known(int x, int y) const { return occupied.at<std::uint8_t>(y, x) != 0 || free.at<std::uint8_t>(y, x) != 0; }
-  bool is_free(int x, int y) const { return free.at<std::uint8_t>(y, x) != 0; }
+  bool known(int x, int y) const { return (cell(x, y) & kKnown) != 0; }
+  bool is_free(int x, int y) const { return (cell(x, y) & kFree) != 0; }
+  std::uint8_t cell(int x, int y) const { return cells.ptr<std::uint8_t>(y)[x]; }
   // Bilinear wall distance at a continuous cell position; `outside` beyond the level's edges.
   // (Inline, like the two below: they are on the refinement's and the scores' per-point paths.)
   float distance_at(float x, float y, float outside) const {
@@ -93,6 +99,8 @@ inline bool seen_from_same_side(const GridLevel& target, const Eigen::Vector2f& 
   if (n.x() == 0.0f && n.y() == 0.0f) return true;
   const Eigen::Vector2f q = p + distance * n;
   const int cx = nearest_cell(q.x()), cy = nearest_cell(q.y());
+  if (cx >= 0 && cy >= 0 && cx < target.width() && cy < target.height()) return (target.cell(cx, cy) & GridLevel::kFreeNear) != 0;
+  // Just outside the level, the block's cells inside it.
   for (int y = std::max(0, cy - 1); y <= std::min(target.height() - 1, cy + 1); ++y)
     for (int x = std::max(0, cx - 1); x <= std::min(target.width() - 1, cx + 1); ++x)
       if (target.is_free(x, y)) return true;
