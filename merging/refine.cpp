@@ -112,7 +112,8 @@ LevelFit refine_at_level(const PreparedGrid& a, const PreparedGrid& b, const cor
     if (dt.norm() > 2.0) dt *= 2.0 / dt.norm();
     // Converged: a step this small changes nothing that counts, and the counts are at t (taking
     // the step would cost one more pass to count again).
-    if (dt.norm() < options.converged_cells && std::abs(dth) * options.converged_radius < options.converged_cells) break;
+    const double converged = level > 0 ? options.coarse_converged_cells : options.converged_cells;
+    if (dt.norm() < converged && std::abs(dth) * options.converged_radius < converged) break;
     const core::Transform2 rot(0.0, 0.0, dth);
     const core::Transform2 step(c + dt - rot.apply(c), dth);
     t = step * t;

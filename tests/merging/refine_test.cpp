@@ -29,5 +29,26 @@ TEST(Refine, ConvergesFromAFewCellsOffToSubCellAccuracy) {
   }
 }
 
+// The coarse levels stop once a step moves the points less than RefineOptions::coarse_converged_cells;
+// the finest level, run to converged_cells, ends where it would end after coarse levels run to
+// converged_cells too: the same answer to a few hundredths of a cell.
+TEST(Refine, CoarseLevelsStoppingEarlierEndAtTheSameAnswer) {
+  core::Random random(12);
+  for (const char* name : {"office", "cave", "maze"}) {
+    const auto source = testing::source_map(name);
+    const CropPair pair = make_crop_pair(source, testing::half_overlap_crops(source), random);
+    const PreparedGrid a(pair.a), b(pair.b);
+    RefineOptions strict;
+    strict.coarse_converged_cells = strict.converged_cells;
+    for (int trial = 0; trial < 3; ++trial) {
+      const core::Transform2 nudge(random.uniform(-3, 3), random.uniform(-3, 3), core::deg2rad(random.uniform(-2, 2)));
+      const LevelFit early = refine_alignment(a, b, nudge * pair.b_to_a, 2);
+      const LevelFit full = refine_alignment(a, b, nudge * pair.b_to_a, 2, strict);
+      EXPECT_LT(mean_displacement(early.b_to_a, full.b_to_a, pair.b), 0.05) << name;
+      EXPECT_NEAR(early.inliers, full.inliers, 0.01 * full.inliers) << name;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace fleetmap::merging
