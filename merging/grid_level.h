@@ -99,7 +99,8 @@ inline bool seen_from_same_side(const GridLevel& target, const Eigen::Vector2f& 
   if (n.x() == 0.0f && n.y() == 0.0f) return true;
   const Eigen::Vector2f q = p + distance * n;
   const int cx = nearest_cell(q.x()), cy = nearest_cell(q.y());
-  if (cx >= 0 && cy >= 0 && cx < target.width() && cy < target.height()) return (target.cell(cx, cy) & GridLevel::kFreeNear) != 0;
+  if (cx >= 0 && cy >= 0 && cx < target.width() && cy < target.height())
+    return (target.cell(cx, cy) & GridLevel::kFreeNear) != 0;
   // Just outside the level, the block's cells inside it.
   for (int y = std::max(0, cy - 1); y <= std::min(target.height() - 1, cy + 1); ++y)
     for (int x = std::max(0, cx - 1); x <= std::min(target.width() - 1, cx + 1); ++x)

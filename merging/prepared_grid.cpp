@@ -223,20 +223,21 @@ cv::Mat capped_wall_distance(const cv::Mat& walls, float cap) {
   return d;
 }
 
-// GridLevel::cells from the level's masks; `free_near` is its free cells dilated by a 3 x 3 block.
-void set_cells(GridLevel& level, const cv::Mat& free_near) {
+// Sets GridLevel::cells from the level's masks; returns its free cells dilated by a 3 x 3 block.
+cv::Mat set_cells(GridLevel& level) {
+  cv::Mat free_near;
+  cv::dilate(level.free, free_near, cv::Mat::ones(3, 3, CV_8U));
   level.cells = ((level.occupied | level.free) & GridLevel::kKnown) | (level.free & GridLevel::kFree) |
                 (free_near & GridLevel::kFreeNear);
+  return free_near;
 }
 
 // `level.clutter` must be set (or empty: none). `wall_cells` gets every wall cell, row by row.
 void finish_level(GridLevel& level, const PrepareOptions& options, std::vector<cv::Point>& wall_cells) {
   if (level.clutter.empty()) level.clutter = cv::Mat::zeros(level.occupied.size(), CV_8U);
   // Walls: occupied cells touching free space (8-neighbourhood).
-  cv::Mat free_near;
-  cv::dilate(level.free, free_near, cv::Mat::ones(3, 3, CV_8U));
+  const cv::Mat free_near = set_cells(level);
   level.walls = level.occupied & free_near;
-  set_cells(level, free_near);
   level.wall_distance = capped_wall_distance(level.walls, float(options.max_wall_distance));
   // At most `cap` points, chosen by a hash of the cell: spread evenly in space without following
   // the raster order (taking every k-th point of a row scan would leave rows, and the Hough
@@ -434,9 +435,7 @@ PreparedGrid PreparedGridParts::cut(const PreparedGrid& source, const cv::Mat& m
     l.factor = f;
     l.occupied = s.occupied(cut) & level_mask;
     l.free = s.free(cut) & level_mask;
-    cv::Mat free_near;
-    cv::dilate(l.free, free_near, cv::Mat::ones(3, 3, CV_8U));
-    set_cells(l, free_near);
+    set_cells(l);
     l.walls = s.walls(cut) & level_mask;
     l.wall_distance = s.wall_distance(cut);
     l.free_band = s.free_band(cut) & level_mask;

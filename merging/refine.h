@@ -13,8 +13,8 @@ struct RefineOptions {
   // ... on the levels above the finest: their answer is only where the next finer level starts,
   // within its reach whether a tenth of a cell off or a hundredth (the finest level sets the
   // accuracy). Gauss-Newton on the interpolated distances creeps there, a tenth of a cell per step
-  // or more for many steps: on real 1000 x 1000-cell map pairs this stop cut the refinement's work
-  // by a third, with the same merges and errors (bench/README.md).
+  // or more for many steps: on real 1000 x 1000-cell map pairs this stop halved the refinement's
+  // work, with the same merges and errors (bench/README.md).
   double coarse_converged_cells = 0.2;
   double converged_radius = 100; // ... counting a rotation step at this distance from the centre
   double inlier_distance = 2.5;  // cells of the level: walls farther from the other map's walls are left out
