@@ -2,7 +2,8 @@
 // against the OpenCV call they replaced (feature matching: about 1400 ORB descriptors per map of
 // 300 x 300 cells, 32 bytes each), and fusing two maps of n x n cells, the second turned by 30
 // degrees (every cell of the fused map looks up its cell in each input: `fleetmap merge`'s last
-// step).
+// step), and preparing one map of n x n cells for the comparisons (merging::PreparedGrid: masks,
+// seams, standing obstacles, the pyramid, wall distances; every merge prepares its two maps).
 #include <benchmark/benchmark.h>
 
 #include <opencv2/core.hpp>
@@ -11,6 +12,7 @@
 #include "core/angle.h"
 #include "merging/fusion.h"
 #include "merging/hamming.h"
+#include "merging/prepared_grid.h"
 
 namespace {
 
@@ -56,6 +58,11 @@ void fuse_pair_turned(benchmark::State& state) {
   for (auto _ : state) benchmark::DoNotOptimize(merging::fuse_pair(a, b, b_to_a).conflict_cells);
 }
 
+void prepare_grid(benchmark::State& state) {
+  const mapping::OccupancyGrid g = room_map(int(state.range(0)));
+  for (auto _ : state) benchmark::DoNotOptimize(merging::PreparedGrid(g).walls().size());
+}
+
 }  // namespace
 
 // n query descriptors against n.
@@ -63,6 +70,8 @@ BENCHMARK(nearest_two_opencv)->Arg(1400)->Unit(benchmark::kMillisecond);
 BENCHMARK(nearest_two_popcount)->Arg(1400)->Unit(benchmark::kMillisecond);
 // Two maps of n x n cells.
 BENCHMARK(fuse_pair_turned)->Arg(300)->Arg(1000)->Unit(benchmark::kMillisecond);
+// One map of n x n cells.
+BENCHMARK(prepare_grid)->Arg(300)->Arg(1000)->Unit(benchmark::kMillisecond);
 
 int main(int argc, char** argv) {
   cv::setNumThreads(1);  // one core, as the merges are timed
