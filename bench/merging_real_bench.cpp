@@ -65,6 +65,7 @@
 #include "core/angle.h"
 #include "core/error.h"
 #include "core/format.h"
+#include "core/memory.h"
 #include "core/random.h"
 #include "mapping/occupancy_grid.h"
 #include "maps/builtin_maps.h"
@@ -106,6 +107,7 @@ struct Args {
   int coarse_candidates = merging::MergeOptions{}.coarse_candidates;
   int fine_candidates = merging::MergeOptions{}.fine_candidates;
   bool peer = true;
+  bool default_allocator = false;  // leave the C library's defaults instead of core::keep_freed_memory (as `fleetmap` sets)
   double clutter = 1.0;      // scales the clutter rates (0: none)
   double furniture = 0.0;    // one piece of furniture per this many m² of floor (0: the bare plans)
   std::uint64_t seed = 1;
@@ -117,7 +119,8 @@ constexpr const char* kUsage =
     "       [--campus-pairs N] [--unrelated N] [--large-pairs N] [--two-robots N] [--two-robots-mixed F] [--overlaps 0.1,0.5,...]\n"
     "       [--real-maps MAP,...] [--real-pairs N] [--real-window CELLS] [--real-coarsen F] [--real-mixed F]\n"
     "       [--real-unrelated N]\n"
-    "       [--method auto] [--min-confidence C] [--coarse-candidates N] [--fine-candidates N] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n";
+    "       [--method auto] [--min-confidence C] [--coarse-candidates N] [--fine-candidates N] [--no-peer] [--clutter SCALE] [--furniture M2] [--seed S] [--build-maps K/N]\n"
+    "       [--default-allocator]\n";
 
 [[noreturn]] void usage(const std::string& problem) {
   std::cerr << "fleetmap_bench_merging_real: " << problem << "\n" << kUsage;
@@ -188,6 +191,7 @@ Args parse_args(int argc, char** argv) {
     else if (k == "--coarse-candidates") a.coarse_candidates = whole(1, 1000);
     else if (k == "--fine-candidates") a.fine_candidates = whole(1, 1000);
     else if (k == "--no-peer") a.peer = false;
+    else if (k == "--default-allocator") a.default_allocator = true;
     else if (k == "--clutter") a.clutter = number(value());
     else if (k == "--furniture") {
       const std::string v = value();
@@ -933,6 +937,8 @@ int main(int argc, char** argv) {
   const Args args = parse_args(argc, argv);
   clutter_scale = args.clutter;
   cv::setNumThreads(1);
+  // Merged as the `fleetmap` program and the Python module merge: freed images kept for reuse.
+  if (!args.default_allocator) core::keep_freed_memory();
   try {
     merging::MergeOptions options;
     options.method = args.method;

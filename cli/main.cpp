@@ -14,6 +14,7 @@
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/memory.h"
 #include "io/file_io.h"
 
 namespace {
@@ -70,6 +71,8 @@ void check_subcommand_words(const CLI::App& app, int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Explorations and benchmarks merge and step large maps over and over (core/memory.h).
+  fleetmap::core::keep_freed_memory();
   // fleetmap reports problems itself, in one line; OpenCV's own log lines would only add noise.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   namespace fm = fleetmap;

@@ -1,5 +1,7 @@
 """Merging two maps (transform and confidence) and planning a path on a map."""
 import math
+import platform
+import resource
 import unittest
 
 import numpy as np
@@ -45,6 +47,27 @@ class MergeTest(unittest.TestCase):
             a.resampled(0.0)
         with self.assertRaisesRegex(fleetmap.InputError, "resampled: 0.001 m cells would make .* over the limit"):
             a.resampled(0.001)
+
+    @unittest.skipUnless(platform.libc_ver()[0] == "glibc", "the allocator setting is glibc's")
+    def test_merging_again_reuses_the_memory_of_the_last_merge(self):
+        # Importing fleetmap keeps freed memory for reuse (core/memory.h): a script that merges
+        # large maps in a loop would otherwise fault every merge's pages in again. Two 1000 x 1200
+        # windows of campus: measured 12255 page faults for the first merge, then 310, 58 and 0; with
+        # glibc's defaults 3061, 2681 and 2623.
+        campus = fleetmap.load_map("campus").image
+        a = fleetmap.Map.from_image(campus[:, : campus.shape[1] - 200].copy())
+        b = fleetmap.Map.from_image(campus[:, 200:].copy())
+
+        def faults_of_a_merge():
+            before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+            result = fleetmap.merge_maps(a, b)
+            self.assertTrue(result.merged, result.reason)
+            self.assertAlmostEqual(result.transform[0], 200.0, delta=0.5)
+            return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+
+        faults_of_a_merge()  # maps what a merge of this size needs
+        for _ in range(2):
+            self.assertLess(faults_of_a_merge(), 1000)  # 4 MB; glibc's defaults fault 10 MB in a merge
 
     def test_maps_with_nothing_in_common_are_not_merged(self):
         empty = np.full((60, 60), 205, np.uint8)
