@@ -43,7 +43,12 @@ long merge_like_round(std::size_t& bytes) {
 }
 
 TEST(KeepFreedMemory, RepeatedLargeAllocationsNoLongerFaultTheirPagesInAgain) {
-  if (!keep_freed_memory()) GTEST_SKIP() << "this C library (or a sanitizer's allocator) has no such setting";
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer's allocator replaces glibc's and has no such setting: the call says so.
+  EXPECT_FALSE(keep_freed_memory());
+  return;
+#endif
+  ASSERT_TRUE(keep_freed_memory());  // glibc, as on every machine fleetmap is built for (Debian 12)
   std::size_t bytes = 0;
   EXPECT_GT(merge_like_round(bytes), 0);  // the first round maps its pages
   // Later rounds reuse them. With glibc's defaults every round faults nearly all of its 17920 pages
