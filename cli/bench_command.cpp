@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cli/command.h"
+#include "cli/map_notes.h"
 #include "cli/progress.h"
 #include "cli/sweep_flags.h"
 #include "cli/validators.h"
@@ -284,6 +285,13 @@ int run_bench(const BenchFlags& f) {
   for (const auto& r : runs) {
     if (!done.count(sweep::run_key(r))) todo.push_back(r);
   }
+  if (!f.quiet) {
+    for (const auto& source : sweep.maps) {  // the inputs are good: how each map file was read
+      io::MapLoadOptions load;
+      load.default_resolution = sweep.base.map_resolution_m;
+      print_map_notes(source, load, f.sweep.resolution || f.sweep.scenario || !f.sweep_file.empty());
+    }
+  }
   folder.claim();
   write_sweep_files(out, sweep);
 
@@ -373,12 +381,15 @@ Command add_bench_command(CLI::App& root) {
   app->add_option("--localization", s.localization,
                   "How robots know their pose: " + core::join(localization::localizer_names()) + " (see `fleetmap explore --help`) [default: ideal]");
   app->add_option("--merging", s.merging,
-                  "How robots bring teammates' maps into their frame: known, rendezvous or overlap (see `fleetmap "
-                  "explore --help`) [default: known]");
+                  "How robots bring teammates' maps into their frame: " + core::join(sim::merging_names()) +
+                      " (see `fleetmap explore --help`) [default: known]");
   app->add_option("--comm-range", s.comm_range, "Communication range in metres, or inf [default: inf]")
       ->check(in_range(sim::limits::kCommRange));
   app->add_option("--sensor-range", s.sensor_range, "Laser range in metres [default: 4]")
       ->check(in_range(sim::limits::kSensorRange));
+  app->add_option("--resolution", s.resolution,
+                  "Metres per cell of bare image maps (PNG/PGM without YAML; a map_server YAML has its own) [default: 0.05]")
+      ->check(in_range(io::kResolutionRange));
   app->add_option("--vary", s.vary,
                   "A further sweep axis, SETTING=V1,V2,... (repeat for more): a scenario key such as "
                   "sensors.range.beams or communication.range, or beams, sensor_range, comm_range, localization, merging, "

@@ -9,9 +9,11 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/map_notes.h"
 #include "cli/plan_output.h"
 #include "cli/progress.h"
 #include "cli/validators.h"
+#include "core/angle.h"
 #include "core/error.h"
 #include "core/format.h"
 #include "exploration/strategy.h"
@@ -35,7 +37,8 @@ namespace {
 
 struct ExploreFlags {
   std::string scenario;
-  std::optional<std::string> map, strategy, localization, comm_range, path_planner, merging, starts;
+  std::optional<std::string> map, strategy, localization, comm_range, path_planner, merging, starts, cluster_at;
+  std::vector<std::string> start;  // --start x,y[,heading_deg], once per robot
   std::optional<double> min_separation, resolution;
   std::string plan_from, plan_to, planner = "astar";
   double plan_time = 1.0;
@@ -66,6 +69,30 @@ sim::Scenario scenario_from(const ExploreFlags& f) {
   if (f.starts) {
     s.placement = *f.starts == "random" ? sim::Placement::Random : sim::Placement::Cluster;
     s.starts.clear();
+  }
+  if (!f.start.empty()) {
+    if (f.starts) throw InputError("--start and --starts " + *f.starts + " go apart: --start places each robot itself");
+    if (f.cluster_at) throw InputError("--start and --cluster-at go apart: --start places each robot itself");
+    if (f.robots && *f.robots != int(f.start.size())) {
+      throw InputError(fmt::format("--robots {} and {} --start poses disagree: give one --start per robot", *f.robots,
+                                   f.start.size()));
+    }
+    s.starts.clear();
+    for (const auto& text : f.start) {
+      const auto v = parse_numbers(text);
+      if (!v || v->size() < 2 || v->size() > 3) {
+        throw InputError("--start '" + text + "': expected x,y or x,y,heading (metres, degrees), e.g. 2.5,4 or 2.5,4,90");
+      }
+      s.starts.emplace_back((*v)[0], (*v)[1], v->size() > 2 ? core::deg2rad((*v)[2]) : 0.0);
+    }
+    s.placement = sim::Placement::List;
+    s.robot_count = int(s.starts.size());
+  }
+  if (f.cluster_at) {
+    const auto p = parse_pair(*f.cluster_at);
+    if (!p) throw InputError("--cluster-at '" + *f.cluster_at + "': expected x,y in metres, e.g. 2.5,4");
+    if (s.placement == sim::Placement::List) s.placement = sim::Placement::Cluster, s.starts.clear();
+    s.cluster_at = Eigen::Vector2d(p->first, p->second);
   }
   if (f.min_separation) s.min_separation_m = *f.min_separation;
   if (f.strategy) s.exploration.strategy = *f.strategy;
@@ -106,6 +133,14 @@ void print_summary(const sim::RunResult& result, const std::string& label) {
   fmt::print("{}: {}, strategy {}, localization {}, communication {}, seed {}\n", label,
              counted(sc.placement == sim::Placement::List ? long(sc.starts.size()) : sc.robot_count, "robot"),
              sc.exploration.strategy, sc.localization, range, sc.seed);
+  if (sc.placement != sim::Placement::List && !sc.cluster_at && !sc.starts.empty()) {
+    // The default placement, said once: where it put the robots and how to choose instead.
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& p : sc.starts) mean += p.position() / double(sc.starts.size());
+    fmt::print("robots start {}, in the largest region a robot can reach (the default; --cluster-at x,y or --start x,y "
+               "to choose)\n",
+               sc.placement == sim::Placement::Random ? "at random places" : "packed around " + core::format_point(mean));
+  }
   fmt::print("explored {} of the observable space in {} ({}); {}, {}\n", format_percent(result.coverage.back()),
              counted(result.steps, "step"), result.finished ? "no reachable frontier left" : "step limit reached",
              level_text("95%", result.steps_to_95), level_text("99%", result.steps_to_99));
@@ -126,7 +161,9 @@ void print_summary(const sim::RunResult& result, const std::string& label) {
              sc.localization == "ideal" ? ""
                                         : fmt::format("localization error (RMSE over robots) {:.3f} m; ", totals.position_rmse_m),
              100.0 * q.wrong_cell_share, q.mean_wall_distance_m);
-  if (sc.merging != "known") {
+  if (sc.merging == "none") {
+    fmt::print("merging (none): every robot mapped alone, in its own frame (robot_<k>.yaml; fleetmap merge joins them)\n");
+  } else if (sc.merging != "known") {
     int made = 0;
     double worst_deg = 0.0, worst_m = 0.0;
     for (const auto& m : result.merges) {
@@ -211,11 +248,16 @@ ExploreOutputs explore_outputs(const ExploreFlags& f, const sim::Scenario& s, bo
   return o;
 }
 
-// The true map; one with no free cell is refused.
-mapping::OccupancyGrid load_truth(const ExploreFlags& f, const sim::Scenario& s) {
+io::MapLoadOptions truth_load_options(const ExploreFlags& f, const sim::Scenario& s) {
   io::MapLoadOptions load;
   load.max_cells = f.max_cells;
   load.default_resolution = s.map_resolution_m;
+  return load;
+}
+
+// The true map; one with no free cell is refused.
+mapping::OccupancyGrid load_truth(const ExploreFlags& f, const sim::Scenario& s) {
+  const io::MapLoadOptions load = truth_load_options(f, s);
   auto truth = maps::load_map_source(s.map, load);
   bool any_free = false;
   for (int i = 0; i < truth.width() * truth.height() && !any_free; ++i) any_free = truth.state_at(i) == mapping::CellState::Free;
@@ -307,6 +349,8 @@ int run_explore(const ExploreFlags& f) {
   } catch (const InputError& e) {
     throw InputError((f.scenario.empty() ? s.map : f.scenario) + ": " + e.what());
   }
+  // The input is good: how the map was read, said before the run.
+  if (!f.quiet) print_map_notes(s.map, truth_load_options(f, s), f.resolution || !f.scenario.empty());
   folder.claim();
   if (attempts) attempts->claim();
   sim::Simulation& simulation = *made;
@@ -345,6 +389,9 @@ int run_explore(const ExploreFlags& f) {
   }
   folder.finish(io::OutputFolder::names(written));
   if (attempts) attempts->finish();
+  if (const std::string warning = sim::reachable_space_warning(result); !warning.empty()) {
+    fmt::print(stderr, "fleetmap: warning: {}: {} (metrics.json: space)\n", label, warning);
+  }
   if (f.quiet) {
     fmt::print("{}\n", (out / "merged.png").string());
     return plan_exit_code(f, plan);
@@ -384,18 +431,27 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--robots", f->robots, "Number of robots, placed as --starts says [default: 4]")
       ->check(in_range(sim::limits::kRobots));
   app->add_option("--starts", f->starts,
-                 "Where robots start: cluster (packed near the map centre) or random (anywhere reachable from the "
-                 "centre, --min-separation apart, random headings) [default: cluster]")
-      ->check(CLI::IsMember({"cluster", "random"}));
+                 "Where robots start: cluster (packed together) or random (anywhere in the region, --min-separation "
+                 "apart, random headings); both in the largest region a robot can reach, or in the one around "
+                 "--cluster-at [default: cluster]")
+      ->check(one_of({"cluster", "random"}));
+  app->add_option("--start", f->start,
+                  "Where a robot starts: x,y or x,y,heading (metres in the map's frame, degrees); once per robot, "
+                  "e.g. --start 2,3 --start 4,3,90 (instead of --robots and --starts)")
+      ->expected(1)
+      ->take_all();
+  app->add_option("--cluster-at", f->cluster_at,
+                  "Pack the robots (or, with --starts random, choose their region) around x,y in metres "
+                  "[default: nearest the map's centre in the largest region a robot can reach]");
   app->add_option("--min-separation", f->min_separation,
                   "Least distance between robot centres at the start, metres [default: 0.6; try 4 with --starts random]")
       ->check(in_range(sim::limits::kSeparation));
   app->add_option("--strategy", f->strategy, "Coordination strategy [default: directional]")
-      ->check(CLI::IsMember(exploration::strategy_names()));
+      ->check(one_of(exploration::strategy_names()));
   app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]")
-      ->check(CLI::IsMember(localization::localizer_names()));
-  app->add_option("--merging", f->merging, "known, rendezvous, overlap or landmarks (see below) [default: known]")
-      ->check(CLI::IsMember(sim::merging_names()));
+      ->check(one_of(localization::localizer_names()));
+  app->add_option("--merging", f->merging, "known, none, rendezvous, overlap or landmarks (see below) [default: known]")
+      ->check(one_of(sim::merging_names()));
   app->add_option("--comm-range", f->comm_range,
                   "Communication range in metres; 0 = only when robots see each other; inf = always [default: inf]")
       ->check(in_range(sim::limits::kCommRange));
@@ -411,7 +467,7 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--path-planner", f->path_planner,
                   "How robots get paths to targets: wave, or a planner of `fleetmap plan` (astar, rrtconnect, ...; "
                   "not prmstar, whose roadmap grows by wall-clock time, so runs would not repeat) [default: wave]")
-      ->check(CLI::IsMember(sim::path_planner_names()));
+      ->check(one_of(sim::path_planner_names()));
   app->add_option("--plan-from", f->plan_from, "After the run, plan from x,y (metres) on the merged map ...");
   app->add_option("--plan-to", f->plan_to, "... to x,y; the path goes on merged.png and into path.json");
   app->add_option("--planner", f->planner, "Planner for --plan-from/--plan-to (see `fleetmap plan --help`)")

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <exception>
 #include <filesystem>
 #include <new>
@@ -15,6 +16,7 @@
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/memory.h"
+#include "core/suggest.h"
 #include "io/file_io.h"
 
 namespace {
@@ -62,10 +64,34 @@ void check_subcommand_words(const CLI::App& app, int argc, char** argv) {
       names += (names.empty() ? "" : ", ") + s->get_name();
     }
     if (next == nullptr) {
-      throw UnknownCommand(command_path(current), "unknown command '" + word + "' (commands: " + names + ")");
+      std::vector<std::string> words;
+      for (const CLI::App* s : subs) words.push_back(s->get_name());
+      throw UnknownCommand(command_path(current), "unknown command '" + word + "'" + fleetmap::core::did_you_mean(word, words) +
+                                                      " (commands: " + names + ")");
     }
     current = next;
   }
+}
+
+// CLI11 lists unexpected arguments last to first, with no hint; this names the first one the user
+// typed and, for a flag, the nearest flag of the command.
+std::string unexpected_argument(const CLI::App& app, int argc, char** argv) {
+  const std::vector<std::string> extras = app.remaining();
+  std::string first;
+  for (int i = 1; i < argc && first.empty(); ++i) {
+    if (std::find(extras.begin(), extras.end(), argv[i]) != extras.end()) first = argv[i];
+  }
+  if (first.empty() && !extras.empty()) first = extras.front();
+  if (first.size() > 1 && first[0] == '-') {
+    const std::string flag = first.substr(0, first.find('='));
+    std::vector<std::string> flags;
+    for (const CLI::Option* o : app.get_options()) {
+      for (const auto& n : o->get_lnames()) flags.push_back("--" + n);
+      for (const auto& n : o->get_snames()) flags.push_back("-" + n);
+    }
+    return "unknown flag '" + flag + "'" + fleetmap::core::did_you_mean(flag, flags);
+  }
+  return "unexpected argument '" + first + "'";
 }
 
 }  // namespace
@@ -103,6 +129,10 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const UnknownCommand& e) {
     fmt::print(stderr, "{}: {}\n", e.where, fm::io::printable(e.what()));
+    return kExitBadInput;
+  } catch (const CLI::ExtrasError&) {
+    const CLI::App* where = deepest_parsed(&app);
+    fmt::print(stderr, "{}: {} (see --help)\n", command_path(where), fm::io::printable(unexpected_argument(*where, argc, argv)));
     return kExitBadInput;
   } catch (const CLI::ParseError& e) {
     fmt::print(stderr, "{}: {} (see --help)\n", command_path(deepest_parsed(&app)), fm::io::printable(e.what()));

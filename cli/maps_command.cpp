@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/map_notes.h"
 #include "cli/outputs.h"
 #include "cli/validators.h"
 #include "core/error.h"
@@ -25,6 +26,7 @@ struct ShowOptions {
   std::string out;
   std::string title;
   double resolution = 0.05;
+  bool resolution_given = false;  // --resolution was on the command line
   long long max_cells = 64'000'000;
 };
 
@@ -51,6 +53,7 @@ int run_show(const ShowOptions& o) {
   load.default_resolution = o.resolution;
   load.max_cells = o.max_cells;
   const auto grid = maps::load_map_source(o.map, load);
+  print_map_notes(o.map, load, o.resolution_given);
   viz::RenderOptions render;
   render.title = o.title.empty() ? fs::path(o.map).stem().string() : o.title;
   write_picture(out, viz::render_map(grid, {}, render));
@@ -73,14 +76,15 @@ Command add_maps_command(CLI::App& root) {
   show->add_option("map", o->map, "Built-in map name, image file or map_server YAML")->required();
   show->add_option("--out,-o", o->out, "Output PNG, or - for the standard output (default: <map name>_map.png in the current folder)");
   show->add_option("--title", o->title, "Title in the legend panel (default: the map name)");
-  show->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
-      ->capture_default_str()
-      ->check(in_range(io::kResolutionRange));
+  CLI::Option* resolution = show->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
+                                 ->capture_default_str()
+                                 ->check(in_range(io::kResolutionRange));
   show->add_option("--max-cells", o->max_cells, "Refuse maps with more cells than this")
       ->capture_default_str()
       ->check(in_range(kMaxCellsRange));
-  return {maps, [list, show, o]() {
+  return {maps, [list, show, o, resolution]() {
             if (list->parsed()) return run_list();
+            o->resolution_given = resolution->count() > 0;
             if (show->parsed()) return run_show(*o);
             return 2;
           }};

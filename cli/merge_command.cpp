@@ -8,14 +8,17 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cli/command.h"
+#include "cli/map_notes.h"
 #include "cli/outputs.h"
 #include "cli/validators.h"
 #include "core/angle.h"
 #include "core/error.h"
+#include "core/format.h"
 #include "io/file_io.h"
 #include "maps/builtin_maps.h"
 #include "io/map_io.h"
@@ -36,6 +39,13 @@ constexpr const char* kConvention =
     "first input's pixel grid, R(theta) = [[cos, -sin], [sin, cos]], scale = the input's metres per cell / the first's "
     "(1 for maps of one resolution)";
 
+// A map file with no map_server YAML: its resolution is not its own.
+bool is_bare_image(const std::string& source) {
+  std::error_code ec;
+  const std::string ext = fs::path(source).extension().string();
+  return fs::is_regular_file(source, ec) && ext != ".yaml" && ext != ".yml";
+}
+
 struct MergeCommandOptions {
   std::vector<std::string> maps;
   std::string method = "auto";
@@ -45,6 +55,7 @@ struct MergeCommandOptions {
   double min_confidence = 0.5;
   std::uint64_t seed = 1;
   double resolution = 0.05;
+  bool resolution_given = false;  // --resolution was on the command line
 };
 
 // An input's place in the first input's pixel grid, as the convention states it: its pixel p lies at
@@ -165,13 +176,33 @@ int run_merge(const MergeCommandOptions& o) {
   std::FILE* report = report_stream(outputs);
   io::MapLoadOptions load;
   load.default_resolution = o.resolution;
+  // A bare image has no resolution of its own: without --resolution it takes the one the other
+  // maps (map_server YAML, built-in) share, so that a robot's PNG merges with its teammate's YAML.
+  std::vector<std::optional<mapping::OccupancyGrid>> loaded(o.maps.size());
+  std::optional<double> shared;
+  std::string shared_by;
+  bool one_resolution = true;
+  for (std::size_t i = 0; i < o.maps.size(); ++i) {
+    if (is_bare_image(o.maps[i])) continue;
+    loaded[i] = maps::load_map_source(o.maps[i], load);
+    const double r = loaded[i]->resolution();
+    if (shared && *shared != r) one_resolution = false;
+    if (!shared) shared = r, shared_by = o.maps[i];
+  }
+  std::string source = "the default; --resolution sets it";
+  if (!o.resolution_given && shared && one_resolution) {
+    load.default_resolution = *shared;
+    source = "that of " + shared_by + "; --resolution sets it";
+  }
   // Maps of different resolutions: each pair is aligned through the coarser map's cells
   // (merging::align_across_resolutions), and the maps are fused in the first map's cells.
   std::vector<mapping::OccupancyGrid> originals;
-  for (const auto& m : o.maps) {
-    originals.push_back(maps::load_map_source(m, load));
+  for (std::size_t i = 0; i < o.maps.size(); ++i) {
+    const auto& m = o.maps[i];
+    originals.push_back(loaded[i] ? std::move(*loaded[i]) : maps::load_map_source(m, load));
     if (originals.back().known_count() == 0) throw InputError(m + ": every cell is unknown; there is nothing to merge");
   }
+  for (const auto& m : o.maps) print_map_notes(m, load, o.resolution_given, source);  // the inputs are good
   const double r0 = originals.front().resolution();
   std::vector<mapping::OccupancyGrid> resampled;  // the maps of other resolutions in the first's cells
   resampled.reserve(originals.size());
@@ -224,8 +255,26 @@ int run_merge(const MergeCommandOptions& o) {
       t["map"] = name;
       t["merged"] = false;
       t["reason"] = merged.reason[i];
+      std::string hint;
+      if (!o.resolution_given && originals[i].resolution() != r0 && (is_bare_image(name) || is_bare_image(o.maps.front()))) {
+        hint = fmt::format(" (the maps' cells are {} m and {} m, a bare image's by default: if that is wrong, give "
+                           "--resolution)", r0, originals[i].resolution());
+      }
+      if (const int k = merged.reason_pair[i]; k >= 0) {
+        // Where the contradiction is, for a refusal that names one: a user looks there first.
+        const auto& p = merged.pairs[std::size_t(k)];
+        const auto& g = originals[std::size_t(p.a)];
+        if (p.result.refusal == merging::Refusal::WallsCross && p.result.quality.open_space_walls > 0 &&
+            g.resolution() == originals[std::size_t(p.b)].resolution()) {
+          const Eigen::Vector2d c = p.result.quality.open_space_at;
+          const Eigen::Vector2d m = g.geometry().grid_to_world(c + Eigen::Vector2d(0.5, 0.5));
+          hint += fmt::format("; the wall stands around pixel ({:.0f}, {:.0f}) of {}, at {} m", c.x(), g.height() - 1 - c.y(),
+                              o.maps[std::size_t(p.a)], core::format_point(m));
+          t["wall_in_open_space_px"] = {std::lround(c.x()), std::lround(g.height() - 1 - c.y())};
+        }
+      }
       j["transforms"].push_back(t);
-      fmt::print(report, "{}: not merged: {}\n", name, merged.reason[i]);
+      fmt::print(report, "{}: not merged: {}{}\n", name, merged.reason[i], hint);
       continue;
     }
     ++placed;
@@ -282,7 +331,7 @@ Command add_merge_command(CLI::App& root) {
       ->required();
   merge->add_option("--method", o->method, "Alignment method: auto, overlap or features (see below)")
       ->capture_default_str()
-      ->check(CLI::IsMember(merging::merge_method_names()));
+      ->check(one_of(merging::merge_method_names()));
   merge->add_option("--out,-o", o->out,
                     "Merged map: a picture (.png; - for the standard output) or a map file in the first map's metres "
                     "(.yaml for map_server with a .pgm beside it, or a bare .pgm) that plan and explore read")
@@ -293,10 +342,15 @@ Command add_merge_command(CLI::App& root) {
       ->capture_default_str()
       ->check(in_range(merging::kConfidenceRange));
   merge->add_option("--seed", o->seed, "Seed of the RANSAC sampling (features)")->capture_default_str()->check(seed_number());
-  merge->add_option("--resolution", o->resolution, "Metres per cell for bare images without YAML")
-      ->capture_default_str()
-      ->check(in_range(io::kResolutionRange));
-  return {merge, [o]() { return run_merge(*o); }};
+  CLI::Option* resolution =
+      merge->add_option("--resolution", o->resolution,
+                        "Metres per cell of bare images (PNG/PGM without YAML) [default: the resolution the map_server "
+                        "maps among the inputs share, else 0.05]");
+  resolution->check(in_range(io::kResolutionRange));
+  return {merge, [o, resolution]() {
+            o->resolution_given = resolution->count() > 0;
+            return run_merge(*o);
+          }};
 }
 
 }  // namespace fleetmap::cli

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "cli/command.h"
+#include "cli/map_notes.h"
 #include "cli/outputs.h"
 #include "cli/plan_output.h"
 #include "cli/validators.h"
@@ -39,6 +40,7 @@ struct PlanCommandOptions {
   std::uint64_t seed = 1;
   std::string out, json;
   double resolution = 0.05;
+  bool resolution_given = false;  // --resolution was on the command line
 };
 
 // An endpoint as the user gave it: the flag and its text, and the point in metres.
@@ -132,6 +134,7 @@ int run_plan(const PlanCommandOptions& o) {
   if (r.status == PlanStatus::GoalOutsideMap || r.status == PlanStatus::GoalInObstacle) {
     throw InputError(goal.flag + " " + goal.text + ": " + r.detail);
   }
+  print_map_notes(o.map, load, o.resolution_given);  // the input is good: how the map was read
 
   if (!o.json.empty()) write_output(o.json, result_json(o, r, start, goal).dump(2) + "\n");
   if (!o.out.empty()) write_picture(o.out, picture(o, grid, space, r, start, goal));
@@ -164,20 +167,24 @@ Command add_plan_command(CLI::App& root) {
   plan->add_option("--to-cell", o->to_cell, "Goal cell column,row (row 0 at the bottom), instead of --to")->excludes(to);
   plan->add_option("--planner", o->planner, "Planner name (see the list below)")
       ->capture_default_str()
-      ->check(CLI::IsMember(planning::planner_names()));
+      ->check(one_of(planning::planner_names()));
   plan->add_option("--time", o->time_s, "Time budget in seconds")->capture_default_str()->check(in_range(planning::kTimeBudgetRange));
   plan->add_option("--radius", o->radius_m, "Robot radius in metres")->capture_default_str()->check(in_range(kRadiusRange));
   plan->add_option("--unknown", o->unknown, "Unknown cells are 'obstacle' or 'free'")
       ->capture_default_str()
-      ->check(CLI::IsMember({"obstacle", "free"}));
+      ->check(one_of({"obstacle", "free"}));
   plan->add_option("--seed", o->seed, "Seed of the sampling planners")->capture_default_str()->check(seed_number());
   plan->add_option("--out,-o", o->out, "Draw the map and the path to this PNG; - for the standard output (default: none)");
   plan->add_option("--json", o->json,
                    "Write planner, success, time, length and waypoints to this JSON; - for the standard output (default: none)");
-  plan->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
-      ->capture_default_str()
-      ->check(in_range(io::kResolutionRange));
-  return {plan, [o]() { return run_plan(*o); }};
+  CLI::Option* resolution =
+      plan->add_option("--resolution", o->resolution, "Metres per cell for a bare image without YAML")
+          ->capture_default_str()
+          ->check(in_range(io::kResolutionRange));
+  return {plan, [o, resolution]() {
+            o->resolution_given = resolution->count() > 0;
+            return run_plan(*o);
+          }};
 }
 
 }  // namespace fleetmap::cli

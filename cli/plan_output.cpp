@@ -5,19 +5,30 @@
 
 namespace fleetmap::cli {
 
-std::optional<std::pair<double, double>> parse_pair(const std::string& text) {
-  const auto comma = text.find(',');
-  if (comma == std::string::npos) return std::nullopt;
-  const std::string a = text.substr(0, comma), b = text.substr(comma + 1);
-  if (a.empty() || b.empty()) return std::nullopt;
-  try {
-    std::size_t na = 0, nb = 0;
-    const double x = std::stod(a, &na), y = std::stod(b, &nb);
-    if (na != a.size() || nb != b.size() || !std::isfinite(x) || !std::isfinite(y)) return std::nullopt;
-    return std::pair{x, y};
-  } catch (const std::exception&) {
-    return std::nullopt;
+std::optional<std::vector<double>> parse_numbers(const std::string& text) {
+  std::vector<double> out;
+  std::size_t start = 0;
+  while (true) {
+    const auto comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (item.empty()) return std::nullopt;
+    try {
+      std::size_t n = 0;
+      const double v = std::stod(item, &n);
+      if (n != item.size() || !std::isfinite(v)) return std::nullopt;
+      out.push_back(v);
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+    if (comma == std::string::npos) return out;
+    start = comma + 1;
   }
+}
+
+std::optional<std::pair<double, double>> parse_pair(const std::string& text) {
+  const auto v = parse_numbers(text);
+  if (!v || v->size() != 2) return std::nullopt;
+  return std::pair{(*v)[0], (*v)[1]};
 }
 
 namespace {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 #include <utility>
 
 #include "planning/planner.h"
@@ -15,6 +16,8 @@ namespace fleetmap::cli {
 
 // Splits "a,b" into two numbers; nullopt unless both parse completely.
 std::optional<std::pair<double, double>> parse_pair(const std::string& text);
+// "a,b,c": finite numbers separated by commas (no spaces); nullopt for anything else.
+std::optional<std::vector<double>> parse_numbers(const std::string& text);
 
 struct PlanJsonContext {
   std::string map;

@@ -4,6 +4,7 @@
 
 #include "core/format.h"
 #include "core/error.h"
+#include "core/suggest.h"
 #include "io/file_io.h"
 #include "sim/scenario.h"
 
@@ -24,12 +25,14 @@ void apply_sweep_flags(sweep::Sweep& sweep, const SweepFlags& f) {
   if (f.merging) {
     const auto names = sim::merging_names();
     if (std::find(names.begin(), names.end(), *f.merging) == names.end()) {
-      throw InputError("--merging: unknown mode '" + *f.merging + "' (valid: " + core::join(names) + ")");
+      throw InputError("--merging: unknown mode '" + *f.merging + "'" + core::did_you_mean(*f.merging, names) +
+                       " (valid: " + core::join(names) + ")");
     }
     sweep.base.merging = *f.merging;
   }
   if (f.comm_range) sweep.base.communication.range_m = sweep::parse_comm_range(*f.comm_range, "--comm-range");
   if (f.sensor_range) sweep.base.range.max_range_m = *f.sensor_range;
+  if (f.resolution) sweep.base.map_resolution_m = *f.resolution;
   if (!f.vary.empty()) {
     sweep.axes.clear();
     for (const auto& text : f.vary) sweep.axes.push_back(sweep::parse_axis(text, "--vary " + text));

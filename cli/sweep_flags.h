@@ -19,11 +19,12 @@ struct SweepFlags {
   std::optional<std::string> merging;     // known, rendezvous or overlap
   std::optional<std::string> comm_range;  // metres, or "inf"
   std::optional<double> sensor_range;
+  std::optional<double> resolution;  // metres per cell of bare image maps
   std::vector<std::string> vary;  // "SETTING=V1,V2", each a further axis (replacing the file's)
 
   bool any() const {
     return maps || strategies || robots || seeds || first_seed || scenario || steps || localization || merging ||
-           comm_range || sensor_range || !vary.empty();
+           comm_range || sensor_range || resolution || !vary.empty();
   }
 };
 

@@ -4,9 +4,14 @@
 // a flag accepts exactly what a file accepts.
 #include <CLI/CLI.hpp>
 
-#include <string>
+#include <algorithm>
 
+#include <string>
+#include <vector>
+
+#include "core/format.h"
 #include "core/range.h"
+#include "core/suggest.h"
 
 namespace fleetmap::cli {
 
@@ -18,6 +23,16 @@ inline CLI::Validator in_range(const core::Range& range) {
         return "expected " + core::expected_text(range) + ", got '" + text + "'";
       },
       "NUMBER");
+}
+
+// One of `names` (a family's members, a fixed set of words); a mistyped one gets the nearest name.
+inline CLI::Validator one_of(std::vector<std::string> names) {
+  return CLI::Validator(
+      [names](std::string& text) -> std::string {
+        if (std::find(names.begin(), names.end(), text) != names.end()) return {};
+        return "unknown value '" + text + "'" + core::did_you_mean(text, names) + " (valid: " + core::join(names) + ")";
+      },
+      "NAME");
 }
 
 // --max-cells of every command that reads maps.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/suggest.h"
 
 namespace fleetmap::core {
 
@@ -39,15 +40,16 @@ class Registry {
     entries_.push_back({std::move(name), std::move(help), std::move(make)});
   }
 
-  // Throws InputError naming the valid names for an unknown one.
+  // Throws InputError naming the valid names (and the nearest one) for an unknown one.
   const Entry& get(std::string_view name) const {
     const std::lock_guard<std::mutex> lock(mutex_);
     for (const auto& e : entries_) {
       if (e.name == name) return e;  // a deque keeps references valid while others are added
     }
-    std::string names;
-    for (const auto& e : entries_) names += (names.empty() ? "" : ", ") + e.name;
-    throw InputError("unknown " + family_ + " '" + std::string(name) + "' (valid: " + names + ")");
+    std::vector<std::string> names;
+    std::string list;
+    for (const auto& e : entries_) names.push_back(e.name), list += (list.empty() ? "" : ", ") + e.name;
+    throw InputError("unknown " + family_ + " '" + std::string(name) + "'" + did_you_mean(name, names) + " (valid: " + list + ")");
   }
 
   bool contains(std::string_view name) const {

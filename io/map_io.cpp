@@ -27,6 +27,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A pixel less opaque than this is transparent: nothing was drawn there, so it is unknown.
+constexpr int kOpaqueAlpha = 128;
+
 // No image side is longer (2^40 pixels); a header declaring more is refused as such.
 constexpr std::int64_t kHugeSide = std::int64_t{1} << 40;
 
@@ -337,6 +340,10 @@ mapping::OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta
     for (int x = 0; x < image.cols; ++x, p += channels) {
       int sum = 0;
       for (int k = 0; k < colour_channels; ++k) sum += p[k];
+      if (has_alpha && p[channels - 1] < kOpaqueAlpha) {
+        grid.set_log_odds({x, y}, 0.0f);  // transparent: nothing was drawn here
+        continue;
+      }
       const bool opaque = !has_alpha || p[channels - 1] == 255;
       grid.set_log_odds({x, y}, table[std::size_t((opaque ? sums : 0) + sum)]);
     }
@@ -378,6 +385,89 @@ mapping::OccupancyGrid load_map(const fs::path& path, const MapLoadOptions& opti
   MapYaml meta;
   meta.resolution = options.default_resolution;
   return grid_from_image(read_image(path, options), meta, options.grid);
+}
+
+namespace {
+
+// The grey a threshold puts between two states: occ = (255 - grey) / 255.
+int grey_of(double occ) { return int(std::floor(255.0 * (1.0 - occ))); }
+
+std::string share(std::int64_t n, std::int64_t of) {
+  return fmt::format("{} pixel{} ({:.1f}%)", n, n == 1 ? "" : "s", of > 0 ? 100.0 * double(n) / double(of) : 0.0);
+}
+
+}  // namespace
+
+std::vector<std::string> map_reading_notes(const fs::path& path, const MapLoadOptions& options,
+                                           const std::string& resolution_source) {
+  const std::string ext = path.extension().string();
+  const bool bare = ext != ".yaml" && ext != ".yml";
+  MapYaml meta;
+  fs::path image_path = path;
+  if (bare) {
+    meta.resolution = options.default_resolution;
+  } else {
+    meta = parse_map_yaml(io::read_file(path, 1 << 20), path.string());
+    image_path = meta.image.is_absolute() ? meta.image : path.parent_path() / meta.image;
+  }
+  const cv::Mat image = read_image(image_path, options);
+  std::vector<std::string> notes;
+  const std::string name = path.string();
+  if (bare && !resolution_source.empty()) {
+    notes.push_back(fmt::format("{}: a bare image (no map_server YAML), read at {} m per cell, {}", name, meta.resolution,
+                                resolution_source));
+  }
+  if (meta.mode == MapMode::Raw) return notes;
+  const int channels = image.channels();
+  const bool has_alpha = channels == 2 || channels == 4;
+  const int colour_channels = has_alpha ? channels - 1 : channels;
+  std::int64_t pixels = 0, transparent = 0, walls = 0, coloured = 0, grey_unknown = 0;
+  std::int64_t coloured_as[3] = {0, 0, 0};  // wall, free, unknown
+  int darkest = 256, lightest = -1;
+  for (int row = 0; row < image.rows; ++row) {
+    const std::uint8_t* p = image.ptr<std::uint8_t>(row);
+    for (int x = 0; x < image.cols; ++x, p += channels) {
+      ++pixels;
+      if (has_alpha && p[channels - 1] < kOpaqueAlpha) {
+        ++transparent;
+        continue;
+      }
+      int sum = 0, lo = 255, hi = 0;
+      for (int k = 0; k < colour_channels; ++k) sum += p[k], lo = std::min<int>(lo, p[k]), hi = std::max<int>(hi, p[k]);
+      double colour = double(sum) / colour_channels;
+      if (meta.negate) colour = 255.0 - colour;
+      const double occ = (255.0 - colour) / 255.0;
+      const int state = occ > meta.occupied_thresh ? 0 : occ < meta.free_thresh ? 1 : 2;
+      walls += state == 0;
+      // A colour is a pixel whose channels differ by more than an eighth of the scale.
+      if (hi - lo > 32) {
+        ++coloured, ++coloured_as[state];
+      } else if (state == 2 && std::abs(colour - 205.0) > 2.0) {  // grey, but not map_saver's unknown 205
+        ++grey_unknown;
+        darkest = std::min(darkest, int(std::lround(colour)));
+        lightest = std::max(lightest, int(std::lround(colour)));
+      }
+    }
+  }
+  const int wall_grey = grey_of(meta.occupied_thresh), free_grey = grey_of(meta.free_thresh) + 1;
+  const std::string rule =
+      fmt::format("darker than {} is a wall, lighter than {} free: occupied_thresh {}, free_thresh {}{}", wall_grey + 1,
+                  free_grey - 1, meta.occupied_thresh, meta.free_thresh, bare ? ", map_server's defaults" : "");
+  if (transparent > 0) {
+    notes.push_back(fmt::format("{}: {} are transparent, read as unknown", name, share(transparent, pixels)));
+  }
+  if (grey_unknown > 0 && (walls == 0 || 100 * grey_unknown >= pixels)) {
+    const double occ = (255.0 - darkest) / 255.0;
+    notes.push_back(fmt::format("{}: {} are grey from {} to {}, between the thresholds, and read as unknown ({}); to read "
+                                "grey {} as walls, give a map_server YAML with occupied_thresh below {:.3f}",
+                                name, share(grey_unknown, pixels), darkest, lightest, rule, darkest, occ));
+  }
+  if (coloured > 0) {
+    notes.push_back(fmt::format("{}: {} are coloured, each read by the mean of its red, green and blue ({}): {} as walls, "
+                                "{} as free, {} as unknown",
+                                name, share(coloured, pixels), rule, coloured_as[0], coloured_as[1], coloured_as[2]));
+  }
+  return notes;
 }
 
 std::vector<fs::path> map_files(const fs::path& path) {

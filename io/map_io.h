@@ -1,7 +1,8 @@
 #pragma once
 // Map files: PNG/PGM images and ROS map_server YAML, with map_server's semantics
 // (image row 0 is the top, cell row 0 the bottom; occ = (255 - mean(RGB)) / 255, inverted by
-// `negate`; Occupied when occ > occupied_thresh, Free when occ < free_thresh).
+// `negate`; Occupied when occ > occupied_thresh, Free when occ < free_thresh). A pixel less than
+// half opaque (alpha < 128) is Unknown: a transparent background was never drawn on.
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -63,6 +64,14 @@ mapping::OccupancyGrid grid_from_map_image(const MapImage& image, const MapYaml&
 // Loads a map from a map_server YAML (.yaml / .yml) or an image (PNG, PGM, ...).
 // Throws InputError naming the file for anything missing, unreadable, empty or too large.
 mapping::OccupancyGrid load_map(const std::filesystem::path& path, const MapLoadOptions& options = {});
+
+// What a user should know about how load_map(path, options) read the map, one line each: the
+// resolution a bare image took, when it was not the user's choice (`resolution_source` says where
+// it came from, e.g. "the default; --resolution sets it"; empty: the user gave it), and pixels read
+// in a way that may surprise (transparent ones; grey between the thresholds, read as unknown;
+// colours, read by their mean). Empty when nothing needs saying. Throws as load_map does.
+std::vector<std::string> map_reading_notes(const std::filesystem::path& path, const MapLoadOptions& options,
+                                           const std::string& resolution_source);
 
 // The files load_map(path) reads: a map_server YAML and the image it names, or the image alone.
 // For checks that no output replaces an input; a YAML that cannot be read gives just itself.

@@ -6,6 +6,7 @@
 
 #include "core/format.h"
 #include "core/error.h"
+#include "core/suggest.h"
 
 namespace fleetmap::io {
 
@@ -134,7 +135,8 @@ std::string YamlMap::text(const std::string& key, const std::string& fallback) {
 std::string YamlMap::choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& valid) {
   const std::string v = text(key, fallback);
   if (std::find(valid.begin(), valid.end(), v) != valid.end()) return v;
-  throw InputError(where(key) + ": unknown value '" + v + "' (valid: " + core::join(valid) + ")");
+  throw InputError(where(key) + ": unknown value '" + v + "'" + core::did_you_mean(v, valid) + " (valid: " +
+                   core::join(valid) + ")");
 }
 
 std::vector<double> YamlMap::numbers(const std::string& key, std::size_t size) {
@@ -162,7 +164,7 @@ void YamlMap::finish() const {
     if (std::find(asked_.begin(), asked_.end(), key) != asked_.end()) continue;
     std::string names;
     for (const auto& s : asked_) names += (names.empty() ? "" : ", ") + s;
-    throw InputError(where_node(kv.first) + ": unknown key '" + full_key(key) + "'" +
+    throw InputError(where_node(kv.first) + ": unknown key '" + full_key(key) + "'" + core::did_you_mean(key, asked_) +
                      (names.empty() ? "" : " (valid" + (prefix_.empty() ? std::string() : " in '" + prefix_ + "'") +
                                                ": " + names + ")"));
   }

@@ -101,6 +101,7 @@ class EkfSlamLocalizer final : public Localizer {
             {"landmarks_removed", static_cast<double>(landmarks_removed_)}};
   }
 
+  bool estimates_landmarks() const override { return true; }
   std::vector<Landmark> landmark_estimates() const override {
     std::vector<Landmark> out;
     out.reserve(tracked_.size());

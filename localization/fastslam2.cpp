@@ -325,6 +325,7 @@ class FastSlam2Localizer final : public Localizer {
   Eigen::Matrix3d covariance() const override { return filter_.pose_covariance(); }
   void change_frame(const core::Transform2& t) override { filter_.change_frame(t); }
   std::vector<Landmark> landmark_estimates() const override { return filter_.map(ParticleMap::Combined); }
+  bool estimates_landmarks() const override { return true; }
   std::vector<std::pair<std::string, double>> counters() const override {
     return {{"landmark_updates", double(filter_.landmark_updates())},
             {"rejected_associations", double(filter_.rejected_associations())},

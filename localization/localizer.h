@@ -145,8 +145,10 @@ class Localizer {
   // "robot_updates", "rejected_robot_detections"; `ekf-slam` also "landmarks_in_state",
   // "landmarks_added", "landmarks_removed".
   virtual std::vector<std::pair<std::string, double>> counters() const { return {}; }
-  // Landmark estimates held in the state, if any (for pictures and metrics).
+  // Landmark estimates held in the state, if any (for pictures, metrics and `--merging landmarks`).
   virtual std::vector<Landmark> landmark_estimates() const { return {}; }
+  // True when the localizer estimates landmarks (landmark_estimates() fills as it observes them).
+  virtual bool estimates_landmarks() const { return false; }
   // The grid the localizer builds itself, if any (`rbpf`: the best particle's map).
   virtual std::optional<mapping::OccupancyGrid> map_estimate() const { return std::nullopt; }
 };

@@ -10,6 +10,7 @@
 
 #include "core/format.h"
 #include "core/error.h"
+#include "core/suggest.h"
 #include "core/random.h"
 #include "io/file_io.h"
 #include "io/map_image.h"
@@ -471,8 +472,10 @@ mapping::OccupancyGrid load_map_source(const std::string& name_or_path, const io
   if (is_builtin_map(name_or_path)) return map_registry().get(name_or_path).make(options);
   const bool looks_like_path = name_or_path.find_first_of("/.") != std::string::npos;
   if (looks_like_path) throw InputError(name_or_path + ": no such file");
-  throw InputError("unknown map '" + name_or_path + "': not a file and not a built-in map (built-in maps: " +
-                   builtin_map_names() + ")");
+  std::vector<std::string> names;
+  for (const auto& m : builtin_maps()) names.push_back(m.name);
+  throw InputError("unknown map '" + name_or_path + "'" + core::did_you_mean(name_or_path, names) +
+                   ": not a file and not a built-in map (built-in maps: " + builtin_map_names() + ")");
 }
 
 }  // namespace fleetmap::maps

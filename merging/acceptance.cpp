@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <tuple>
 #include <cmath>
 #include <numbers>
 #include <unordered_map>
@@ -170,16 +171,22 @@ void tally(const PreparedGrid& from, const PreparedGrid& to, const core::Transfo
 }
 
 // The most points in one group of `points` whose nearest cells (rounded) are 8-neighbours, a chain
-// of them counting as one group.
-int largest_group(const std::vector<Eigen::Vector2d>& points) {
-  std::unordered_map<std::int64_t, int> cells;  // points per cell; a cell leaves when its group is counted
+// of them counting as one group, and the mean of that group's points.
+std::pair<int, Eigen::Vector2d> largest_group(const std::vector<Eigen::Vector2d>& points) {
+  std::unordered_map<std::int64_t, std::pair<int, Eigen::Vector2d>> cells;  // points per cell and their sum
   const auto key = [](long x, long y) { return (std::int64_t(x) << 32) ^ std::int64_t(std::uint32_t(y)); };
-  for (const auto& p : points) ++cells[key(std::lround(p.x()), std::lround(p.y()))];
+  for (const auto& p : points) {
+    auto& c = cells.try_emplace(key(std::lround(p.x()), std::lround(p.y())), 0, Eigen::Vector2d::Zero()).first->second;
+    ++c.first;
+    c.second += p;
+  }
   int largest = 0;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   std::vector<std::pair<long, long>> stack;
   while (!cells.empty()) {
     const std::int64_t start = cells.begin()->first;
-    int size = cells.begin()->second;
+    int size = cells.begin()->second.first;
+    Eigen::Vector2d sum = cells.begin()->second.second;
     cells.erase(cells.begin());
     stack.assign(1, {long(start >> 32), long(std::int32_t(std::uint32_t(start & 0xffffffff)))});
     while (!stack.empty()) {
@@ -189,14 +196,15 @@ int largest_group(const std::vector<Eigen::Vector2d>& points) {
         for (int dx = -1; dx <= 1; ++dx) {
           const auto n = cells.find(key(x + dx, y + dy));
           if (n == cells.end()) continue;
-          size += n->second;
+          size += n->second.first;
+          sum += n->second.second;
           cells.erase(n);
           stack.push_back({x + dx, y + dy});
         }
     }
-    largest = std::max(largest, size);
+    if (size > largest) largest = size, centre = sum / double(size);
   }
-  return largest;
+  return {largest, centre};
 }
 
 // The points farther than `tolerance` from the straight lines that hold the most points, taken one
@@ -513,7 +521,7 @@ AlignmentQuality evaluate_alignment(const PreparedGrid& a, const PreparedGrid& b
   q.contradicted = t.contradicted;
   q.score = t.matched - options.contradiction_weight * t.contradicted;
   q.agreement = t.matched + t.contradicted > 0 ? double(t.matched) / double(t.matched + t.contradicted) : 0.0;
-  q.open_space_walls = largest_group(t.open_space);
+  std::tie(q.open_space_walls, q.open_space_at) = largest_group(t.open_space);
   if (options.shape) {
     std::vector<Line> lines;
     const std::vector<int> left = beyond_lines(t.structure_positions, 4, 2.0, &lines, t.structure_normals,

@@ -73,6 +73,7 @@ struct AlignmentQuality {
   // far from the jambs; two copies of a repeated place laid on each other can put one map's end
   // wall across the other's corridor.
   int open_space_walls = 0;
+  Eigen::Vector2d open_space_at = Eigen::Vector2d::Zero();  // the mean of that group, in a's cells
   // Smallest eigenvalue of the information the matched walls give about (tx, ty, theta * radius):
   // how many wall cells' worth pin the weakest direction down. A straight wall alone, or one
   // round obstacle, leaves a direction free and gives ~0.

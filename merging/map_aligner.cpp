@@ -18,6 +18,12 @@ class KnownFramesAligner final : public MapAligner {
   FrameAlignment align(const AlignmentRequest&) const override { return {}; }
 };
 
+// Robots that never bring another's map into their own: each explores and maps alone.
+class NoAligner final : public MapAligner {
+ public:
+  FrameAlignment align(const AlignmentRequest&) const override { return {}; }
+};
+
 // D'Alfonso et al., §3.2: both robots see each other and send each other their pose and
 // their reading of the other (5 numbers each).
 class RendezvousAligner final : public MapAligner {
@@ -66,6 +72,7 @@ class OverlapAligner final : public MapAligner {
 class LandmarkAligner final : public MapAligner {
  public:
   bool costly() const override { return true; }
+  bool needs_landmark_estimates() const override { return true; }
   FrameAlignment align(const AlignmentRequest& q) const override {
     FrameAlignment out;
     const auto to_map = [](const std::vector<localization::Landmark>& landmarks) {
@@ -113,6 +120,10 @@ core::Registry<MapAlignerFactory>& map_aligner_registry() {
   static const bool built_in = [] {
     auto& r = registry;
     r.add("known", "every robot knows its start in one shared frame; maps simply add up", make<KnownFramesAligner>());
+    r.add("none",
+          "every robot maps alone in its own frame and never takes another's map (its map is written as robot_<k>.yaml: "
+          "merge them afterwards with fleetmap merge)",
+          make<NoAligner>());
     r.add("rendezvous",
           "robots that detect each other compute each other's frame from the detection (D'Alfonso et al., §3.2)",
           make<RendezvousAligner>());

@@ -2,6 +2,7 @@
 // How a robot brings a teammate's map into its own map frame before they share maps: the
 // simulator's `merging:` modes, one interface for every way of finding the transform.
 //   known       every robot knows its start in one shared frame: nothing to align;
+//   none        every robot maps alone in its own frame and never takes another's map;
 //   rendezvous  both robots detect each other and exchange poses and readings (D'Alfonso et al.
 //               2013, §3.2);
 //   overlap     the two occupancy grids are searched for their best overlap (merge.h, the
@@ -60,12 +61,15 @@ class MapAligner {
   virtual bool costly() const { return false; }
   // The sender's whole map goes along with the attempt (the simulator counts the bytes).
   virtual bool sends_map() const { return false; }
+  // True when the aligner works on the robots' estimated landmarks (AlignmentRequest's
+  // *_landmarks), so that the robots' localizer must estimate some.
+  virtual bool needs_landmark_estimates() const { return false; }
   virtual FrameAlignment align(const AlignmentRequest& request) const = 0;
 };
 
 using MapAlignerFactory = std::function<std::unique_ptr<MapAligner>()>;
 
-// The built-in aligners (known, rendezvous, overlap, landmarks) and any registered since.
+// The built-in aligners (known, none, rendezvous, overlap, landmarks) and any registered since.
 core::Registry<MapAlignerFactory>& map_aligner_registry();
 // Adds an aligner under `name` (Error if the name is taken or unusable).
 void register_map_aligner(std::string name, std::string help, MapAlignerFactory make);

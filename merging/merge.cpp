@@ -526,8 +526,9 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
     const double constraint = best_q.constraint;
     const auto [refusal, why] = [&]() -> std::pair<Refusal, const char*> {
       if (open_space_factor < 0.5 && open_space_factor <= wall_agreement)
-        return {Refusal::WallsCross, "a wall of one map stands in the other's open space, where it saw a room or "
-                                     "corridor (two copies of a repeated place laid on each other)"};
+        return {Refusal::WallsCross, "a wall of one map stands in the other's open space, where that one saw a room or "
+                                     "corridor (a wall drawn or moved there, or two copies of a repeated place laid on "
+                                     "each other)"};
       if (agree_factor < 0.5) return {Refusal::WallsCross, "the walls of one map cross the other's free space"};
       if (acceptance_factor < 0.5)
         return {Refusal::CellsDisagree, "the maps disagree on the cells they share (free in one, occupied in the other)"};
@@ -640,6 +641,7 @@ MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b) {
   result.transform = move(result.transform);
   if (result.alternative) result.alternative = move(*result.alternative);
   result.quality.overlap_centre += oa;
+  result.quality.open_space_at += oa;
   return result;
 }
 

@@ -17,6 +17,7 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
   out.confidence.assign(std::size_t(n), 0.0);
   out.method.assign(std::size_t(n), "");
   out.reason.assign(std::size_t(n), "");
+  out.reason_pair.assign(std::size_t(n), -1);
   if (n == 0) return out;
   // Each map cut and prepared once, when a pair of one resolution first needs it (a pair of two
   // resolutions aligns resampled copies instead).
@@ -92,6 +93,7 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
         if (closest == nullptr || p.result.confidence > closest->result.confidence) closest = &p;
       }
     }
+    if (closest != nullptr) out.reason_pair[std::size_t(i)] = int(closest - out.pairs.data());
     out.reason[std::size_t(i)] = closest != nullptr && !closest->result.reason.empty()
                                      ? closest->result.reason
                                      : "no reliable overlap with any map linked to the first";

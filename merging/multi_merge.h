@@ -30,6 +30,7 @@ struct MultiMergeResult {
   std::vector<double> confidence;   // of the pair that placed input i (1 for the first, 0 if not placed)
   std::vector<std::string> method;  // method of that pair
   std::vector<std::string> reason;  // why input i was not placed; empty when placed
+  std::vector<int> reason_pair;     // the index in `pairs` of the refusal that gave the reason; -1 for none
   std::vector<PairAlignment> pairs; // every pairwise result
   // Reliable pairs outside the tree check it: the largest gap, at the overlap centre, between the
   // pair's own transform and the one the tree implies (cells). 0 without such pairs.

@@ -83,15 +83,40 @@ std::vector<core::Pose2> place_robots(const Scenario& s, const World& world, cor
     if (!cell) throw InputError("robots.cluster_at " + point_text(centre) + " is outside the map (" + extent_text(g) + ")");
     if (world.blocked(*cell)) throw InputError("robots.cluster_at " + point_text(centre) + " is inside a wall");
   }
+  const ReachableRegions regions = world.reachable_regions(r);
+  if (regions.largest < 0) {
+    throw InputError(fmt::format("robots: a robot of radius {:.2f} m fits nowhere on the map: no free place is {:.2f} m wide",
+                                 r, 2.0 * r));
+  }
+  // Every robot starts in one region: the one of the free cells around cluster_at when the user
+  // chose it (the region nearest to it), else the largest, so that the team can meet and has the
+  // most to explore wherever the map's centre happens to fall.
   const double separation = std::max(s.min_separation_m, 2.0 * r + 0.05);
   const double need = r + 0.05;
-  std::vector<Cell> candidates;
-  if (s.placement == Placement::Cluster) {
-    candidates = free_cells_from(world, centre, std::size_t(-1) / 2);
-  } else {
-    candidates = free_cells_from(world, centre, std::size_t(-1) / 2);
-    std::shuffle(candidates.begin(), candidates.end(), rng.engine());
+  std::vector<Cell> candidates = free_cells_from(world, centre, std::size_t(-1) / 2);
+  int region = regions.largest;
+  if (s.cluster_at) {
+    for (const Cell& c : candidates) {
+      if (const int l = regions.at(g.index(c)); l >= 0) {
+        region = l;
+        break;
+      }
+    }
   }
+  const auto in_region = [&](const Cell& c) { return regions.at(g.index(c)) == region; };
+  if (std::none_of(candidates.begin(), candidates.end(), in_region)) {
+    // The free space around the point does not lead into the region: start from its cell nearest the point.
+    Cell nearest{0, 0};
+    double best = INFINITY;
+    for (int i = 0; i < g.cell_count(); ++i) {
+      if (regions.at(i) != region) continue;
+      const double d = (g.cell_center(g.cell_of_index(i)) - centre).squaredNorm();
+      if (d < best) best = d, nearest = g.cell_of_index(i);
+    }
+    candidates = free_cells_from(world, g.cell_center(nearest), std::size_t(-1) / 2);
+  }
+  if (s.placement == Placement::Random) std::shuffle(candidates.begin(), candidates.end(), rng.engine());
+  std::erase_if(candidates, [&](const Cell& c) { return !in_region(c); });
   std::vector<core::Pose2> starts;
   for (const Cell& c : candidates) {
     if (int(starts.size()) == s.robot_count) break;

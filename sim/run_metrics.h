@@ -19,6 +19,11 @@ struct RunTotals {
 
 RunTotals run_totals(const RunResult& result);
 
+// Why a run's coverage may mislead, in one line, or "" when it need not: the robots start outside
+// the largest region a robot can reach, in several regions, or can observe less than half of the
+// map's free space (a start in a pocket explores the pocket "completely").
+std::string reachable_space_warning(const RunResult& result);
+
 // The text of metrics.json as `fleetmap explore` writes it (indented JSON), for programs that link
 // fleetmap; `map_label` is the map's name in it.
 std::string metrics_json_text(const RunResult& result, const std::string& map_label);

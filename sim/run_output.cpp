@@ -186,7 +186,11 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
                 {"free_m2", double(sp.free_cells) * sp.cell_area_m2},
                 {"pose_cells", sp.pose_cells},
                 {"unreachable_observable_m2", double(sp.unreachable_cells) * sp.cell_area_m2},
-                {"seen_unreachable_m2", double(sp.seen_unreachable.size()) * sp.cell_area_m2}};
+                {"seen_unreachable_m2", double(sp.seen_unreachable.size()) * sp.cell_area_m2},
+                {"largest_region_pose_cells", sp.largest_region_pose_cells},
+                {"start_regions", sp.start_regions},
+                {"observable_share_of_free", sp.free_cells > 0 ? double(sp.observable_cells) / double(sp.free_cells) : 0.0}};
+  if (const std::string warning = reachable_space_warning(r); !warning.empty()) j["space"]["warning"] = warning;
   j["unexplored"] = unexplored_json(r);
   j["landmarks"] = r.landmarks.size();
   j["map_quality"] = map_quality_json(r.map_quality);

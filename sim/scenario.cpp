@@ -11,6 +11,7 @@
 #include "core/format.h"
 #include "core/angle.h"
 #include "core/error.h"
+#include "core/suggest.h"
 #include "io/file_io.h"
 #include "io/map_io.h"
 #include "io/yaml_reader.h"
@@ -101,7 +102,9 @@ void read_robots(io::YamlMap& top, Scenario& s) {
     s.robot_count = int(top.number("robots", 4, limits::kRobots));
   } else {
     auto robots = top.map("robots");
-    const bool has_count = robots.has("count"), has_random = robots.has("random"), has_starts = robots.has("starts");
+    // node() marks a key as known, so that a message about an unknown key lists all three.
+    const bool has_count = robots.node("count").has_value(), has_random = robots.node("random").has_value(),
+               has_starts = robots.node("starts").has_value();
     if (int(has_count) + int(has_random) + int(has_starts) > 1) {
       throw InputError(robots.where(has_starts ? "starts" : "random") +
                        ": give only one of 'count' (a cluster), 'random: N' or 'starts'");
@@ -309,7 +312,8 @@ void validate_scenario(const Scenario& s) {
   check("map_resolution", s.map_resolution_m, io::kResolutionRange);
   const auto check_name = [](const std::string& key, const std::string& value, const std::vector<std::string>& valid) {
     if (std::find(valid.begin(), valid.end(), value) != valid.end()) return;
-    throw InputError(key + ": unknown value '" + value + "' (valid: " + core::join(valid) + ")");
+    throw InputError(key + ": unknown value '" + value + "'" + core::did_you_mean(value, valid) + " (valid: " +
+                     core::join(valid) + ")");
   };
   check_name("exploration.strategy", s.exploration.strategy, exploration::strategy_names());
   check_name("localization", s.localization, localization::localizer_names());
@@ -326,8 +330,30 @@ void validate_scenario(const Scenario& s) {
                      "or choose a localizer that needs none (odometry, scan-matching, rbpf, mcl, polynomial)");
   }
   check_name("merging", s.merging, merging_names());
+  if (merging::make_map_aligner(s.merging)->needs_landmark_estimates()) {
+    bool estimates = true;  // a localizer that cannot be made without a run is checked by the simulator
+    try {
+      estimates = localization::make_localizer(s.localization, {})->estimates_landmarks();
+    } catch (const std::exception&) {
+    }
+    if (!estimates) throw InputError(landmark_merging_problem(s));
+  }
   check_name("merging.method", s.merge_method, merging::merge_method_names());
   check_name("exploration.path_planner", s.path_planner, path_planner_names());
+}
+
+std::string landmark_merging_problem(const Scenario& s) {
+  std::vector<std::string> able;
+  for (const auto& name : localization::localizer_names()) {
+    try {
+      if (localization::make_localizer(name, {})->estimates_landmarks()) able.push_back(name);
+    } catch (const std::exception&) {
+      // A localizer that cannot be made without a run is not one to suggest.
+    }
+  }
+  return "merging '" + s.merging + "' aligns the robots' estimated landmark maps, and localization '" + s.localization +
+         "' estimates no landmarks: choose one that does (" + core::join(able) +
+         ", with landmarks: --landmarks 0.5) or a merging that needs none (overlap, rendezvous)";
 }
 
 std::string map_source(const Scenario& s) {

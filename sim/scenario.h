@@ -124,7 +124,12 @@ std::string map_source(const Scenario& scenario);
 // file finds its map from wherever it is run.
 std::string scenario_to_yaml(const Scenario& scenario, const std::filesystem::path& file_dir = {});
 
-// Checks values that need no map (counts, ranges, noise, names). Throws InputError naming the key.
+// Checks values that need no map (counts, ranges, noise, names, a merging whose needs the
+// localizer meets). Throws InputError naming the key.
 void validate_scenario(const Scenario& scenario);
+
+// The message for a merging that aligns estimated landmarks (MapAligner::needs_landmark_estimates)
+// with a localizer that estimates none, naming the localizers that do.
+std::string landmark_merging_problem(const Scenario& scenario);
 
 }  // namespace fleetmap::sim

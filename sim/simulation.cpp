@@ -159,6 +159,9 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, S
     robot.localizer = make ? make(context) : localization::make_localizer(scenario_.localization, context);
     robot.map = mapping::OccupancyGrid(frame_geometry_[std::size_t(robot.frame)]);
   }
+  if (aligner_->needs_landmark_estimates() && !robots_.front().localizer->estimates_landmarks()) {
+    throw InputError(landmark_merging_problem(scenario_));
+  }
   if (scenario_.path_planner != "wave") {
     planning::PlanPathOptions plan;
     plan.planner = scenario_.path_planner;

@@ -68,6 +68,8 @@ struct CoverageSpace {
   std::int64_t unreachable_cells = 0;  // observable, but outside every reachable pose's disc
   std::int64_t pose_cells = 0;         // cells where a robot's centre can be
   std::int64_t free_cells = 0;         // every free cell of the true map
+  std::int64_t largest_region_pose_cells = 0;  // poses of the largest region a robot can reach, wherever it starts
+  int start_regions = 0;               // the regions the robots start in (more than one: some never meet)
   double cell_area_m2 = 0.0;
   std::vector<int> seen_unreachable;   // cell indices: the unreachable cells the merged map observed
 };

@@ -78,6 +78,8 @@ RunResult Simulation::result() const {
   r.space.unreachable_cells = std::int64_t(observable_.unreachable.size());
   r.space.pose_cells = observable_.poses;
   r.space.free_cells = observable_.free_cells;
+  r.space.largest_region_pose_cells = observable_.largest_region_poses;
+  r.space.start_regions = observable_.start_regions;
   r.space.cell_area_m2 = observable_.cell_area_m2;
   for (int idx : observable_.unreachable)
     if (merged_.log_odds_at(idx) != 0.0f) r.space.seen_unreachable.push_back(idx);

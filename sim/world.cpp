@@ -52,6 +52,49 @@ bool World::disc_free(const Eigen::Vector2d& p, double radius_m) const {
   return clearance(p, radius_m + 1e-9) > radius_m;
 }
 
+namespace {
+
+// The 4-connected components of the cells flagged in `fits` (w x h, row-major).
+ReachableRegions label_regions(const std::vector<std::uint8_t>& fits, int w, int h) {
+  const std::size_t n = fits.size();
+  ReachableRegions out;
+  out.label.assign(n, -1);
+  std::vector<int> stack;
+  for (std::size_t seed = 0; seed < n; ++seed) {
+    if (!fits[seed] || out.label[seed] >= 0) continue;
+    const int region = int(out.cells.size());
+    std::int64_t size = 0;
+    out.label[seed] = region;
+    stack.push_back(int(seed));
+    while (!stack.empty()) {
+      const int i = stack.back();
+      stack.pop_back();
+      ++size;
+      const int x = i % w, y = i / w;
+      for (const auto& [nx, ny] : {std::pair{x + 1, y}, {x - 1, y}, {x, y + 1}, {x, y - 1}}) {
+        if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+        const std::size_t j = std::size_t(ny) * std::size_t(w) + std::size_t(nx);
+        if (!fits[j] || out.label[j] >= 0) continue;
+        out.label[j] = region;
+        stack.push_back(int(j));
+      }
+    }
+    out.cells.push_back(size);
+    if (out.largest < 0 || size > out.cells[std::size_t(out.largest)]) out.largest = region;
+  }
+  return out;
+}
+
+}  // namespace
+
+ReachableRegions World::reachable_regions(double robot_radius_m) const {
+  const auto& g = geometry();
+  const std::size_t n = std::size_t(g.cell_count());
+  std::vector<std::uint8_t> blocking(n);
+  for (std::size_t i = 0; i < n; ++i) blocking[i] = truth_.state_at(int(i)) != mapping::CellState::Free;
+  return label_regions(exploration::fitting_cells(g, blocking, robot_radius_m), g.width(), g.height());
+}
+
 ObservableSpace World::observable_space(const std::vector<Eigen::Vector2d>& starts, double robot_radius_m,
                                        double sensor_range_m) const {
   const auto& g = geometry();
@@ -66,6 +109,8 @@ ObservableSpace World::observable_space(const std::vector<Eigen::Vector2d>& star
     out.free_cells += !blocking[i];
   }
   const std::vector<std::uint8_t> fits = exploration::fitting_cells(g, blocking, robot_radius_m);
+  const ReachableRegions regions = label_regions(fits, w, h);
+  if (regions.largest >= 0) out.largest_region_poses = regions.cells[std::size_t(regions.largest)];
 
   // Poses: from the fitting cell nearest to each start (a start need not be a cell centre), through
   // 4-connected fitting cells.
@@ -109,6 +154,12 @@ ObservableSpace World::observable_space(const std::vector<Eigen::Vector2d>& star
       }
     }
   };
+  {
+    std::vector<int> start_regions;
+    for (int i : stack) start_regions.push_back(regions.at(i));
+    std::sort(start_regions.begin(), start_regions.end());
+    out.start_regions = int(std::unique(start_regions.begin(), start_regions.end()) - start_regions.begin());
+  }
   flood(pose, [&](int j) { return fits[std::size_t(j)] != 0; });
   std::vector<int> boundary;  // poses beside a cell that is not one
   for (int i = 0; i < int(n); ++i) {

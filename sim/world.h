@@ -23,7 +23,22 @@ struct ObservableSpace {
   std::vector<int> unreachable;  // the observable cells no robot's body can cover (outside every pose's disc)
   std::int64_t poses = 0;        // cells where a robot's centre can be
   std::int64_t free_cells = 0;   // every free cell of the map
+  // Poses in the largest region a robot of this radius can reach (ReachableRegions), wherever the
+  // starts are: `poses` below it means the robots start outside it.
+  std::int64_t largest_region_poses = 0;
+  int start_regions = 0;         // the regions the starts lie in: robots of two never meet
   double cell_area_m2 = 0.0;
+};
+
+// The places a robot's centre can be, split into the regions it can drive between: 4-connected
+// components of the cells where it fits (exploration::fitting_cells on the true map, as
+// ObservableSpace's poses are found).
+struct ReachableRegions {
+  std::vector<int> label;            // per cell: -1 where the robot does not fit, else its region
+  std::vector<std::int64_t> cells;   // the size of each region, in cells
+  int largest = -1;                  // the region with the most cells; -1 when the robot fits nowhere
+
+  int at(int cell_index) const { return label[std::size_t(cell_index)]; }
 };
 
 class World {
@@ -40,6 +55,9 @@ class World {
   double clearance(const Eigen::Vector2d& p, double horizon_m) const;
   // A disc of radius r at p touches no blocked cell and lies inside the map.
   bool disc_free(const Eigen::Vector2d& p, double radius_m) const;
+
+  // Where a robot of radius `robot_radius_m` can be, region by region.
+  ReachableRegions reachable_regions(double robot_radius_m) const;
 
   // The space exploration is measured on, for robots of radius `robot_radius_m` with a range sensor
   // of `sensor_range_m` starting at `starts` (see ObservableSpace). The one definition behind

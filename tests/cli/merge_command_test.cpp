@@ -257,7 +257,7 @@ TEST(MergeCommand, HelpStatesTheConventionAndEveryFlagWithItsDefault) {
   ASSERT_EQ(r.exit_code, 0);
   for (const char* part : {"R(theta) (u, v) + (tx, ty)", "u = column", "row from the top", "--method",
                            "=auto", "--out", "=merged.png", "--json", "default: none", "--min-confidence", "=0.5",
-                           "--seed", "--resolution", "=0.05", "overlap:", "features:", "auto:", "merged: false"}) {
+                           "--seed", "--resolution", "else 0.05", "overlap:", "features:", "auto:", "merged: false"}) {
     EXPECT_NE(r.out.find(part), std::string::npos) << part;
   }
 }

@@ -247,28 +247,31 @@ TEST(MapIo, ScaleModeKeepsProbabilitiesAndAlphaMeansUnknown) {
   EXPECT_FLOAT_EQ(ga.log_odds({1, 0}), 0.0f);
 }
 
-// Every grey value, opaque or not, as map_server reads it (scale mode: between the thresholds the
-// probability is kept, unless the pixel is transparent).
-TEST(MapIo, EveryGreyValueOpaqueOrNotAsMapServer) {
+// Every grey value, as map_server reads it: map_server's rules for opaque pixels and partly transparent ones (between the thresholds: unknown
+// in scale mode); a pixel less than half opaque is unknown whatever its colour (a transparent
+// background was never drawn on).
+TEST(MapIo, EveryGreyValueOpaquePartlyTransparentOrTransparent) {
   MapYaml meta;
   meta.mode = MapMode::Scale;
-  cv::Mat rgba(2, 256, CV_8UC4);
+  cv::Mat rgba(3, 256, CV_8UC4);
   for (int v = 0; v < 256; ++v) {
     rgba.at<cv::Vec4b>(0, v) = {std::uint8_t(v), std::uint8_t(v), std::uint8_t(v), 255};
-    rgba.at<cv::Vec4b>(1, v) = {std::uint8_t(v), std::uint8_t(v), std::uint8_t(v), 0};
+    rgba.at<cv::Vec4b>(1, v) = {std::uint8_t(v), std::uint8_t(v), std::uint8_t(v), 200};
+    rgba.at<cv::Vec4b>(2, v) = {std::uint8_t(v), std::uint8_t(v), std::uint8_t(v), 0};
   }
   const auto g = grid_from_image(rgba, meta);
   for (int v = 0; v < 256; ++v) {
     const double occ = (255.0 - v) / 255.0;
+    EXPECT_EQ(g.log_odds({v, 0}), 0.0f) << v;  // image row 2, transparent: unknown
     for (const bool opaque : {true, false}) {
-      const float l = g.log_odds({v, opaque ? 1 : 0});  // image row 0 is the map's top row
+      const float l = g.log_odds({v, opaque ? 2 : 1});  // image row 0 is the map's top row
       if (occ > meta.occupied_thresh) EXPECT_EQ(l, g.max_log_odds()) << v;
       else if (occ < meta.free_thresh) EXPECT_EQ(l, g.min_log_odds()) << v;
       else if (!opaque) EXPECT_EQ(l, 0.0f) << v;
       else {
         // Clamped as every update is (the grid's bounds keep it able to change).
         const double p = (1.0 + 98.0 * (occ - meta.free_thresh) / (meta.occupied_thresh - meta.free_thresh)) / 100.0;
-        EXPECT_NEAR(g.probability({v, 1}), std::clamp(p, g.options().min_probability, g.options().max_probability), 1e-6) << v;
+        EXPECT_NEAR(g.probability({v, 2}), std::clamp(p, g.options().min_probability, g.options().max_probability), 1e-6) << v;
       }
     }
   }
