@@ -188,11 +188,20 @@ def save_map(map: Map, path: PathLike) -> None:
 
 
 def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1) -> MergeResult:
-    """Aligns map b to map a. The result's `transform` (tx, ty, theta) takes b's cells into a's
-    cells; `confidence` is in [0, 1] and `merged` says whether it reached `min_confidence`.
-    Maps of two resolutions (robots mapping at 0.05 and 0.1 m) are aligned as `fleetmap merge`
-    aligns them, through the coarser map's cells; `transform` then takes the cells of b seen
-    through a's cells (`b.resampled(a.resolution)`) into a's cells."""
+    """Aligns map b to map a as `fleetmap merge a b` does (maps of two resolutions too).
+
+    The result's `transform` (tx, ty, theta) takes b's map frame into a's, in metres and degrees: a
+    point p of b (metres, in the frame b's origin defines; a bare image's lower-left corner is
+    (0, 0)) lies at R(theta) p + (tx, ty) in a's, R(theta) = [[cos, -sin], [sin, cos]] - the
+    numbers `fleetmap merge` prints and writes as tx_m, ty_m, theta_deg. `pixel_transform` is the
+    same in pixels (tx_px, ty_px, theta_px_deg, with `scale`). `confidence` is in [0, 1] and
+    `merged` says whether it reached `min_confidence`. `map` is the fused map (in a's frame and
+    resolution, what `fleetmap merge a b --out merged.yaml` writes), for plan_path; None when not
+    merged."""
+    for name, value in (("a", a), ("b", b)):
+        if not isinstance(value, Map):
+            raise InputError(f"merge_maps: {name} must be a fleetmap.Map (load_map, Map.from_image), "
+                             f"got {type(value).__name__}")
     return _fleetmap._merge_maps(a, b, method, min_confidence, seed)
 
 
@@ -201,6 +210,9 @@ def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: 
     """Plans a path for a round robot from `start` to `goal` (x, y in metres) on `map`, unknown
     cells counting as obstacles. `planner` is one of planner_names(). The result's `path` is an
     (N, 2) array of waypoints; `status` says why there is none."""
+    if not isinstance(map, Map):
+        got = "None (a merge_maps result that did not merge has no map)" if map is None else type(map).__name__
+        raise InputError(f"plan_path: map must be a fleetmap.Map, got {got}")
     return _fleetmap._plan_path(map, (float(start[0]), float(start[1])), (float(goal[0]), float(goal[1])),
                                 planner, float(robot_radius), float(time_budget), int(seed))
 
