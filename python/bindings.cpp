@@ -30,7 +30,9 @@
 #include "sim/run_output.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"
+#include "io/file_io.h"
 #include "sweep/sweep.h"
+#include "sweep/sweep_report.h"
 #include "sweep/sweep_results.h"
 #include "sweep/sweep_runner.h"
 
@@ -162,29 +164,66 @@ Run explore(const std::string& yaml, const std::string& source, const std::strin
 }
 
 // A sweep's rows as results.csv has them: the header, then one line per run, in the sweep's order.
+// With `out`, the folder `fleetmap bench --out` writes too (results.csv, the reports, sweep.yaml and
+// scenario.yaml): new, empty, or written before by a sweep, whose files it replaces.
 std::vector<std::string> run_sweep(const std::string& yaml, const std::string& source, const std::string& base_dir,
-                                   int jobs) {
+                                   int jobs, const std::string& out) {
   const sweep::Sweep spec = sweep::parse_sweep(yaml, source, base_dir);
   sweep::SweepMaps truths;
+  std::vector<std::string> labels;
+  std::vector<fs::path> inputs;
+  if (io::is_regular_file(source)) inputs.push_back(source);
   for (const auto& m : spec.maps) {
     io::MapLoadOptions load;
     load.default_resolution = spec.base.map_resolution_m;
-    truths.emplace(sweep::map_label(m), maps::load_map_source(m, load));
+    labels.push_back(sweep::map_label(m));
+    truths.emplace(labels.back(), maps::load_map_source(m, load));
+    for (auto& file : maps::map_source_files(m)) inputs.push_back(std::move(file));
   }
   sweep::check_placements(spec, truths);
   const auto runs = sweep::sweep_runs(spec);
+  std::optional<io::OutputFolder> folder;
+  if (!out.empty()) {
+    folder.emplace(out, "bench", sweep::sweep_folder_files(labels, spec.base.html_replay ? runs : std::vector<sweep::SweepRun>{}),
+                   inputs, "out " + out);
+    folder->claim();
+  }
   std::vector<sweep::RunRecord> records;
   std::mutex mutex;
   sweep::SweepRunOptions run_options;
   run_options.jobs = jobs;
+  run_options.replay_dir = out;
   sweep::run_sweep(spec, runs, truths, run_options, [&](const sweep::RunRecord& r) {
     const std::lock_guard<std::mutex> lock(mutex);
     records.push_back(r);
   });
   sweep::sort_records(records, runs);
+  if (folder) {
+    auto written = sweep::write_sweep_definition(out, spec);
+    sweep::write_results(fs::path(out) / "results.csv", records);
+    written.push_back(fs::path(out) / "results.csv");
+    for (auto& p : sweep::write_sweep_reports(out, records)) written.push_back(std::move(p));
+    for (const auto& r : runs) {
+      const fs::path replay = fs::path(out) / sweep::replay_file_name(sweep::run_key(r));
+      if (spec.base.html_replay && io::is_regular_file(replay)) written.push_back(replay);
+    }
+    folder->finish(io::OutputFolder::names(written));
+  }
   std::vector<std::string> lines{sweep::results_header()};
   for (const auto& r : records) lines.push_back(sweep::format_record(r));
   return lines;
+}
+
+// Writes rows given as the text of each results.csv column (sweep()'s rows turned back into text)
+// as `fleetmap bench` writes results.csv: each row read as bench reads one, so a wrong value is
+// refused with the row and the column, then written in bench's own formats.
+void write_results(const std::vector<std::string>& lines, const std::string& path) {
+  std::vector<sweep::RunRecord> records;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    records.push_back(sweep::parse_record(lines[i], fmt::format("save_results: rows[{}]", i)));
+  }
+  io::check_output_file(path, {}, "save_results");
+  sweep::write_results(path, records);
 }
 
 // What a Python strategy gets besides the arrays (its assign's optional fifth argument): the
@@ -443,8 +482,10 @@ PYBIND11_MODULE(_fleetmap, m) {
           py::arg("folder"));
   m.def("_explore", &explore, py::arg("yaml"), py::arg("source"), py::arg("base_dir"),
         py::call_guard<py::gil_scoped_release>());
-  m.def("_sweep", &run_sweep, py::arg("yaml"), py::arg("source"), py::arg("base_dir"), py::arg("jobs"),
+  m.def("_sweep", &run_sweep, py::arg("yaml"), py::arg("source"), py::arg("base_dir"), py::arg("jobs"), py::arg("out"),
         py::call_guard<py::gil_scoped_release>());
+  m.def("_results_header", &sweep::results_header);
+  m.def("_write_results", &write_results, py::arg("lines"), py::arg("path"));
 
   py::class_<PairMerge>(m, "MergeResult", "Map b aligned to map a, as `fleetmap merge a b` aligns them.")
       .def_property_readonly("merged", of_result(&merging::MergeResult::merged),

@@ -19,7 +19,7 @@ import json
 import math
 import os
 from pathlib import Path
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
 try:
     import numpy as np
@@ -47,7 +47,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
 
 __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
-    "explore", "sweep", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
+    "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
     "map_names", "strategy_names", "planner_names", "merge_method_names",
 ]
 
@@ -168,18 +168,51 @@ def _number(text: str) -> Any:
     return {"true": True, "false": False}.get(text, text)
 
 
-def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, **keys: Any) -> list:
+def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, out: Optional[PathLike] = None,
+          **keys: Any) -> list:
     """Runs a benchmark sweep (every map x strategy x team size x seed) and returns its rows.
 
     `spec` is a sweep dict or sweep YAML file (keys as `fleetmap bench --sweep`: maps, strategies,
     robots, seeds, steps, comm_range, vary, ...); keyword arguments add keys. Returns one dict per
     run with the columns of bench's results.csv (numbers as int/float, empty cells as None), in the
-    sweep's order. `jobs` runs that many simulations at once.
+    sweep's order. `jobs` runs that many simulations at once. With `out`, also writes the folder
+    `fleetmap bench --out` writes (results.csv, summary.csv, summary.md, the plots, report.html,
+    sweep.yaml, scenario.yaml), which `fleetmap bench --compare A B out` and `--combine out ...`
+    read; the folder must be new, empty, or written before by a sweep (its files are replaced).
     """
     text, source, base = _spec_text(spec, keys, "sweep")
-    lines = _fleetmap._sweep(text, source, base, int(jobs))
+    lines = _fleetmap._sweep(text, source, base, int(jobs), "" if out is None else str(out))
     rows = csv.DictReader(io.StringIO("\n".join(lines) + "\n"))
     return [{k: v if k in _TEXT_COLUMNS else _number(v) for k, v in row.items()} for row in rows]
+
+
+def _cell_text(value: Any) -> str:
+    """A value of a sweep row as results.csv spells it before bench formats it."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    return str(value)
+
+
+def save_results(rows: Iterable[Mapping[str, Any]], path: PathLike) -> None:
+    """Writes rows of sweep() (any of them, of one sweep or several) as results.csv, in exactly the
+    columns and formats `fleetmap bench` writes, so that `fleetmap bench --compare A B FOLDER` and
+    `--combine FOLDER ... --out DIR` (summary, plots, report.html) read them. A row without a
+    column, or with a value bench would not read, raises InputError naming the row and column."""
+    columns = _fleetmap._results_header().split(",")
+    lines = []
+    for i, row in enumerate(rows):
+        missing = [c for c in columns if c not in row]
+        if missing:
+            raise InputError(f"save_results: rows[{i}]: no column '{missing[0]}' (a row of fleetmap.sweep() has "
+                             f"every column of results.csv)")
+        lines.append(",".join(_cell_text(row[c]) for c in columns))
+    _fleetmap._write_results(lines, str(path))
 
 
 def save_map(map: Map, path: PathLike) -> None:

@@ -1,6 +1,6 @@
 # Type hints of the package `fleetmap` (the Python half in __init__.py, the C++ half in _fleetmap).
 import os
-from typing import Any, Mapping, Optional, Protocol, Sequence, Tuple, Union
+from typing import Any, Iterable, Mapping, Optional, Protocol, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -137,7 +137,11 @@ class StrategyWithContext(Protocol):
                context: AssignmentContext) -> Sequence[int]: ...
 
 def explore(scenario: Union[None, Mapping[str, Any], PathLike] = None, **keys: Any) -> ExplorationResult: ...
-def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, **keys: Any) -> list[dict[str, Any]]: ...
+def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, out: Optional[PathLike] = None,
+          **keys: Any) -> list[dict[str, Any]]:
+    """The rows of results.csv, one dict per run; with `out`, also the folder `fleetmap bench --out` writes."""
+def save_results(rows: Iterable[Mapping[str, Any]], path: PathLike) -> None:
+    """Writes sweep rows as `fleetmap bench` writes results.csv (the columns and formats every bench verb reads)."""
 def load_map(source: str, resolution: float = 0.05) -> Map:
     """A built-in map by name (map_names()) or a PNG/PGM/map_server YAML file."""
 def save_map(map: Map, path: PathLike) -> None: ...
