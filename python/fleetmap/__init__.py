@@ -18,16 +18,26 @@ import io
 import json
 import math
 import os
+import sys
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
+
+_here = Path(__file__).resolve().parent
+if not (_here / "_built_for.py").is_file():
+    # This is the source folder python/fleetmap, found before the built package because python runs
+    # inside python/: the built package further along sys.path serves it, or one line says what to do.
+    _built = next((d for d in (Path(p or os.getcwd()).resolve() / "fleetmap" for p in sys.path)
+                   if (d / "_built_for.py").is_file()), None)
+    if _built is None:
+        raise ImportError(f"{_here} is fleetmap's source folder, not the package the build makes: set "
+                          f"PYTHONPATH=<build folder>/python (e.g. PYTHONPATH=build/python from the repository)")
+    __path__[:] = [str(_built)]
 
 try:
     import numpy as np
 
     from . import _fleetmap
 except ImportError as error:  # another python than the one it was built for, or no numpy
-    import sys
-
     from ._built_for import PYTHON, VERSION
     raise ImportError(f"fleetmap was built for {PYTHON} (Python {VERSION}, with numpy); this is {sys.executable} "
                       f"(Python {sys.version_info.major}.{sys.version_info.minor}): {error}") from error
