@@ -73,21 +73,18 @@ fs::path results_of(const std::string& dir, const std::string& flag) {
   return d / "results.csv";
 }
 
-// The sweep a results folder was made by (its sweep.yaml), if it has one that still loads.
+// The sweep a results folder was made by (its sweep.yaml), if it has one that loads here. One that
+// does not (a strategy registered by the program that ran it, e.g. in Python; a map file moved
+// since) is named in a note on stderr, and the results combine without it.
 std::optional<sweep::Sweep> sweep_of(const fs::path& dir) {
   if (!io::is_regular_file(dir / "sweep.yaml")) return std::nullopt;
-  return sweep::load_sweep(dir / "sweep.yaml");
-}
-
-// The two files that define a sweep in its results folder.
-std::pair<std::string, std::string> sweep_files(const fs::path& out, const sweep::Sweep& sweep) {
-  return {sweep::sweep_to_yaml(sweep, "scenario.yaml"), sim::scenario_to_yaml(sweep.base, out)};
-}
-
-void write_sweep_files(const fs::path& out, const sweep::Sweep& sweep) {
-  const auto [sweep_yaml, scenario_yaml] = sweep_files(out, sweep);
-  io::write_file_atomic(out / "scenario.yaml", scenario_yaml);
-  io::write_file_atomic(out / "sweep.yaml", sweep_yaml);
+  try {
+    return sweep::load_sweep(dir / "sweep.yaml");
+  } catch (const InputError& e) {
+    fmt::print(stderr, "fleetmap: note: {}; combining without it (runs in key order, missing runs not counted)\n",
+               e.what());
+    return std::nullopt;
+  }
 }
 
 // The first line where two texts differ, for messages: "seeds: 6" against "seeds: 4".
@@ -108,7 +105,7 @@ std::pair<std::string, std::string> first_difference(const std::string& a, const
 void check_same_sweep(const fs::path& out, const sweep::Sweep& sweep, const std::vector<sweep::SweepRun>& runs,
                       const std::vector<sweep::RunRecord>& records) {
   const std::string where = "--out " + out.string() + ": ";
-  const auto [sweep_yaml, scenario_yaml] = sweep_files(out, sweep);
+  const auto [sweep_yaml, scenario_yaml] = sweep::sweep_definition(out, sweep);
   for (const auto& [name, now] : {std::pair{std::string("sweep.yaml"), sweep_yaml}, std::pair{std::string("scenario.yaml"), scenario_yaml}}) {
     if (!io::is_regular_file(out / name)) {
       throw InputError(where + "holds results.csv but no " + name + ", so its sweep is unknown; choose another --out");
@@ -128,23 +125,6 @@ void check_same_sweep(const fs::path& out, const sweep::Sweep& sweep, const std:
     throw InputError(where + "holds a run that is not part of this sweep" + std::string(runs.size() < sweep::sweep_runs(sweep).size() ? " (shard)" : "") +
                      " (" + sweep::run_key_text(r.key) + "); resume only with the same sweep and shard, or choose another --out");
   }
-}
-
-// The files a bench folder holds for these maps.
-std::vector<std::string> bench_files(const std::vector<std::string>& map_labels,
-                                     const std::vector<sweep::SweepRun>& replayed = {}) {
-  std::vector<std::string> files = {"results.csv", "summary.csv", "summary.md", "report.html", "sweep.yaml", "scenario.yaml"};
-  for (const auto& r : replayed) files.push_back(sweep::replay_file_name(sweep::run_key(r)));
-  std::vector<std::string> plots = {"efficiency"};
-  for (const auto& m : map_labels) {
-    plots.push_back("coverage_" + m);
-    plots.push_back("time_" + m);
-  }
-  for (const auto& p : plots) {
-    files.push_back(p + ".png");
-    files.push_back(p + ".svg");
-  }
-  return files;
 }
 
 void print_outputs(const fs::path& out, const std::vector<fs::path>& reports) {
@@ -206,7 +186,7 @@ int run_combine(const BenchFlags& f) {
   for (const auto& r : records) {
     if (std::find(labels.begin(), labels.end(), r.key.map) == labels.end()) labels.push_back(r.key.map);
   }
-  io::OutputFolder folder(out, "bench", bench_files(labels), inputs, "--out " + out.string());
+  io::OutputFolder folder(out, "bench", sweep::sweep_folder_files(labels), inputs, "--out " + out.string());
   folder.claim();
   std::vector<fs::path> written;
   std::size_t expected = 0;
@@ -214,8 +194,7 @@ int run_combine(const BenchFlags& f) {
     const auto runs = sweep::sweep_runs(*sweep);
     expected = runs.size();
     sweep::sort_records(records, runs);
-    write_sweep_files(out, *sweep);
-    written = {out / "sweep.yaml", out / "scenario.yaml"};
+    written = sweep::write_sweep_definition(out, *sweep);
   } else {
     sweep::sort_records(records, {});
   }
@@ -256,7 +235,7 @@ int run_bench(const BenchFlags& f) {
     labels.push_back(sweep::map_label(source));
     for (auto& file : maps::map_source_files(source)) inputs.push_back(std::move(file));
   }
-  io::OutputFolder folder(out, "bench", bench_files(labels, sweep.base.html_replay ? runs : std::vector<sweep::SweepRun>{}),
+  io::OutputFolder folder(out, "bench", sweep::sweep_folder_files(labels, sweep.base.html_replay ? runs : std::vector<sweep::SweepRun>{}),
                           inputs, "--out " + out.string());
 
   sweep::SweepMaps maps;
@@ -293,7 +272,7 @@ int run_bench(const BenchFlags& f) {
     }
   }
   folder.claim();
-  write_sweep_files(out, sweep);
+  sweep::write_sweep_definition(out, sweep);
 
   const auto t0 = std::chrono::steady_clock::now();
   {

@@ -1,9 +1,10 @@
 // `fleetmap merge`: several robots' map images become one, with each input's transform into the
-// first input's pixel grid, a confidence, and a picture.
+// first input's map frame (metres and degrees; pixels besides), a confidence, and a picture.
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -35,9 +36,12 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kConvention =
-    "pixel (u, v) of an input (u = column, v = row from the top) lies at scale R(theta) (u, v) + (tx, ty) in the "
-    "first input's pixel grid, R(theta) = [[cos, -sin], [sin, cos]], scale = the input's metres per cell / the first's "
-    "(1 for maps of one resolution)";
+    "a point p (metres) of an input's map frame lies at R(theta) p + (tx_m, ty_m) in the first input's map frame, "
+    "R(theta) = [[cos, -sin], [sin, cos]], theta in degrees counter-clockwise; a map frame is the one its map_server "
+    "YAML's origin defines (a bare image's lower-left corner is (0, 0))";
+constexpr const char* kPixelConvention =
+    "pixel (u, v) of an input (u = column, v = row from the top) lies at scale R(theta_px) (u, v) + (tx_px, ty_px) in "
+    "the first input's pixel grid, scale = the input's metres per cell / the first's (1 for maps of one resolution)";
 
 // A map file with no map_server YAML: its resolution is not its own.
 bool is_bare_image(const std::string& source) {
@@ -58,37 +62,18 @@ struct MergeCommandOptions {
   bool resolution_given = false;  // --resolution was on the command line
 };
 
-// An input's place in the first input's pixel grid, as the convention states it: its pixel p lies at
-// scale R(theta) p + t.
-struct PixelPlacement {
-  core::Transform2 rigid;  // R(theta) and t
-  double scale = 1.0;
-};
-
-// `cells` takes the cells of `merged` (the input seen through the first input's cells: `original`
-// itself, or resampled when its resolution differs; merging::merge_maps gives its transforms so)
-// into the first input's cells. A pixel (u, v) of `original` is the cell (u, H - 1 - v), whose
-// centre lies s (u, H - 1 - v) + c (1, 1) in `merged`'s cells (same origin; s = its cell size / the
-// first's, c = (s - 1) / 2), which is the pixel s (u, v) + o of `merged`; the rigid placement of
-// `merged`'s pixels then gives s R p + (R o + t).
-PixelPlacement to_first_pixels(const core::Transform2& cells, const mapping::OccupancyGrid& first,
-                               const mapping::OccupancyGrid& merged, const mapping::OccupancyGrid& original) {
-  const core::Transform2 rigid = merging::flip_rows(cells, first.height(), merged.height());
-  const double s = original.resolution() / merged.resolution();
-  const double c = (s - 1.0) / 2.0;
-  const Eigen::Vector2d o(c, merged.height() - 1.0 - s * (original.height() - 1.0) - c);
-  return {core::Transform2(rigid.rotation_matrix() * o + rigid.translation(), rigid.rotation()), s};
-}
-
-nlohmann::json transform_json(const std::string& map, const PixelPlacement& pixels, const merging::MergeResult& pair,
+nlohmann::json transform_json(const std::string& map, const merging::Placement& place, const merging::MergeResult& pair,
                               double confidence, const std::string& method, const std::string& via) {
   nlohmann::json j;
   j["map"] = map;
   j["merged"] = true;
-  j["tx"] = pixels.rigid.translation().x();
-  j["ty"] = pixels.rigid.translation().y();
-  j["theta_deg"] = core::rad2deg(pixels.rigid.rotation());
-  j["scale"] = pixels.scale;
+  j["tx_m"] = place.metres.translation().x();
+  j["ty_m"] = place.metres.translation().y();
+  j["theta_deg"] = core::rad2deg(place.metres.rotation());
+  j["tx_px"] = place.pixels.translation().x();
+  j["ty_px"] = place.pixels.translation().y();
+  j["theta_px_deg"] = core::rad2deg(place.pixels.rotation());
+  j["scale"] = place.scale;
   j["acceptance"] = pair.acceptance;
   j["confidence"] = confidence;
   j["method"] = method;
@@ -96,11 +81,15 @@ nlohmann::json transform_json(const std::string& map, const PixelPlacement& pixe
   return j;
 }
 
-// The fused map in map colours: free cells tinted by the inputs that saw them, occupied cells
-// black (walls dark and clear), cells where inputs disagree in red.
+// The fused map in map colours: free cells in the tint of the one input that saw them, or white
+// when several did; occupied cells black (walls dark and clear), cells where inputs disagree in red.
 uchar free_tint(double channel) { return cv::saturate_cast<uchar>(255 * 0.7 + channel * 0.3); }
 
 viz::Color free_tint(const viz::Color& c) { return {free_tint(c.r), free_tint(c.g), free_tint(c.b)}; }
+
+constexpr viz::Color kSharedFree{255, 255, 255}, kUnknown{205, 205, 205}, kOccupied{0, 0, 0}, kConflict{214, 39, 40};
+
+cv::Vec3b bgr(const viz::Color& c) { return {c.b, c.g, c.r}; }
 
 cv::Mat tinted(const merging::FusedMap& fused) {
   const auto& g = fused.grid;
@@ -110,25 +99,17 @@ cv::Mat tinted(const merging::FusedMap& fused) {
     for (int x = 0; x < g.width(); ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(g.width()) + std::size_t(x);
       const auto state = g.state({x, y});
-      if (state == mapping::CellState::Unknown) {
-        row[x] = cv::Vec3b(205, 205, 205);
-        continue;
-      }
-      cv::Vec3d tint(0, 0, 0);
-      int n = 0;
-      for (std::size_t k = 0; k < fused.inputs.size() && k < 32; ++k) {
-        if (!(fused.sources[i] & (1u << k))) continue;
-        const viz::Color c = viz::palette_color(fused.inputs[k]);
-        tint += cv::Vec3d(c.b, c.g, c.r);
-        ++n;
-      }
-      if (n > 0) tint /= n;
-      if (state == mapping::CellState::Free) {
-        row[x] = cv::Vec3b(free_tint(tint[0]), free_tint(tint[1]), free_tint(tint[2]));
+      if (fused.conflicts[i]) {
+        row[x] = bgr(kConflict);
+      } else if (state == mapping::CellState::Unknown) {
+        row[x] = bgr(kUnknown);
+      } else if (state == mapping::CellState::Occupied) {
+        row[x] = bgr(kOccupied);
       } else {
-        row[x] = cv::Vec3b(0, 0, 0);
+        const std::uint32_t bits = fused.sources[i];
+        const bool one = bits != 0 && (bits & (bits - 1)) == 0;
+        row[x] = one ? bgr(free_tint(viz::palette_color(fused.inputs[std::size_t(std::countr_zero(bits))]))) : bgr(kSharedFree);
       }
-      if (fused.conflicts[i]) row[x] = cv::Vec3b(40, 39, 214);
     }
   }
   return img;
@@ -136,15 +117,18 @@ cv::Mat tinted(const merging::FusedMap& fused) {
 
 cv::Mat picture(const merging::FusedMap& fused, const std::vector<std::string>& names) {
   viz::Overlays overlays;
+  viz::RenderOptions render;
+  render.map_legend = {{viz::LegendItem::Swatch, kUnknown, "unknown"},
+                       {viz::LegendItem::Swatch, kSharedFree, "free in several maps"},
+                       {viz::LegendItem::Swatch, kOccupied, "occupied"}};
   for (int input : fused.inputs) {
     overlays.legend.push_back({viz::LegendItem::Swatch, free_tint(viz::palette_color(input)),
                                std::to_string(input + 1) + ": " + fs::path(names[std::size_t(input)]).filename().string()});
   }
-  if (fused.conflict_cells > 0) overlays.legend.push_back({viz::LegendItem::Swatch, {214, 39, 40}, "free vs occupied"});
-  viz::RenderOptions render;
+  if (fused.conflict_cells > 0) overlays.legend.push_back({viz::LegendItem::Swatch, kConflict, "free vs occupied"});
   render.title = "merged: " + std::to_string(fused.inputs.size()) + " of " + std::to_string(names.size()) + " maps";
-  // The known cells and half a metre around them: a small map gives a small picture.
-  render.crop_margin_m = 0.5;
+  // The known cells and the margin of the map file: a small map gives a small picture.
+  render.crop_margin_m = merging::kMergedMarginM;
   return viz::decorate(tinted(fused), fused.grid.geometry(), overlays, render);
 }
 
@@ -204,31 +188,27 @@ int run_merge(const MergeCommandOptions& o) {
   }
   for (const auto& m : o.maps) print_map_notes(m, load, o.resolution_given, source);  // the inputs are good
   const double r0 = originals.front().resolution();
-  std::vector<mapping::OccupancyGrid> resampled;  // the maps of other resolutions in the first's cells
-  resampled.reserve(originals.size());
-  std::vector<const mapping::OccupancyGrid*> pointers, fused_grids;
+  bool resolutions_differ = false;
+  std::vector<const mapping::OccupancyGrid*> pointers;
   for (std::size_t i = 0; i < originals.size(); ++i) {
     const auto& g = originals[i];
     pointers.push_back(&g);
-    if (g.resolution() == r0) {
-      fused_grids.push_back(&g);
-      continue;
-    }
+    if (g.resolution() == r0) continue;
+    resolutions_differ = true;
     const double count = mapping::resampled_cell_count(g, r0);
     if (count > double(load.max_cells)) {
       throw InputError(fmt::format("{}: its {} m cells seen through {}'s {} m cells would make {:.0f} cells, over the "
                                    "limit of {}; give a map of coarser cells first",
                                    o.maps[i], g.resolution(), o.maps.front(), r0, count, load.max_cells));
     }
-    resampled.push_back(mapping::resample(g, r0));
-    fused_grids.push_back(&resampled.back());
   }
 
   merging::MergeOptions options;
   options.method = o.method;
   options.min_confidence = o.min_confidence;
   options.seed = o.seed;
-  const merging::MultiMergeResult merged = merging::merge_maps(pointers, options);
+  const merging::MergedMaps result = merging::merge_and_fuse(pointers, options);
+  const merging::MultiMergeResult& merged = result.merge;
 
   // The pair that placed each input, for its acceptance.
   const auto pair_of = [&](int i, int parent) -> const merging::MergeResult& {
@@ -239,18 +219,19 @@ int run_merge(const MergeCommandOptions& o) {
   };
   nlohmann::json j;
   j["convention"] = kConvention;
+  j["pixel_convention"] = kPixelConvention;
   j["reference"] = o.maps.front();
   j["method"] = o.method;
   j["transforms"] = nlohmann::json::array();
   int placed = 1;
   fmt::print(report, "{}: the reference (first input)\n", o.maps.front());
-  if (!resampled.empty()) {
+  if (resolutions_differ) {
     fmt::print(report, "maps of different resolutions: each pair aligned through the coarser one's cells, fused in {}'s {} m cells\n",
                o.maps.front(), r0);
   }
   for (std::size_t i = 1; i < originals.size(); ++i) {
     const auto& name = o.maps[i];
-    if (!merged.to_first[i]) {
+    if (!result.placements[i]) {
       nlohmann::json t;
       t["map"] = name;
       t["merged"] = false;
@@ -278,25 +259,26 @@ int run_merge(const MergeCommandOptions& o) {
       continue;
     }
     ++placed;
-    const PixelPlacement pixels = to_first_pixels(*merged.to_first[i], originals.front(), *fused_grids[i], originals[i]);
+    const merging::Placement& place = *result.placements[i];
     const int parent = merged.parent[i];
     const auto& pair = pair_of(int(i), parent);
-    j["transforms"].push_back(transform_json(name, pixels, pair, merged.confidence[i], merged.method[i],
+    j["transforms"].push_back(transform_json(name, place, pair, merged.confidence[i], merged.method[i],
                                              o.maps[std::size_t(parent)]));
-    const std::string scale = pixels.scale == 1.0 ? "" : fmt::format(", scale {:.4g}", pixels.scale);
-    fmt::print(report, "{}: tx {:.2f} ty {:.2f} px, theta {:.3f} deg{}, acceptance {:.3f}, confidence {:.2f} ({}, via {})\n",
-               name, pixels.rigid.translation().x(), pixels.rigid.translation().y(),
-               core::rad2deg(pixels.rigid.rotation()), scale, pair.acceptance, merged.confidence[i], merged.method[i],
+    const std::string scale = place.scale == 1.0 ? "" : fmt::format(", scale {:.4g}", place.scale);
+    fmt::print(report,
+               "{}: tx {:.3f} ty {:.3f} m, theta {:.3f} deg (pixels: tx {:.2f} ty {:.2f}, theta {:.3f} deg{}), "
+               "acceptance {:.3f}, confidence {:.2f} ({}, via {})\n",
+               name, place.metres.translation().x(), place.metres.translation().y(),
+               core::rad2deg(place.metres.rotation()), place.pixels.translation().x(), place.pixels.translation().y(),
+               core::rad2deg(place.pixels.rotation()), scale, pair.acceptance, merged.confidence[i], merged.method[i],
                o.maps[std::size_t(parent)]);
   }
   j["merged_maps"] = placed;
   j["max_loop_gap_px"] = merged.max_loop_gap;
-
-  const merging::FusedMap fused = merging::fuse_merged(fused_grids, merged);
-  j["conflict_cells"] = fused.conflict_cells;
+  j["conflict_cells"] = result.fused.conflict_cells;
   if (!o.json.empty()) write_output(o.json, j.dump(2) + "\n");
-  if (out_is_map) io::save_map(fused.grid, o.out);
-  if (!picture_path.empty()) write_picture(picture_path, picture(fused, o.maps));
+  if (out_is_map) io::save_map(result.map, o.out);
+  if (!picture_path.empty()) write_picture(picture_path, picture(result.fused, o.maps));
   for (const auto& out : outputs) {
     if (!out.path.empty() && !io::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
   }
@@ -312,20 +294,23 @@ int run_merge(const MergeCommandOptions& o) {
 
 Command add_merge_command(CLI::App& root) {
   CLI::App* merge = root.add_subcommand("merge", "Merge map images of several robots into one map");
-  merge->footer(std::string("Convention: ") + kConvention +
+  merge->footer(std::string("Transforms: ") + kConvention + ". Pixels, for images: " + kPixelConvention +
                 ".\n\nMethods:\n" + merging::merge_method_help() +
                 "\nEvery answer has a confidence in [0, 1]; below --min-confidence a map is not merged (\"no reliable\n"
                 "overlap\"): a wrong merge is worse than none. More than two maps: every pair is aligned, and the most\n"
                 "confident pairs chain each map to the first.\n"
                 "Maps of different resolutions are aligned pair by pair through the coarser one's cells and fused in\n"
                 "the first's.\n"
-                "--json holds `transforms`: per input after the first, map, merged, tx, ty (pixels), theta_deg,\n"
-                "scale, acceptance, confidence, method, via (the input it was aligned to); or merged: false and the\n"
-                "reason.\n"
-                "The picture tints each input's free cells in its own colour, walls black; red cells are free in one\n"
-                "map, occupied in another; it holds the known cells and half a metre around them, with metre axes. A map file (--out merged.yaml) holds the fused map as map_server writes maps (0 occupied,\n"
-                "254 free, 205 unknown), with the first map's resolution and origin: `fleetmap plan --map merged.yaml`\n"
-                "plans on it in the first robot's metres. Exit codes: 0 all merged, 1 some map not merged, 2 bad input.");
+                "--json holds `transforms`: per input after the first, map, merged, tx_m, ty_m, theta_deg (metres and\n"
+                "degrees), tx_px, ty_px, theta_px_deg, scale (pixels), acceptance, confidence, method, via (the input it\n"
+                "was aligned to); or merged: false and the reason.\n"
+                "The picture shows free cells in the tint of the one input that saw them, or white when several did;\n"
+                "walls black, unknown grey; red cells are free in one map, occupied in another; it holds the known cells\n"
+                "and half a metre around them, with metre axes. A map file (--out merged.yaml) holds the fused map as\n"
+                "map_server writes maps (0 occupied, 254 free, 205 unknown) in the first map's frame and resolution, cut\n"
+                "to the known cells and half a metre around them (its origin says where): `fleetmap plan --map\n"
+                "merged.yaml` plans on it in the first robot's metres. Exit codes: 0 all merged, 1 some map not merged,\n"
+                "2 bad input.");
   auto o = std::make_shared<MergeCommandOptions>();
   merge->add_option("maps", o->maps, "Two or more maps: PNG/PGM images or map_server YAML files (the first is the reference)")
       ->required();

@@ -143,12 +143,19 @@ double resampled_cell_count(const OccupancyGrid& grid, double resolution) {
   return resampled_count(grid.width(), ratio) * resampled_count(grid.height(), ratio);
 }
 
-OccupancyGrid resample(const OccupancyGrid& grid, double resolution) {
+GridGeometry resampled_geometry(const GridGeometry& geometry, double resolution) {
   check_resolution(resolution);
+  const double ratio = resolution / geometry.resolution();
+  return GridGeometry(resolution, int(resampled_count(geometry.width(), ratio)),
+                      int(resampled_count(geometry.height(), ratio)), geometry.origin());
+}
+
+OccupancyGrid resample(const OccupancyGrid& grid, double resolution) {
+  const GridGeometry geometry = resampled_geometry(grid.geometry(), resolution);
   const double ratio = resolution / grid.resolution();
   const int w = grid.width(), h = grid.height();
-  const int nw = int(resampled_count(w, ratio)), nh = int(resampled_count(h, ratio));
-  OccupancyGrid out(GridGeometry(resolution, nw, nh, grid.geometry().origin()), grid.options());
+  const int nw = geometry.width(), nh = geometry.height();
+  OccupancyGrid out(geometry, grid.options());
   if (w == 0 || h == 0) return out;
   const float occupied = float(probability_to_log_odds(grid.options().occupied_threshold));
   const float free = float(probability_to_log_odds(grid.options().free_threshold));
@@ -198,6 +205,30 @@ OccupancyGrid pool(const OccupancyGrid& grid, double resolution, const core::Tra
     for (int x = 0; x < width; ++x) {
       const float v = cells[std::size_t(y) * std::size_t(width) + std::size_t(x)].log_odds(occupied);
       if (v != 0.0f) out.set_log_odds({x, y}, v);
+    }
+  }
+  return out;
+}
+
+OccupancyGrid crop_to_known(const OccupancyGrid& grid, int margin) {
+  int x0 = grid.width(), y0 = grid.height(), x1 = -1, y1 = -1;
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      if (grid.state_at(y * grid.width() + x) == CellState::Unknown) continue;
+      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+  }
+  if (x1 < 0) return grid;
+  x0 = std::max(0, x0 - margin), y0 = std::max(0, y0 - margin);
+  x1 = std::min(grid.width() - 1, x1 + margin), y1 = std::min(grid.height() - 1, y1 + margin);
+  const double res = grid.resolution();
+  const core::Pose2 origin = grid.geometry().origin().compose(core::Pose2(x0 * res, y0 * res, 0.0));
+  OccupancyGrid out(GridGeometry(res, x1 - x0 + 1, y1 - y0 + 1, origin), grid.options());
+  const std::vector<float>& from = grid.log_odds_data();
+  for (int y = y0; y <= y1; ++y) {
+    const float* row = from.data() + std::size_t(y) * std::size_t(grid.width());
+    for (int x = x0; x <= x1; ++x) {
+      if (row[x] != 0.0f) out.set_log_odds({x - x0, y - y0}, row[x]);
     }
   }
   return out;

@@ -134,6 +134,14 @@ OccupancyGrid resample(const OccupancyGrid& grid, double resolution);
 // The cells resample(grid, resolution) would hold (width x height, as a double: it may exceed any
 // int), to refuse one too large before making it. Throws as resample.
 double resampled_cell_count(const OccupancyGrid& grid, double resolution);
+// The geometry of resample(grid, resolution): the same origin, the extent rounded up to whole cells.
+// Throws as resample.
+GridGeometry resampled_geometry(const GridGeometry& geometry, double resolution);
+
+// The grid cut to the box of its known (Free or Occupied) cells grown by `margin` cells on every
+// side (within the grid), at the same place in the world: every cell keeps its world position and
+// state. A grid with no known cell comes back whole.
+OccupancyGrid crop_to_known(const OccupancyGrid& grid, int margin);
 
 // `grid`'s cells pooled into a width x height grid of `resolution` cells (at least grid's) laid
 // anywhere: `place` takes the cells of resample(grid, resolution) (same origin; a cell's centre at

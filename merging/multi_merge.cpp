@@ -1,8 +1,10 @@
 #include "merging/multi_merge.h"
 
+#include <cmath>
 #include <memory>
 
 #include "core/error.h"
+#include "merging/rendezvous.h"
 #include "merging/resolutions.h"
 
 namespace fleetmap::merging {
@@ -123,6 +125,52 @@ FusedMap fuse_merged(const std::vector<const mapping::OccupancyGrid*>& grids, co
   FusedMap fused = fuse_grids(placed, transforms);
   fused.inputs = std::move(inputs);
   return fused;
+}
+
+Placement placement(const core::GridGeometry& first, const core::GridGeometry& input, const core::Transform2& cells) {
+  const core::GridGeometry seen = mapping::resampled_geometry(input, first.resolution());
+  Placement out;
+  out.metres = world_from_cells(first, seen, cells);
+  // A pixel (u, v) of the input is its cell (u, H - 1 - v), whose centre lies s (u, H - 1 - v) + c (1, 1)
+  // in the seen cells (same origin; c = (s - 1) / 2), which is the seen grid's pixel s (u, v) + o;
+  // the rigid placement of the seen grid's pixels then gives s R p + (R o + t).
+  const core::Transform2 rigid = flip_rows(cells, first.height(), seen.height());
+  const double s = input.resolution() / first.resolution(), c = (s - 1.0) / 2.0;
+  const Eigen::Vector2d o(c, seen.height() - 1.0 - s * (input.height() - 1.0) - c);
+  out.pixels = core::Transform2(rigid.rotation_matrix() * o + rigid.translation(), rigid.rotation());
+  out.scale = s;
+  return out;
+}
+
+MergedMaps merge_and_fuse(const std::vector<const mapping::OccupancyGrid*>& grids, const MergeOptions& options,
+                          const std::function<void(int, int)>& progress) {
+  return fuse_placed(grids, merge_maps(grids, options, progress));
+}
+
+MergedMaps fuse_placed(const std::vector<const mapping::OccupancyGrid*>& grids, MultiMergeResult merge) {
+  if (grids.size() != merge.to_first.size()) throw Error("fuse_placed: one merge result per grid expected");
+  MergedMaps out;
+  out.merge = std::move(merge);
+  if (grids.empty()) return out;
+  const mapping::OccupancyGrid& first = *grids.front();
+  // Maps of other resolutions are fused through the first's cells.
+  std::vector<mapping::OccupancyGrid> resampled;
+  resampled.reserve(grids.size());
+  std::vector<const mapping::OccupancyGrid*> in_first_cells;
+  for (std::size_t i = 0; i < grids.size(); ++i) {
+    const mapping::OccupancyGrid& g = *grids[i];
+    out.placements.push_back(out.merge.to_first[i] ? std::optional(placement(first.geometry(), g.geometry(), *out.merge.to_first[i]))
+                                                   : std::nullopt);
+    if (g.resolution() == first.resolution() || !out.merge.to_first[i]) {
+      in_first_cells.push_back(&g);
+      continue;
+    }
+    resampled.push_back(mapping::resample(g, first.resolution()));
+    in_first_cells.push_back(&resampled.back());
+  }
+  out.fused = fuse_merged(in_first_cells, out.merge);
+  out.map = mapping::crop_to_known(out.fused.grid, int(std::ceil(kMergedMarginM / first.resolution())));
+  return out;
 }
 
 }  // namespace fleetmap::merging

@@ -45,4 +45,42 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
 // The fused map of the inputs that were placed (others are left out).
 FusedMap fuse_merged(const std::vector<const mapping::OccupancyGrid*>& grids, const MultiMergeResult& merged);
 
+// Where an input lies in the first input's frame, in the two forms `fleetmap merge` and Python's
+// merge_maps report.
+struct Placement {
+  // The input's map frame into the first's, in metres (a frame as its map_server origin defines it;
+  // a bare image's has the lower-left corner at (0, 0)): p_first = R(theta) p + t.
+  core::Transform2 metres;
+  // Pixel (u, v) of the input (u = column, v = row from the top) lies at
+  // scale R(theta) (u, v) + t in the first input's pixel grid.
+  core::Transform2 pixels;
+  double scale = 1.0;  // the input's metres per cell / the first's
+};
+
+// The placement of an input whose cells seen through the first's cells (mapping::resample(input,
+// first.resolution()), the input's own cells at one resolution) `cells` takes into the first's
+// cells, as MultiMergeResult::to_first and its pairs' transforms do.
+Placement placement(const core::GridGeometry& first, const core::GridGeometry& input, const core::Transform2& cells);
+
+// The margin kept around the known cells of a merged map (metres): what `fleetmap merge --out
+// merged.yaml` writes and its picture shows.
+inline constexpr double kMergedMarginM = 0.5;
+
+// Maps merged and fused as `fleetmap merge` and Python's merge_maps do it.
+struct MergedMaps {
+  MultiMergeResult merge;
+  std::vector<std::optional<Placement>> placements;  // per input; nullopt when not placed
+  // The placed inputs fused in the first's cells (maps of other resolutions resampled to them).
+  FusedMap fused;
+  // fused.grid cut to its known cells and kMergedMarginM around them, at the same place in the world.
+  mapping::OccupancyGrid map;
+};
+
+// Aligns every pair of `grids` (the first is the reference; any resolutions), places them, and
+// fuses the placed ones. Throws as merge_maps.
+MergedMaps merge_and_fuse(const std::vector<const mapping::OccupancyGrid*>& grids, const MergeOptions& options = {},
+                          const std::function<void(int, int)>& progress = {});
+// The same from merge_maps(grids)'s result.
+MergedMaps fuse_placed(const std::vector<const mapping::OccupancyGrid*>& grids, MultiMergeResult merge);
+
 }  // namespace fleetmap::merging

@@ -11,10 +11,12 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "core/angle.h"
 #include "core/error.h"
 #include "core/memory.h"
 #include "exploration/strategy.h"
@@ -28,7 +30,9 @@
 #include "sim/run_output.h"
 #include "sim/scenario.h"
 #include "sim/simulation.h"
+#include "io/file_io.h"
 #include "sweep/sweep.h"
+#include "sweep/sweep_report.h"
 #include "sweep/sweep_results.h"
 #include "sweep/sweep_runner.h"
 
@@ -86,6 +90,61 @@ mapping::OccupancyGrid grid_from_array(const py::array_t<std::uint8_t, py::array
   return io::grid_from_map_image(image, meta);
 }
 
+// Refuses a resampling of `grid` to `resolution` over the cells a loaded map may have.
+void check_resampled_size(const mapping::OccupancyGrid& grid, double resolution, const std::string& what) {
+  const double cells = mapping::resampled_cell_count(grid, resolution);
+  if (const auto limit = io::MapLoadOptions{}.max_cells; cells > double(limit)) {
+    throw InputError(fmt::format("{}: {} m cells would make {:.0f} cells, over the limit of {}", what, resolution, cells,
+                                 limit));
+  }
+}
+
+// Two maps aligned as `fleetmap merge` aligns them; the fused map is made when first asked for (a
+// script that merges in a loop for the transforms does not pay for it).
+class PairMerge {
+ public:
+  PairMerge(py::object a, py::object b, const merging::MergeOptions& options)
+      : a_(std::move(a)), b_(std::move(b)) {
+    const auto grids = this->grids();
+    {
+      py::gil_scoped_release release;
+      merge_ = merging::merge_maps(grids, options);
+    }
+    const auto& pair = result();
+    placement_ = merging::placement(grids[0]->geometry(), grids[1]->geometry(), pair.transform);
+  }
+  const merging::MergeResult& result() const { return merge_.pairs.front().result; }
+  const merging::Placement& placement() const { return placement_; }
+  std::optional<mapping::OccupancyGrid> map() {
+    if (!merge_.to_first[1]) return std::nullopt;
+    if (!map_) {
+      const auto grids = this->grids();
+      py::gil_scoped_release release;
+      map_ = merging::fuse_placed(grids, merge_).map;
+    }
+    return map_;
+  }
+
+ private:
+  std::vector<const mapping::OccupancyGrid*> grids() const {
+    return {&a_.cast<const mapping::OccupancyGrid&>(), &b_.cast<const mapping::OccupancyGrid&>()};
+  }
+  py::object a_, b_;  // held, so that the maps outlive the result that fuses them
+  merging::MultiMergeResult merge_;
+  merging::Placement placement_;
+  std::optional<mapping::OccupancyGrid> map_;
+};
+
+// A getter of a PairMerge's field of its pair's result.
+template <typename T>
+auto of_result(T merging::MergeResult::*field) {
+  return [field](const PairMerge& r) { return r.result().*field; };
+}
+
+py::tuple transform_tuple(const core::Transform2& t) {
+  return py::make_tuple(t.translation().x(), t.translation().y(), core::rad2deg(t.rotation()));
+}
+
 // A finished exploration run and the label its map goes by.
 struct Run {
   sim::RunResult result;
@@ -105,29 +164,66 @@ Run explore(const std::string& yaml, const std::string& source, const std::strin
 }
 
 // A sweep's rows as results.csv has them: the header, then one line per run, in the sweep's order.
+// With `out`, the folder `fleetmap bench --out` writes too (results.csv, the reports, sweep.yaml and
+// scenario.yaml): new, empty, or written before by a sweep, whose files it replaces.
 std::vector<std::string> run_sweep(const std::string& yaml, const std::string& source, const std::string& base_dir,
-                                   int jobs) {
+                                   int jobs, const std::string& out) {
   const sweep::Sweep spec = sweep::parse_sweep(yaml, source, base_dir);
   sweep::SweepMaps truths;
+  std::vector<std::string> labels;
+  std::vector<fs::path> inputs;
+  if (io::is_regular_file(source)) inputs.push_back(source);
   for (const auto& m : spec.maps) {
     io::MapLoadOptions load;
     load.default_resolution = spec.base.map_resolution_m;
-    truths.emplace(sweep::map_label(m), maps::load_map_source(m, load));
+    labels.push_back(sweep::map_label(m));
+    truths.emplace(labels.back(), maps::load_map_source(m, load));
+    for (auto& file : maps::map_source_files(m)) inputs.push_back(std::move(file));
   }
   sweep::check_placements(spec, truths);
   const auto runs = sweep::sweep_runs(spec);
+  std::optional<io::OutputFolder> folder;
+  if (!out.empty()) {
+    folder.emplace(out, "bench", sweep::sweep_folder_files(labels, spec.base.html_replay ? runs : std::vector<sweep::SweepRun>{}),
+                   inputs, "out " + out);
+    folder->claim();
+  }
   std::vector<sweep::RunRecord> records;
   std::mutex mutex;
   sweep::SweepRunOptions run_options;
   run_options.jobs = jobs;
+  run_options.replay_dir = out;
   sweep::run_sweep(spec, runs, truths, run_options, [&](const sweep::RunRecord& r) {
     const std::lock_guard<std::mutex> lock(mutex);
     records.push_back(r);
   });
   sweep::sort_records(records, runs);
+  if (folder) {
+    auto written = sweep::write_sweep_definition(out, spec);
+    sweep::write_results(fs::path(out) / "results.csv", records);
+    written.push_back(fs::path(out) / "results.csv");
+    for (auto& p : sweep::write_sweep_reports(out, records)) written.push_back(std::move(p));
+    for (const auto& r : runs) {
+      const fs::path replay = fs::path(out) / sweep::replay_file_name(sweep::run_key(r));
+      if (spec.base.html_replay && io::is_regular_file(replay)) written.push_back(replay);
+    }
+    folder->finish(io::OutputFolder::names(written));
+  }
   std::vector<std::string> lines{sweep::results_header()};
   for (const auto& r : records) lines.push_back(sweep::format_record(r));
   return lines;
+}
+
+// Writes rows given as the text of each results.csv column (sweep()'s rows turned back into text)
+// as `fleetmap bench` writes results.csv: each row read as bench reads one, so a wrong value is
+// refused with the row and the column, then written in bench's own formats.
+void write_results(const std::vector<std::string>& lines, const std::string& path) {
+  std::vector<sweep::RunRecord> records;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    records.push_back(sweep::parse_record(lines[i], fmt::format("save_results: rows[{}]", i)));
+  }
+  io::check_output_file(path, {}, "save_results");
+  sweep::write_results(path, records);
 }
 
 // What a Python strategy gets besides the arrays (its assign's optional fifth argument): the
@@ -326,11 +422,7 @@ PYBIND11_MODULE(_fleetmap, m) {
               throw InputError("resampled: resolution: expected " + core::expected_text(io::kResolutionRange) +
                                " metres per cell");
             }
-            const double cells = mapping::resampled_cell_count(g, resolution);
-            if (const auto limit = io::MapLoadOptions{}.max_cells; cells > double(limit)) {
-              throw InputError(fmt::format("resampled: {} m cells would make {:.0f} cells, over the limit of {}",
-                                           resolution, cells, limit));
-            }
+            check_resampled_size(g, resolution, "resampled");
             return mapping::resample(g, resolution);
           },
           py::arg("resolution"),
@@ -390,42 +482,55 @@ PYBIND11_MODULE(_fleetmap, m) {
           py::arg("folder"));
   m.def("_explore", &explore, py::arg("yaml"), py::arg("source"), py::arg("base_dir"),
         py::call_guard<py::gil_scoped_release>());
-  m.def("_sweep", &run_sweep, py::arg("yaml"), py::arg("source"), py::arg("base_dir"), py::arg("jobs"),
+  m.def("_sweep", &run_sweep, py::arg("yaml"), py::arg("source"), py::arg("base_dir"), py::arg("jobs"), py::arg("out"),
         py::call_guard<py::gil_scoped_release>());
+  m.def("_results_header", &sweep::results_header);
+  m.def("_write_results", &write_results, py::arg("lines"), py::arg("path"));
 
-  py::class_<merging::MergeResult>(m, "MergeResult", "Map b aligned to map a.")
-      .def_readonly("merged", &merging::MergeResult::merged, "Whether the confidence reached min_confidence.")
-      .def_readonly("confidence", &merging::MergeResult::confidence, "In [0, 1].")
-      .def_readonly("acceptance", &merging::MergeResult::acceptance,
-                    "The share of cells known in both maps that agree at `transform` (Birk & Carpin 2006's omega).")
-      .def_readonly("method", &merging::MergeResult::method, "The method whose candidate won; empty when none.")
-      .def_readonly("reason", &merging::MergeResult::reason, "Why not merged; empty when merged.")
+  py::class_<PairMerge>(m, "MergeResult", "Map b aligned to map a, as `fleetmap merge a b` aligns them.")
+      .def_property_readonly("merged", of_result(&merging::MergeResult::merged),
+                             "Whether the confidence reached min_confidence.")
+      .def_property_readonly("confidence", of_result(&merging::MergeResult::confidence), "In [0, 1].")
+      .def_property_readonly("acceptance", of_result(&merging::MergeResult::acceptance),
+                             "The share of cells known in both maps that agree at `transform` (Birk & Carpin "
+                             "2006's omega).")
+      .def_property_readonly("method", of_result(&merging::MergeResult::method),
+                             "The method whose candidate won; empty when none.")
+      .def_property_readonly("reason", of_result(&merging::MergeResult::reason), "Why not merged; empty when merged.")
       .def_property_readonly(
-          "transform",
-          [](const merging::MergeResult& r) {
-            return py::make_tuple(r.transform.translation().x(), r.transform.translation().y(),
-                                  r.transform.rotation());
-          },
-          "(tx, ty, theta): b's cells into a's cells, a = R(theta) b + t (the best candidate even when not merged); "
-          "for maps of two resolutions, b's cells seen through a's (b.resampled(a.resolution)).")
-      .def("__repr__", [](const merging::MergeResult& r) {
-        return std::string("<fleetmap.MergeResult ") + (r.merged ? "merged" : "not merged") +
-               ", confidence " + std::to_string(r.confidence) + ">";
+          "transform", [](const PairMerge& r) { return transform_tuple(r.placement().metres); },
+          "(tx, ty, theta): b's map frame into a's, metres and degrees: a point p of b (metres, in the frame b's "
+          "origin defines; a bare image's lower-left corner is (0, 0)) lies at R(theta) p + (tx, ty) in a's, as "
+          "`fleetmap merge` reports tx_m, ty_m, theta_deg. The best candidate even when not merged.")
+      .def_property_readonly(
+          "pixel_transform", [](const PairMerge& r) { return transform_tuple(r.placement().pixels); },
+          "(tx, ty, theta): pixel (u, v) of b (u = column, v = row from the top) lies at scale R(theta) (u, v) + "
+          "(tx, ty) in a's pixel grid, theta in degrees (`fleetmap merge`'s tx_px, ty_px, theta_px_deg).")
+      .def_property_readonly(
+          "scale", [](const PairMerge& r) { return r.placement().scale; },
+          "b's metres per cell / a's: the scale of pixel_transform.")
+      .def_property_readonly("map", &PairMerge::map,
+                             "The fused map (a Map in a's frame and resolution, cut to the known cells and half a "
+                             "metre around them: what `fleetmap merge a b --out merged.yaml` writes); None when not "
+                             "merged.")
+      .def("__repr__", [](const PairMerge& r) {
+        return std::string("<fleetmap.MergeResult ") + (r.result().merged ? "merged" : "not merged") +
+               ", confidence " + std::to_string(r.result().confidence) + ">";
       });
   m.def(
       "_merge_maps",
-      [](const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& b, const std::string& method,
-         double min_confidence, std::uint64_t seed) {
+      [](const py::object& a, const py::object& b, const std::string& method, double min_confidence,
+         std::uint64_t seed) {
+        const auto& ga = a.cast<const mapping::OccupancyGrid&>();
+        const auto& gb = b.cast<const mapping::OccupancyGrid&>();
+        if (ga.resolution() != gb.resolution()) check_resampled_size(gb, ga.resolution(), "merge_maps: b seen through a's cells");
         merging::MergeOptions options;
         options.method = method;
         options.min_confidence = min_confidence;
         options.seed = seed;
-        // As `fleetmap merge` aligns them (align_maps for one resolution; for two, through the
-        // coarser map's cells, the transform given in a's cells).
-        return merging::merge_maps({&a, &b}, options).pairs.front().result;
+        return PairMerge(a, b, options);
       },
-      py::arg("a"), py::arg("b"), py::arg("method"), py::arg("min_confidence"), py::arg("seed"),
-      py::call_guard<py::gil_scoped_release>());
+      py::arg("a"), py::arg("b"), py::arg("method"), py::arg("min_confidence"), py::arg("seed"));
 
   py::class_<planning::PlanResult>(m, "PlanResult", "A planned path.")
       .def_property_readonly("success", &planning::PlanResult::success, "Whether there is a path.")

@@ -668,4 +668,31 @@ std::vector<fs::path> write_sweep_reports(const fs::path& dir, const std::vector
   return written;
 }
 
+std::pair<std::string, std::string> sweep_definition(const fs::path& dir, const Sweep& sweep) {
+  return {sweep_to_yaml(sweep, "scenario.yaml"), sim::scenario_to_yaml(sweep.base, dir)};
+}
+
+std::vector<fs::path> write_sweep_definition(const fs::path& dir, const Sweep& sweep) {
+  const auto [sweep_yaml, scenario_yaml] = sweep_definition(dir, sweep);
+  io::write_file_atomic(dir / "scenario.yaml", scenario_yaml);
+  io::write_file_atomic(dir / "sweep.yaml", sweep_yaml);
+  return {dir / "sweep.yaml", dir / "scenario.yaml"};
+}
+
+std::vector<std::string> sweep_folder_files(const std::vector<std::string>& map_labels,
+                                            const std::vector<SweepRun>& replayed) {
+  std::vector<std::string> files = {"results.csv", "summary.csv", "summary.md", "report.html", "sweep.yaml", "scenario.yaml"};
+  for (const auto& r : replayed) files.push_back(replay_file_name(run_key(r)));
+  std::vector<std::string> plots = {"efficiency"};
+  for (const auto& m : map_labels) {
+    plots.push_back("coverage_" + m);
+    plots.push_back("time_" + m);
+  }
+  for (const auto& p : plots) {
+    files.push_back(p + ".png");
+    files.push_back(p + ".svg");
+  }
+  return files;
+}
+
 }  // namespace fleetmap::sweep

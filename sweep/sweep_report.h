@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sweep/statistics.h"
@@ -97,5 +98,15 @@ std::string replay_file_name(const RunKey& key);
 // folder holds (replay_file_name).
 std::vector<std::filesystem::path> write_sweep_reports(const std::filesystem::path& dir,
                                                        const std::vector<RunRecord>& records);
+
+// The texts of sweep.yaml and scenario.yaml, which define `sweep` in its output folder `dir` (a
+// folder is resumed only by the sweep whose texts these are).
+std::pair<std::string, std::string> sweep_definition(const std::filesystem::path& dir, const Sweep& sweep);
+// Writes them into `dir`, each atomically; returns their paths.
+std::vector<std::filesystem::path> write_sweep_definition(const std::filesystem::path& dir, const Sweep& sweep);
+// Every file a sweep's output folder may hold: results.csv, the reports for these maps
+// (write_sweep_reports), sweep.yaml and scenario.yaml, and the replays of `replayed`.
+std::vector<std::string> sweep_folder_files(const std::vector<std::string>& map_labels,
+                                            const std::vector<SweepRun>& replayed = {});
 
 }  // namespace fleetmap::sweep

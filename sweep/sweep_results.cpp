@@ -101,7 +101,9 @@ struct FieldReader {
   }
   bool boolean() {
     const std::string& t = text();
-    if (t == "true" || t == "false") return t == "true";
+    // Python's csv module writes its booleans capitalised.
+    if (t == "true" || t == "True") return true;
+    if (t == "false" || t == "False") return false;
     fail("true or false");
   }
   std::vector<std::optional<int>> levels() {
@@ -198,9 +200,27 @@ std::string row_text(const RunRecord& r, bool wall_time) {
   return line;
 }
 
-std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+// Lines may end in CR LF (CSV's own line end, which Python's csv module writes).
+std::string without_cr(std::string line) {
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  return line;
+}
+
+std::string first_line(const std::string& text) { return without_cr(text.substr(0, text.find('\n'))); }
 
 std::string errno_text() { return std::strerror(errno); }
+
+// Where a header differs from results_header(): "column 3 is 'seeds', expected 'seed'".
+std::string header_difference(const std::string& header) {
+  const auto got = split_fields(header);
+  for (std::size_t i = 0; i < columns().size(); ++i) {
+    if (i >= got.size()) return fmt::format("it ends after {} columns, expected {}", got.size(), columns().size());
+    if (got[i] != columns()[i].name) {
+      return fmt::format("column {} is '{}', expected '{}'", i + 1, io::printable(got[i]), columns()[i].name);
+    }
+  }
+  return fmt::format("it has {} columns, expected {}", got.size(), columns().size());
+}
 
 }  // namespace
 
@@ -306,9 +326,9 @@ ResultsTable read_results(const fs::path& path) {
   const std::string text = io::read_file(path);
   ResultsTable table;
   const std::string name = path.string();
-  if (first_line(text) != results_header()) {
-    throw InputError(name + ":1: not a results table of this fleetmap bench (its columns differ: written by another "
-                            "version or another program); use another output folder");
+  if (const std::string header = first_line(text); header != results_header()) {
+    throw InputError(name + ":1: not a results table of this fleetmap bench (" + header_difference(header) +
+                     ": written by another version or another program); use another output folder");
   }
   std::map<RunKey, std::pair<std::size_t, int>> seen;  // key -> (record index, line)
   std::size_t pos = text.find('\n');
@@ -321,7 +341,7 @@ ResultsTable read_results(const fs::path& path) {
       table.partial_last_line = true;  // a row cut short: not a row
       break;
     }
-    const std::string line = text.substr(begin, pos - begin);
+    const std::string line = without_cr(text.substr(begin, pos - begin));
     if (line.empty()) continue;
     const std::string where = name + ":" + std::to_string(line_no);
     RunRecord r = parse_record(line, where);

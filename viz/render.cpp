@@ -145,7 +145,7 @@ namespace {
 // The cells of the box, one pixel each (cells beyond the grid in the "outside" colour), with the
 // overlays' cell layers blended in at one pixel per cell, before scaling, so they stay crisp.
 cv::Mat box_cells(const cv::Mat& base, const core::GridGeometry& geometry, const CellBox& box, const Overlays& overlays,
-                  std::vector<LegendItem>& legend) {
+                  const RenderOptions& options, std::vector<LegendItem>& legend) {
   cv::Mat map(box.height(), box.width(), CV_8UC3, cv::Scalar(kOutside[0], kOutside[1], kOutside[2]));
   const cv::Rect in_grid = cv::Rect(box.x0, box.y0, box.width(), box.height()) & cv::Rect(0, 0, geometry.width(), geometry.height());
   if (in_grid.area() > 0) {
@@ -155,9 +155,10 @@ cv::Mat box_cells(const cv::Mat& base, const core::GridGeometry& geometry, const
     base(src).copyTo(map(dst));
   }
   const bool outside = box.x0 < 0 || box.y0 < 0 || box.x1 > geometry.width() || box.y1 > geometry.height();
-  legend = {{LegendItem::Swatch, {205, 205, 205}, "unknown"},
-            {LegendItem::Swatch, {255, 255, 255}, "free"},
-            {LegendItem::Swatch, {0, 0, 0}, "occupied"}};
+  legend = options.map_legend ? *options.map_legend
+                              : std::vector<LegendItem>{{LegendItem::Swatch, {205, 205, 205}, "unknown"},
+                                                        {LegendItem::Swatch, {255, 255, 255}, "free"},
+                                                        {LegendItem::Swatch, {0, 0, 0}, "occupied"}};
   if (outside) legend.push_back({LegendItem::Swatch, {kOutside[2], kOutside[1], kOutside[0]}, "outside the grid"});
   for (const auto& layer : overlays.cells) {
     const cv::Vec3d c(layer.color.b, layer.color.g, layer.color.r);
@@ -291,7 +292,7 @@ Picture draw_picture(const cv::Mat& base, const core::GridGeometry& geometry, co
   if (longest > options.max_size_px) scale = double(options.max_size_px) / longest;
 
   std::vector<LegendItem> legend;
-  const cv::Mat map = box_cells(base, geometry, box, overlays, legend);
+  const cv::Mat map = box_cells(base, geometry, box, overlays, options, legend);
   cv::Mat img;
   if (scale >= 1.0) cv::resize(map, img, {}, scale, scale, cv::INTER_NEAREST);
   else cv::resize(map, img, {}, scale, scale, cv::INTER_AREA);

@@ -79,6 +79,9 @@ struct RenderOptions {
   // small picture; unset: the whole grid. Either way the picture grows to hold every overlay,
   // e.g. an estimated trajectory that drifted off the grid (drawn over "outside the grid").
   std::optional<double> crop_margin_m;
+  // The legend's rows for the map's own colours, before the overlays'; unset: unknown grey, free
+  // white, occupied black (colorize's colours).
+  std::optional<std::vector<LegendItem>> map_legend;
   // Robot discs are at least this radius, and a fraction of the picture on large maps.
   int min_marker_px = 7;
 };

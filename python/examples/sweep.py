@@ -1,5 +1,7 @@
 #!/usr/bin/env python3
 """A small benchmark sweep: two strategies, two team sizes, three seeds; mean coverage per series.
+Its folder (out/python_sweep) is the one `fleetmap bench` writes: then
+`fleetmap bench --compare coordinated uncoordinated out/python_sweep`.
 
     PYTHONPATH=build/python python3 python/examples/sweep.py [sweep.yaml]
 """
@@ -10,10 +12,10 @@ from collections import defaultdict
 import fleetmap
 
 if len(sys.argv) > 1:
-    rows = fleetmap.sweep(sys.argv[1], jobs=2)
+    rows = fleetmap.sweep(sys.argv[1], jobs=2, out="out/python_sweep")
 else:
     rows = fleetmap.sweep(maps=["office"], strategies=["coordinated", "uncoordinated"], robots="2,4",
-                          seeds=3, steps=300, jobs=2)
+                          seeds=3, steps=300, jobs=2, out="out/python_sweep")
 series = defaultdict(list)
 for row in rows:
     series[(row["map"], row["strategy"], row["robots"])].append(row)

@@ -18,16 +18,26 @@ import io
 import json
 import math
 import os
+import sys
 from pathlib import Path
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Iterable, Mapping, Optional, Sequence, Union
+
+_here = Path(__file__).resolve().parent
+if not (_here / "_built_for.py").is_file():
+    # This is the source folder python/fleetmap, found before the built package because python runs
+    # inside python/: the built package further along sys.path serves it, or one line says what to do.
+    _built = next((d for d in (Path(p or os.getcwd()).resolve() / "fleetmap" for p in sys.path)
+                   if (d / "_built_for.py").is_file()), None)
+    if _built is None:
+        raise ImportError(f"{_here} is fleetmap's source folder, not the package the build makes: set "
+                          f"PYTHONPATH=<build folder>/python (e.g. PYTHONPATH=build/python from the repository)")
+    __path__[:] = [str(_built)]
 
 try:
     import numpy as np
 
     from . import _fleetmap
 except ImportError as error:  # another python than the one it was built for, or no numpy
-    import sys
-
     from ._built_for import PYTHON, VERSION
     raise ImportError(f"fleetmap was built for {PYTHON} (Python {VERSION}, with numpy); this is {sys.executable} "
                       f"(Python {sys.version_info.major}.{sys.version_info.minor}): {error}") from error
@@ -47,7 +57,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
 
 __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
-    "explore", "sweep", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
+    "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
     "map_names", "strategy_names", "planner_names", "merge_method_names",
 ]
 
@@ -168,18 +178,51 @@ def _number(text: str) -> Any:
     return {"true": True, "false": False}.get(text, text)
 
 
-def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, **keys: Any) -> list:
+def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, out: Optional[PathLike] = None,
+          **keys: Any) -> list:
     """Runs a benchmark sweep (every map x strategy x team size x seed) and returns its rows.
 
     `spec` is a sweep dict or sweep YAML file (keys as `fleetmap bench --sweep`: maps, strategies,
     robots, seeds, steps, comm_range, vary, ...); keyword arguments add keys. Returns one dict per
     run with the columns of bench's results.csv (numbers as int/float, empty cells as None), in the
-    sweep's order. `jobs` runs that many simulations at once.
+    sweep's order. `jobs` runs that many simulations at once. With `out`, also writes the folder
+    `fleetmap bench --out` writes (results.csv, summary.csv, summary.md, the plots, report.html,
+    sweep.yaml, scenario.yaml), which `fleetmap bench --compare A B out` and `--combine out ...`
+    read; the folder must be new, empty, or written before by a sweep (its files are replaced).
     """
     text, source, base = _spec_text(spec, keys, "sweep")
-    lines = _fleetmap._sweep(text, source, base, int(jobs))
+    lines = _fleetmap._sweep(text, source, base, int(jobs), "" if out is None else str(out))
     rows = csv.DictReader(io.StringIO("\n".join(lines) + "\n"))
     return [{k: v if k in _TEXT_COLUMNS else _number(v) for k, v in row.items()} for row in rows]
+
+
+def _cell_text(value: Any) -> str:
+    """A value of a sweep row as results.csv spells it before bench formats it."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    return str(value)
+
+
+def save_results(rows: Iterable[Mapping[str, Any]], path: PathLike) -> None:
+    """Writes rows of sweep() (any of them, of one sweep or several) as results.csv, in exactly the
+    columns and formats `fleetmap bench` writes, so that `fleetmap bench --compare A B FOLDER` and
+    `--combine FOLDER ... --out DIR` (summary, plots, report.html) read them. A row without a
+    column, or with a value bench would not read, raises InputError naming the row and column."""
+    columns = _fleetmap._results_header().split(",")
+    lines = []
+    for i, row in enumerate(rows):
+        missing = [c for c in columns if c not in row]
+        if missing:
+            raise InputError(f"save_results: rows[{i}]: no column '{missing[0]}' (a row of fleetmap.sweep() has "
+                             f"every column of results.csv)")
+        lines.append(",".join(_cell_text(row[c]) for c in columns))
+    _fleetmap._write_results(lines, str(path))
 
 
 def save_map(map: Map, path: PathLike) -> None:
@@ -188,11 +231,20 @@ def save_map(map: Map, path: PathLike) -> None:
 
 
 def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1) -> MergeResult:
-    """Aligns map b to map a. The result's `transform` (tx, ty, theta) takes b's cells into a's
-    cells; `confidence` is in [0, 1] and `merged` says whether it reached `min_confidence`.
-    Maps of two resolutions (robots mapping at 0.05 and 0.1 m) are aligned as `fleetmap merge`
-    aligns them, through the coarser map's cells; `transform` then takes the cells of b seen
-    through a's cells (`b.resampled(a.resolution)`) into a's cells."""
+    """Aligns map b to map a as `fleetmap merge a b` does (maps of two resolutions too).
+
+    The result's `transform` (tx, ty, theta) takes b's map frame into a's, in metres and degrees: a
+    point p of b (metres, in the frame b's origin defines; a bare image's lower-left corner is
+    (0, 0)) lies at R(theta) p + (tx, ty) in a's, R(theta) = [[cos, -sin], [sin, cos]] - the
+    numbers `fleetmap merge` prints and writes as tx_m, ty_m, theta_deg. `pixel_transform` is the
+    same in pixels (tx_px, ty_px, theta_px_deg, with `scale`). `confidence` is in [0, 1] and
+    `merged` says whether it reached `min_confidence`. `map` is the fused map (in a's frame and
+    resolution, what `fleetmap merge a b --out merged.yaml` writes), for plan_path; None when not
+    merged."""
+    for name, value in (("a", a), ("b", b)):
+        if not isinstance(value, Map):
+            raise InputError(f"merge_maps: {name} must be a fleetmap.Map (load_map, Map.from_image), "
+                             f"got {type(value).__name__}")
     return _fleetmap._merge_maps(a, b, method, min_confidence, seed)
 
 
@@ -201,6 +253,9 @@ def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: 
     """Plans a path for a round robot from `start` to `goal` (x, y in metres) on `map`, unknown
     cells counting as obstacles. `planner` is one of planner_names(). The result's `path` is an
     (N, 2) array of waypoints; `status` says why there is none."""
+    if not isinstance(map, Map):
+        got = "None (a merge_maps result that did not merge has no map)" if map is None else type(map).__name__
+        raise InputError(f"plan_path: map must be a fleetmap.Map, got {got}")
     return _fleetmap._plan_path(map, (float(start[0]), float(start[1])), (float(goal[0]), float(goal[1])),
                                 planner, float(robot_radius), float(time_budget), int(seed))
 

@@ -1,6 +1,6 @@
 # Type hints of the package `fleetmap` (the Python half in __init__.py, the C++ half in _fleetmap).
 import os
-from typing import Any, Mapping, Optional, Protocol, Sequence, Tuple, Union
+from typing import Any, Iterable, Mapping, Optional, Protocol, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -46,15 +46,35 @@ class Map:
         cells."""
 
 class MergeResult:
-    merged: bool
-    confidence: float
-    acceptance: float
-    method: str
-    reason: str
+    """Map b aligned to map a, as `fleetmap merge a b` aligns them."""
+    @property
+    def merged(self) -> bool: ...
+    @property
+    def confidence(self) -> float: ...
+    @property
+    def acceptance(self) -> float: ...
+    @property
+    def method(self) -> str: ...
+    @property
+    def reason(self) -> str: ...
     @property
     def transform(self) -> Tuple[float, float, float]:
-        """(tx, ty, theta): b's cells into a's cells (the best candidate even when not merged); for maps
-        of two resolutions, b's cells seen through a's (b.resampled(a.resolution))."""
+        """(tx, ty, theta): b's map frame into a's, metres and degrees: a point p of b (metres, in the
+        frame b's origin defines; a bare image's lower-left corner is (0, 0)) lies at
+        R(theta) p + (tx, ty) in a's, R(theta) = [[cos, -sin], [sin, cos]]; `fleetmap merge`'s tx_m,
+        ty_m, theta_deg. The best candidate even when not merged."""
+    @property
+    def pixel_transform(self) -> Tuple[float, float, float]:
+        """(tx, ty, theta): pixel (u, v) of b (u = column, v = row from the top) lies at
+        scale R(theta) (u, v) + (tx, ty) in a's pixel grid, theta in degrees; `fleetmap merge`'s
+        tx_px, ty_px, theta_px_deg."""
+    @property
+    def scale(self) -> float:
+        """b's metres per cell / a's."""
+    @property
+    def map(self) -> Optional[Map]:
+        """The fused map in a's frame and resolution, cut to the known cells and half a metre around
+        them (what `fleetmap merge a b --out merged.yaml` writes); None when not merged."""
 
 class PlanResult:
     planner: str
@@ -117,11 +137,16 @@ class StrategyWithContext(Protocol):
                context: AssignmentContext) -> Sequence[int]: ...
 
 def explore(scenario: Union[None, Mapping[str, Any], PathLike] = None, **keys: Any) -> ExplorationResult: ...
-def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, **keys: Any) -> list[dict[str, Any]]: ...
+def sweep(spec: Union[None, Mapping[str, Any], PathLike] = None, jobs: int = 1, out: Optional[PathLike] = None,
+          **keys: Any) -> list[dict[str, Any]]:
+    """The rows of results.csv, one dict per run; with `out`, also the folder `fleetmap bench --out` writes."""
+def save_results(rows: Iterable[Mapping[str, Any]], path: PathLike) -> None:
+    """Writes sweep rows as `fleetmap bench` writes results.csv (the columns and formats every bench verb reads)."""
 def load_map(source: str, resolution: float = 0.05) -> Map:
     """A built-in map by name (map_names()) or a PNG/PGM/map_server YAML file."""
 def save_map(map: Map, path: PathLike) -> None: ...
-def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1) -> MergeResult: ...
+def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1) -> MergeResult:
+    """Aligns b to a as `fleetmap merge a b` does: `transform` in metres and degrees, `map` the fused map."""
 def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: str = "astar",
               robot_radius: float = 0.2, time_budget: float = 1.0, seed: int = 1) -> PlanResult: ...
 def register_strategy(name: str, cls: Any, help: str = "", joint: bool = True) -> None: ...

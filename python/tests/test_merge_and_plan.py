@@ -1,53 +1,135 @@
-"""Merging two maps (transform and confidence) and planning a path on a map."""
+"""Merging two maps (transform, confidence, fused map) and planning a path on a map."""
+import json
 import math
 import platform
 import resource
+import tempfile
 import unittest
+from pathlib import Path
 
 import numpy as np
 
 import fleetmap
+from cli_support import run_fleetmap
+
+
+def office_windows():
+    """The built-in office (0.05 m cells, 200 x 200) cut in two overlapping windows: a holds its
+    columns 0-129, b its columns 70-199, so b's frame is a's moved 3.5 m along x."""
+    office = fleetmap.load_map("office").image
+    return fleetmap.Map.from_image(office[:, :130].copy()), fleetmap.Map.from_image(office[:, 70:].copy())
 
 
 class MergeTest(unittest.TestCase):
-    def test_two_overlapping_parts_of_a_map_are_aligned(self):
-        office = fleetmap.load_map("office").image
-        # a: the left 130 columns; b: the right 130 columns (top row first), so b's cell x is a's x - 70.
-        a = fleetmap.Map.from_image(office[:, :130].copy())
-        b = fleetmap.Map.from_image(office[:, 70:].copy())
+    def test_two_overlapping_parts_of_a_map_are_aligned_in_metres_and_degrees(self):
+        a, b = office_windows()
         result = fleetmap.merge_maps(a, b)
         self.assertTrue(result.merged, result.reason)
         self.assertGreaterEqual(result.confidence, 0.5)
-        tx, ty, theta = result.transform
         # Sub-cell accuracy is the refinement's goal; half a cell and half a degree leave room for it.
-        self.assertAlmostEqual(tx, 70.0, delta=0.5)
-        self.assertAlmostEqual(ty, 0.0, delta=0.5)
-        self.assertAlmostEqual(theta, 0.0, delta=math.radians(0.5))
+        tx, ty, theta = result.transform
+        self.assertAlmostEqual(tx, 3.5, delta=0.025)
+        self.assertAlmostEqual(ty, 0.0, delta=0.025)
+        self.assertAlmostEqual(theta, 0.0, delta=0.5)
+        # The same in pixels: b's column u is a's column u + 70.
+        px, py, ptheta = result.pixel_transform
+        self.assertAlmostEqual(px, 70.0, delta=0.5)
+        self.assertAlmostEqual(py, 0.0, delta=0.5)
+        self.assertAlmostEqual(ptheta, 0.0, delta=0.5)
+        self.assertEqual(result.scale, 1.0)
 
-    def test_maps_of_different_resolutions_are_aligned_through_the_coarser_cells(self):
+    def test_a_turned_and_shifted_map_file_is_recovered_in_metres(self):
         office = fleetmap.load_map("office").image
-        a = fleetmap.Map.from_image(office[:, :130].copy(), resolution=0.05)
-        coarse = fleetmap.Map.from_image(office[:, 70:].copy(), resolution=0.05).resampled(0.1)
-        self.assertEqual((coarse.width, coarse.height), ((office.shape[1] - 70 + 1) // 2, (office.shape[0] + 1) // 2))
+        a = fleetmap.Map.from_image(office[:, :130].copy())
+        # b: the right window turned a quarter turn counter-clockwise, its lower-left corner at (1, 2) m.
+        # A point q of the office is at R(90) (q - (3.5, 0)) + (10, 0) + (1, 2) in b's frame, so a point
+        # p of b's frame is at R(-90) p + (1.5, 11) in a's (= the office's).
+        b = fleetmap.Map.from_image(np.rot90(office[:, 70:]).copy(), origin=(1.0, 2.0, 0.0))
+        result = fleetmap.merge_maps(a, b)
+        self.assertTrue(result.merged, result.reason)
+        tx, ty, theta = result.transform
+        self.assertAlmostEqual(theta, -90.0, delta=0.5)
+        # Within a cell at b's far corner (10 m from its origin): the rotation's error included.
+        self.assertLess(math.hypot(tx - 1.5, ty - 11.0), 0.05 + math.radians(abs(theta + 90.0)) * 12.0)
+
+    def test_maps_of_different_resolutions_are_aligned_in_one_frame_of_metres(self):
+        a, b = office_windows()
+        coarse = b.resampled(0.1)
+        self.assertEqual((coarse.width, coarse.height), ((b.width + 1) // 2, (b.height + 1) // 2))
         self.assertAlmostEqual(coarse.resolution, 0.1)
-        # The transform takes the second map's cells seen through the first's into the first's:
-        # b's 0.05 m cell x is a's x + 70, and a's 0.1 m cell x is coarse's x - 35.
-        for first, second, expected_tx in ((a, coarse, 70.0), (coarse, a, -35.0)):
+        # Metres do not depend on the cells: b's frame is a's moved 3.5 m, whichever map has which cells.
+        for first, second, expected_tx, scale in ((a, coarse, 3.5, 2.0), (coarse, a, -3.5, 0.5),
+                                                  (a.resampled(0.1), coarse, 3.5, 1.0)):
             result = fleetmap.merge_maps(first, second)
             self.assertTrue(result.merged, result.reason)
             tx, ty, theta = result.transform
-            self.assertAlmostEqual(tx, expected_tx, delta=1.0)
-            self.assertAlmostEqual(ty, 0.0, delta=1.0)
-            self.assertAlmostEqual(theta, 0.0, delta=math.radians(0.5))
-        # Seen through one resolution, the same answer in 0.1 m cells.
-        result = fleetmap.merge_maps(a.resampled(0.1), coarse)
-        self.assertTrue(result.merged, result.reason)
-        self.assertAlmostEqual(result.transform[0], 35.0, delta=0.5)
+            self.assertAlmostEqual(tx, expected_tx, delta=0.05)
+            self.assertAlmostEqual(ty, 0.0, delta=0.05)
+            self.assertAlmostEqual(theta, 0.0, delta=0.5)
+            self.assertEqual(result.scale, scale)
         with self.assertRaisesRegex(fleetmap.InputError, "resampled: resolution"):
             a.resampled(0.0)
         with self.assertRaisesRegex(fleetmap.InputError, "resampled: 0.001 m cells would make .* over the limit"):
             a.resampled(0.001)
 
+    def test_the_fused_map_plans_across_the_part_only_the_second_map_knew(self):
+        a, b = office_windows()
+        result = fleetmap.merge_maps(a, b)
+        self.assertTrue(result.merged, result.reason)
+        fused = result.map
+        self.assertIsInstance(fused, fleetmap.Map)
+        self.assertEqual(fused.resolution, a.resolution)
+        self.assertGreater(fused.free_cells, max(a.free_cells, b.free_cells))
+        # From a room only a knew (x < 3.5 m) to one only b knew (x > 6.5 m), along the corridor at y = 5 m.
+        start, goal = (1.0, 5.0), (9.0, 5.0)
+        self.assertFalse(fleetmap.plan_path(a, start, goal).success)
+        path = fleetmap.plan_path(fused, start, goal)
+        self.assertTrue(path.success, path.detail)
+        self.assertGreater(path.path[:, 0].max(), 6.5)
+
+    def test_a_merge_refused_has_no_map_and_planning_on_it_says_so(self):
+        empty = np.full((60, 60), 205, np.uint8)
+        empty[10:50, 10:50] = 254
+        result = fleetmap.merge_maps(fleetmap.Map.from_image(empty), fleetmap.Map.from_image(empty))
+        self.assertFalse(result.merged)
+        self.assertTrue(result.reason)
+        self.assertIsNone(result.map)
+        with self.assertRaisesRegex(fleetmap.InputError, "plan_path: map must be a fleetmap.Map, got None"):
+            fleetmap.plan_path(result.map, (1, 1), (2, 2))
+        with self.assertRaisesRegex(fleetmap.InputError, "merge_maps: b must be a fleetmap.Map"):
+            fleetmap.merge_maps(fleetmap.Map.from_image(empty), empty)
+
+
+class MergeAgreesWithTheCommandTest(unittest.TestCase):
+    """Python and `fleetmap merge` on the same two map files give the same numbers and the same map."""
+
+    def test_the_transform_and_the_fused_map_are_the_commands(self):
+        office = fleetmap.load_map("office").image
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            # Inside a larger unknown area, as a robot's map often is; b turned and placed elsewhere.
+            a = fleetmap.Map.from_image(np.pad(office[:, :130], 60, constant_values=205), origin=(-2.0, 1.0, 0.0))
+            b = fleetmap.Map.from_image(np.pad(np.rot90(office[:, 70:], 3), 40, constant_values=205),
+                                        origin=(3.0, -4.0, 0.3))
+            fleetmap.save_map(a, folder / "a.yaml")
+            fleetmap.save_map(b, folder / "b.yaml")
+            code, out, err = run_fleetmap("merge", "a.yaml", "b.yaml", "--json", "r.json", "--out", "merged.yaml",
+                                          cwd=folder)
+            self.assertEqual(code, 0, err + out)
+            command = json.loads((folder / "r.json").read_text())["transforms"][0]
+            result = fleetmap.merge_maps(fleetmap.load_map(str(folder / "a.yaml")), fleetmap.load_map(str(folder / "b.yaml")))
+            self.assertTrue(result.merged, result.reason)
+            np.testing.assert_allclose(result.transform, (command["tx_m"], command["ty_m"], command["theta_deg"]),
+                                       rtol=0, atol=1e-9)
+            np.testing.assert_allclose(result.pixel_transform,
+                                       (command["tx_px"], command["ty_px"], command["theta_px_deg"]), rtol=0, atol=1e-9)
+            written = fleetmap.load_map(str(folder / "merged.yaml"))
+            self.assertEqual((written.width, written.height), (result.map.width, result.map.height))
+            np.testing.assert_allclose(written.origin, result.map.origin, atol=1e-6)
+            np.testing.assert_array_equal(written.image, result.map.image)
+
+
+class MergeMemoryTest(unittest.TestCase):
     @unittest.skipUnless(platform.libc_ver()[0] == "glibc", "the allocator setting is glibc's")
     def test_merging_again_reuses_the_memory_of_the_last_merge(self):
         # Importing fleetmap keeps freed memory for reuse (core/memory.h): a script that merges
@@ -62,19 +144,12 @@ class MergeTest(unittest.TestCase):
             before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
             result = fleetmap.merge_maps(a, b)
             self.assertTrue(result.merged, result.reason)
-            self.assertAlmostEqual(result.transform[0], 200.0, delta=0.5)
+            self.assertAlmostEqual(result.transform[0], 10.0, delta=0.025)  # 200 cells of 0.05 m
             return resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
 
         faults_of_a_merge()  # maps what a merge of this size needs
         for _ in range(2):
             self.assertLess(faults_of_a_merge(), 1000)  # 4 MB; glibc's defaults fault 10 MB in a merge
-
-    def test_maps_with_nothing_in_common_are_not_merged(self):
-        empty = np.full((60, 60), 205, np.uint8)
-        empty[10:50, 10:50] = 254
-        result = fleetmap.merge_maps(fleetmap.Map.from_image(empty), fleetmap.Map.from_image(empty))
-        self.assertFalse(result.merged)
-        self.assertTrue(result.reason)
 
 
 class PlanTest(unittest.TestCase):

@@ -28,22 +28,55 @@ struct PixelTruth {
   double tx, ty, theta_deg;
 };
 
-// Two crops of the built-in office, the second turned and shifted, saved as map_saver PNGs. The
-// truth is in the command's pixel convention.
-PixelTruth write_pair(const TempDir& dir, const std::string& a_name, const std::string& b_name, std::uint64_t seed) {
-  const auto office = maps::load_map_source("office");
+// Two 140-cell crops of the built-in office overlapping by half, the second turned and shifted.
+merging::CropPair office_pair(std::uint64_t seed) {
   core::Random random(seed);
   merging::CropPairOptions o;
   o.width = o.height = 140;
   o.overlap = 0.5;
-  const merging::CropPair pair = merging::make_crop_pair(office, o, random);
+  return merging::make_crop_pair(maps::load_map_source("office"), o, random);
+}
+
+// office_pair saved as map_saver PNGs. The truth is in the command's pixel convention.
+PixelTruth write_pair(const TempDir& dir, const std::string& a_name, const std::string& b_name, std::uint64_t seed) {
+  const merging::CropPair pair = office_pair(seed);
   io::save_map_image(pair.a, dir / a_name);
   io::save_map_image(pair.b, dir / b_name);
   const core::Transform2 px = merging::flip_rows(pair.b_to_a, pair.a.height(), pair.b.height());
   return {px.translation().x(), px.translation().y(), core::rad2deg(px.rotation())};
 }
 
-TEST(MergeCommand, MergesTwoMapsInThePixelConvention) {
+// The centre of the free cell farthest from any other cell (metres): a place to plan from.
+Eigen::Vector2d widest_free_point(const mapping::OccupancyGrid& g) {
+  cv::Mat free(g.height(), g.width(), CV_8U);
+  for (int y = 0; y < g.height(); ++y) {
+    for (int x = 0; x < g.width(); ++x) free.at<uchar>(y, x) = g.state({x, y}) == mapping::CellState::Free ? 255 : 0;
+  }
+  cv::Mat clearance;
+  cv::distanceTransform(free, clearance, cv::DIST_L2, 3);
+  cv::Point widest;
+  cv::minMaxLoc(clearance, nullptr, nullptr, nullptr, &widest);
+  return g.geometry().cell_center({widest.x, widest.y});
+}
+
+// The share of `a`'s known cells that `merged` holds at the same place in metres (a cell centre on
+// a cell centre) and in the same state.
+double share_in_place(const mapping::OccupancyGrid& a, const mapping::OccupancyGrid& merged) {
+  std::int64_t same = 0, known = 0;
+  for (int y = 0; y < a.height(); ++y) {
+    for (int x = 0; x < a.width(); ++x) {
+      const auto state = a.state({x, y});
+      if (state == mapping::CellState::Unknown) continue;
+      ++known;
+      const Eigen::Vector2d p = a.geometry().cell_center({x, y});
+      const auto cell = merged.geometry().world_to_cell(p);
+      same += cell && (merged.geometry().cell_center(*cell) - p).norm() < 1e-6 && merged.state(*cell) == state;
+    }
+  }
+  return known > 0 ? double(same) / double(known) : 0.0;
+}
+
+TEST(MergeCommand, MergesTwoMapsAndGivesThePixelPlacement) {
   TempDir dir;
   const PixelTruth truth = write_pair(dir, "a.png", "b.png", 5);
   const auto r = run_fleetmap("merge a.png b.png --out out/merged.png --json out/result.json", dir);
@@ -56,15 +89,16 @@ TEST(MergeCommand, MergesTwoMapsInThePixelConvention) {
   EXPECT_EQ(t["merged"], true);
   // Within a degree; within a cell at the crop (the translation is at the image origin, so allow
   // the rotation error over the crop's extent too).
-  const double dtheta = std::abs(core::rad2deg(core::normalize_angle(core::deg2rad(t["theta_deg"].get<double>() - truth.theta_deg))));
+  const double dtheta = std::abs(core::rad2deg(core::normalize_angle(core::deg2rad(t["theta_px_deg"].get<double>() - truth.theta_deg))));
   EXPECT_LT(dtheta, 1.0);
-  EXPECT_LT(std::hypot(t["tx"].get<double>() - truth.tx, t["ty"].get<double>() - truth.ty), 1.0 + core::deg2rad(dtheta) * 200.0);
+  EXPECT_LT(std::hypot(t["tx_px"].get<double>() - truth.tx, t["ty_px"].get<double>() - truth.ty), 1.0 + core::deg2rad(dtheta) * 200.0);
   EXPECT_GT(t["acceptance"].get<double>(), 0.95);
   EXPECT_GE(t["confidence"].get<double>(), 0.5);
   EXPECT_LE(t["confidence"].get<double>(), 1.0);
   EXPECT_EQ(t["method"], "overlap");
   EXPECT_EQ(t["via"], "a.png");
-  EXPECT_NE(j["convention"].get<std::string>().find("R(theta) (u, v) + (tx, ty)"), std::string::npos);
+  EXPECT_NE(j["convention"].get<std::string>().find("R(theta) p + (tx_m, ty_m)"), std::string::npos);
+  EXPECT_NE(j["pixel_convention"].get<std::string>().find("R(theta_px) (u, v) + (tx_px, ty_px)"), std::string::npos);
 
   // The picture tints each input's free cells toward its palette colour (legend swatches included).
   const cv::Mat img = cv::imread((dir / "out" / "merged.png").string());
@@ -83,17 +117,40 @@ TEST(MergeCommand, MergesTwoMapsInThePixelConvention) {
   EXPECT_TRUE(has_colour(viz::palette_color(1)));
 }
 
+// A known turn and shift between two map_server files, origins and all, comes back in metres and
+// degrees: a point p of b's map frame lies at R(theta) p + (tx_m, ty_m) in a's.
+TEST(MergeCommand, ReportsTheTransformBetweenTheMapFilesFramesInMetresAndDegrees) {
+  TempDir dir;
+  const merging::CropPair pair = office_pair(5);
+  io::save_map_image(pair.a, dir / "a.png");
+  io::save_map_image(pair.b, dir / "b.png");
+  dir.write("a.yaml", "image: a.png\nresolution: 0.05\norigin: [1.0, 2.0, 0.0]\n");
+  dir.write("b.yaml", "image: b.png\nresolution: 0.05\norigin: [-3.0, 0.5, 0.4]\n");
+  const auto a = io::load_map(dir / "a.yaml"), b = io::load_map(dir / "b.yaml");
+  const core::Transform2 truth = merging::world_from_cells(a.geometry(), b.geometry(), pair.b_to_a);
+  const auto r = run_fleetmap("merge a.yaml b.yaml --json r.json --out m.png", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const auto t = nlohmann::json::parse(slurp(dir / "r.json"))["transforms"][0];
+  ASSERT_EQ(t["merged"], true) << t.dump();
+  const core::Transform2 got(t["tx_m"].get<double>(), t["ty_m"].get<double>(), core::deg2rad(t["theta_deg"].get<double>()));
+  EXPECT_LT(std::abs(core::rad2deg(core::normalize_angle(got.rotation() - truth.rotation()))), 1.0) << got << " vs " << truth;
+  // b's centre lands within a cell and a half of where it belongs.
+  const Eigen::Vector2d centre = b.geometry().cell_center({b.width() / 2, b.height() / 2});
+  EXPECT_LT((got.apply(centre) - truth.apply(centre)).norm(), 0.075) << got << " vs " << truth;
+  // The printed line says the same numbers.
+  EXPECT_NE(r.out.find(fmt::format("b.yaml: tx {:.3f} ty {:.3f} m, theta {:.3f} deg (pixels: tx {:.2f} ty {:.2f}",
+                                   got.translation().x(), got.translation().y(), t["theta_deg"].get<double>(),
+                                   t["tx_px"].get<double>(), t["ty_px"].get<double>())),
+            std::string::npos)
+      << r.out;
+}
+
 // Robots with different map resolutions: the second map is the pair's b seen through 0.1 m cells
 // (a's are 0.05 m), given second and then first. Its pixel p is placed at scale R p + t, with
-// scale its cell size over the first map's.
+// scale its cell size over the first map's; in metres the frames are the same whatever the cells.
 TEST(MergeCommand, MergesMapsOfDifferentResolutions) {
   TempDir dir;
-  const auto office = maps::load_map_source("office");
-  core::Random random(5);
-  merging::CropPairOptions o;
-  o.width = o.height = 140;
-  o.overlap = 0.5;
-  const merging::CropPair pair = merging::make_crop_pair(office, o, random);
+  const merging::CropPair pair = office_pair(5);
   const mapping::OccupancyGrid coarse = mapping::coarsen(pair.b, 2);
   io::save_map_image(pair.a, dir / "a.png");
   io::save_map_image(coarse, dir / "b.png");
@@ -106,11 +163,22 @@ TEST(MergeCommand, MergesMapsOfDifferentResolutions) {
     return b_to_a.apply(Eigen::Vector2d(2 * p.x() + 0.5, 2 * p.y() + pair.b.height() + 0.5 - 2 * coarse.height()));
   };
   const auto placed = [](const nlohmann::json& t, const Eigen::Vector2d& p) {
-    const core::Transform2 rigid(t["tx"].get<double>(), t["ty"].get<double>(), core::deg2rad(t["theta_deg"].get<double>()));
+    const core::Transform2 rigid(t["tx_px"].get<double>(), t["ty_px"].get<double>(),
+                                 core::deg2rad(t["theta_px_deg"].get<double>()));
     return rigid.apply(t["scale"].get<double>() * p);
   };
   const std::vector<Eigen::Vector2d> corners = {
       {0, 0}, {coarse.width() - 1.0, 0}, {0, coarse.height() - 1.0}, {coarse.width() - 1.0, coarse.height() - 1.0}};
+  // Both files have their origin at (0, 0): b's frame in metres is pair.b's at 0.05 m.
+  const core::Transform2 metres = merging::world_from_cells(io::load_map(dir / "a.yaml").geometry(),
+                                                            core::GridGeometry(0.05, pair.b.width(), pair.b.height()),
+                                                            pair.b_to_a);
+  const auto expect_metres = [&](const nlohmann::json& t, const core::Transform2& truth, const mapping::OccupancyGrid& b) {
+    const core::Transform2 got(t["tx_m"].get<double>(), t["ty_m"].get<double>(), core::deg2rad(t["theta_deg"].get<double>()));
+    for (const Eigen::Vector2d& corner : {Eigen::Vector2d(0, 0), Eigen::Vector2d(b.geometry().width_m(), b.geometry().height_m())}) {
+      EXPECT_LT((got.apply(corner) - truth.apply(corner)).norm(), 0.1) << got << " vs " << truth;
+    }
+  };
 
   // Coarse second: resampled to 0.05 m; the placement within a fine cell and a half at b's corners.
   auto r = run_fleetmap("merge a.yaml b.yaml --json r.json --out m.yaml", dir);
@@ -120,6 +188,7 @@ TEST(MergeCommand, MergesMapsOfDifferentResolutions) {
   ASSERT_EQ(t["merged"], true) << t.dump();
   EXPECT_DOUBLE_EQ(t["scale"].get<double>(), 2.0);
   for (const auto& p : corners) EXPECT_LT((placed(t, p) - coarse_to_a(p)).norm(), 1.5) << t.dump();
+  expect_metres(t, metres, coarse);
   // The fused map is in the first map's cells.
   const auto fused = io::load_map(dir / "m.yaml");
   EXPECT_DOUBLE_EQ(fused.resolution(), 0.05);
@@ -131,6 +200,7 @@ TEST(MergeCommand, MergesMapsOfDifferentResolutions) {
   t = nlohmann::json::parse(slurp(dir / "r2.json"))["transforms"][0];
   ASSERT_EQ(t["merged"], true) << t.dump();
   EXPECT_DOUBLE_EQ(t["scale"].get<double>(), 0.5);
+  expect_metres(t, metres.inverse(), io::load_map(dir / "a.yaml"));
   // a's fine pixel q lies at the coarse pixel c with coarse_to_a(c) = q.
   const core::Transform2 a_to_b = b_to_a.inverse();
   for (const Eigen::Vector2d& q : {Eigen::Vector2d(0, 0), Eigen::Vector2d(pair.a.width() - 1.0, pair.a.height() - 1.0),
@@ -158,6 +228,51 @@ TEST(MergeCommand, ThePictureHoldsTheMapWithoutEmptyMarginsAndDarkWalls) {
   EXPECT_GT(cv::countNonZero(black), 2000);
 }
 
+// The part of a merge picture inside the margin of unknown cells around the known ones (the largest
+// patch of unknown grey), its central three fifths.
+cv::Mat central_known_area(const cv::Mat& img) {
+  cv::Mat grey, labels, stats, centroids;
+  cv::inRange(img, cv::Scalar(205, 205, 205), cv::Scalar(205, 205, 205), grey);
+  const int n = cv::connectedComponentsWithStats(grey, labels, stats, centroids);
+  int largest = 1;
+  for (int k = 2; k < n; ++k) {
+    if (stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(largest, cv::CC_STAT_AREA)) largest = k;
+  }
+  const cv::Rect ring(stats.at<int>(largest, cv::CC_STAT_LEFT), stats.at<int>(largest, cv::CC_STAT_TOP),
+                      stats.at<int>(largest, cv::CC_STAT_WIDTH), stats.at<int>(largest, cv::CC_STAT_HEIGHT));
+  return img(cv::Rect(ring.x + ring.width / 5, ring.y + ring.height / 5, ring.width * 3 / 5, ring.height * 3 / 5));
+}
+
+double share_of(const cv::Mat& img, const cv::Vec3b& bgr) {
+  cv::Mat hit;
+  cv::inRange(img, cv::Scalar(bgr[0], bgr[1], bgr[2]), cv::Scalar(bgr[0], bgr[1], bgr[2]), hit);
+  return double(cv::countNonZero(hit)) / double(img.total());
+}
+
+// Cells free in both maps stand apart from unknown grey and from each map's own tint.
+TEST(MergeCommand, CellsFreeInSeveralMapsAreWhiteNeitherUnknownGreyNorATint) {
+  TempDir dir;
+  const merging::CropPair pair = office_pair(5);
+  // In a larger unknown area, so that the picture has its margin of unknown around the known cells.
+  const mapping::OccupancyGrid a = merging::crop_grid(pair.a, -20, -20, pair.a.width() + 40, pair.a.height() + 40);
+  io::save_map_image(a, dir / "a.png");
+  io::save_map_image(a, dir / "same.png");
+  ASSERT_EQ(run_fleetmap("merge a.png same.png --out m.png", dir).exit_code, 0);
+  const cv::Mat img = cv::imread((dir / "m.png").string());
+  ASSERT_FALSE(img.empty());
+  const cv::Mat known = central_known_area(img);
+  // Every known cell is free in both maps or a wall.
+  EXPECT_GT(share_of(known, {255, 255, 255}), 0.5);
+  EXPECT_GT(share_of(known, {255, 255, 255}) + share_of(known, {0, 0, 0}), 0.999);
+  EXPECT_EQ(share_of(known, {205, 205, 205}), 0.0);
+  // The inputs' tints appear in the legend's swatches only (14 x 14 pixels).
+  const auto tint = [](const viz::Color& c) {
+    const auto t = [](int v) { return cv::saturate_cast<uchar>(255 * 0.7 + v * 0.3); };
+    return cv::Vec3b(t(c.b), t(c.g), t(c.r));
+  };
+  for (int k : {0, 1}) EXPECT_LT(share_of(img, tint(viz::palette_color(k))) * double(img.total()), 14 * 14);
+}
+
 TEST(MergeCommand, AMapWithoutOverlapIsReportedNotMerged) {
   TempDir dir;
   write_pair(dir, "a.png", "b.png", 6);
@@ -172,7 +287,7 @@ TEST(MergeCommand, AMapWithoutOverlapIsReportedNotMerged) {
   EXPECT_EQ(j["transforms"][0]["map"], "maze.png");
   EXPECT_EQ(j["transforms"][0]["merged"], false);
   EXPECT_NE(j["transforms"][0]["reason"].get<std::string>().find("no reliable overlap"), std::string::npos);
-  EXPECT_FALSE(j["transforms"][0].contains("tx"));
+  EXPECT_FALSE(j["transforms"][0].contains("tx_m"));
   EXPECT_EQ(j["transforms"][1]["merged"], true);
   EXPECT_TRUE(std::filesystem::exists(dir / "m.png"));
 }
@@ -202,29 +317,10 @@ TEST(MergeCommand, WritesAMapFileInTheFirstMapsMetresThatPlanReads) {
   EXPECT_GT(merged.known_count(), a.known_count());
   // Every cell of the reference keeps its place in metres (the fused map adds b's evidence, so a
   // few cells may change state, not many).
-  std::int64_t same = 0, known = 0;
-  for (int y = 0; y < a.height(); ++y) {
-    for (int x = 0; x < a.width(); ++x) {
-      const auto state = a.state({x, y});
-      if (state == mapping::CellState::Unknown) continue;
-      const auto cell = merged.geometry().world_to_cell(a.geometry().cell_center({x, y}));
-      ASSERT_TRUE(cell.has_value());
-      ++known;
-      same += merged.state(*cell) == state;
-    }
-  }
-  EXPECT_GT(double(same) / double(known), 0.97);
+  EXPECT_GT(share_in_place(a, merged), 0.97);
 
   // Plan between two points of the reference's free space, in its metres, on the merged map.
-  cv::Mat free(a.height(), a.width(), CV_8U);
-  for (int y = 0; y < a.height(); ++y) {
-    for (int x = 0; x < a.width(); ++x) free.at<uchar>(y, x) = a.state({x, y}) == mapping::CellState::Free ? 255 : 0;
-  }
-  cv::Mat clearance;
-  cv::distanceTransform(free, clearance, cv::DIST_L2, 3);
-  cv::Point widest;
-  cv::minMaxLoc(clearance, nullptr, nullptr, nullptr, &widest);
-  const Eigen::Vector2d from = a.geometry().cell_center({widest.x, widest.y});
+  const Eigen::Vector2d from = widest_free_point(a);
   const Eigen::Vector2d to = from + Eigen::Vector2d(0.2, 0.1);
   const auto p = run_fleetmap(fmt::format("plan --map out/merged.yaml --from {},{} --to {},{} --planner astar --json "
                                           "path.json",
@@ -234,6 +330,45 @@ TEST(MergeCommand, WritesAMapFileInTheFirstMapsMetresThatPlanReads) {
   const auto path = nlohmann::json::parse(slurp(dir / "path.json"));
   EXPECT_TRUE(path["success"].get<bool>()) << path.dump();
   EXPECT_NEAR(path["start"][0].get<double>(), from.x(), 1e-6);
+}
+
+// Maps inside a large unknown area (as robots allocate them): the merged map file holds the known
+// cells and half a metre around them, each at its place in the first map's metres, and plan's
+// picture of it is the map, not a field of unknown.
+TEST(MergeCommand, CutsTheMergedMapFileToTheKnownCellsKeepingTheirPlaceInMetres) {
+  TempDir dir;
+  const merging::CropPair pair = office_pair(7);
+  io::save_map_image(merging::crop_grid(pair.a, -150, -150, pair.a.width() + 300, pair.a.height() + 300), dir / "a.png");
+  io::save_map_image(merging::crop_grid(pair.b, -100, -120, pair.b.width() + 220, pair.b.height() + 240), dir / "b.png");
+  const mapping::OccupancyGrid a = io::load_map(dir / "a.png");
+  const auto r = run_fleetmap("merge a.png b.png --out merged.yaml", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const mapping::OccupancyGrid merged = io::load_map(dir / "merged.yaml");
+  // The known cells' box, 10 cells (0.5 m) from every edge.
+  int x0 = merged.width(), y0 = merged.height(), x1 = -1, y1 = -1;
+  for (int y = 0; y < merged.height(); ++y) {
+    for (int x = 0; x < merged.width(); ++x) {
+      if (merged.state({x, y}) == mapping::CellState::Unknown) continue;
+      x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+    }
+  }
+  EXPECT_EQ(x0, 10);
+  EXPECT_EQ(y0, 10);
+  EXPECT_EQ(merged.width() - 1 - x1, 10);
+  EXPECT_EQ(merged.height() - 1 - y1, 10);
+  // Two 140-cell crops overlapping by half span at most 280 cells.
+  EXPECT_LE(std::max(merged.width(), merged.height()), 300);
+  // Every known cell of the reference is where it was, in metres.
+  EXPECT_GT(share_in_place(a, merged), 0.97);
+  // plan reads it, and its picture is mostly map.
+  const Eigen::Vector2d from = widest_free_point(a);
+  const auto p = run_fleetmap(fmt::format("plan --map merged.yaml --from {},{} --to {},{} --planner astar --out plan.png",
+                                          from.x(), from.y(), from.x() + 0.1, from.y()),
+                              dir);
+  ASSERT_EQ(p.exit_code, 0) << p.err << p.out;
+  const cv::Mat picture = cv::imread((dir / "plan.png").string());
+  ASSERT_FALSE(picture.empty());
+  EXPECT_LT(share_of(picture, {205, 205, 205}), 0.25);
 }
 
 TEST(MergeCommand, PictureAndMapFileNamesAreChecked) {
@@ -255,9 +390,11 @@ TEST(MergeCommand, HelpStatesTheConventionAndEveryFlagWithItsDefault) {
   TempDir dir;
   const auto r = run_fleetmap("merge --help", dir);
   ASSERT_EQ(r.exit_code, 0);
-  for (const char* part : {"R(theta) (u, v) + (tx, ty)", "u = column", "row from the top", "--method",
+  for (const char* part : {"R(theta) p + (tx_m, ty_m)", "metres", "degrees", "origin", "tx_px",
+                           "R(theta_px) (u, v) + (tx_px, ty_px)", "u = column", "row from the top", "--method",
                            "=auto", "--out", "=merged.png", "--json", "default: none", "--min-confidence", "=0.5",
-                           "--seed", "--resolution", "else 0.05", "overlap:", "features:", "auto:", "merged: false"}) {
+                           "--seed", "--resolution", "else 0.05", "overlap:", "features:", "auto:", "merged: false",
+                           "white when several did", "to the known cells and half a metre around them (its origin says where)"}) {
     EXPECT_NE(r.out.find(part), std::string::npos) << part;
   }
 }

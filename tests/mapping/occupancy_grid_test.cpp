@@ -260,5 +260,28 @@ TEST(Resample, ANonPositiveResolutionIsRefused) {
   EXPECT_THROW(resample(g, std::nan("")), Error);
 }
 
+TEST(CropToKnown, KeepsTheKnownCellsAndTheMarginAtTheirPlaceInTheWorld) {
+  // A turned origin: the cut's origin must move along the grid's own axes.
+  OccupancyGrid g(GridGeometry(0.1, 100, 80, core::Pose2(-2.0, 3.0, 0.5)));
+  g.set_state({30, 20}, CellState::Free);
+  g.set_state({60, 25}, CellState::Occupied);
+  g.set_state({45, 50}, CellState::Free);
+  g.set_state({97, 50}, CellState::Free);  // 2 cells from the right edge: the margin stops there
+  const OccupancyGrid cut = crop_to_known(g, 5);
+  EXPECT_EQ(cut.width(), 99 - 25 + 1);
+  EXPECT_EQ(cut.height(), 55 - 15 + 1);
+  EXPECT_EQ(cut.known_count(), g.known_count());
+  for (const Cell c : {Cell{30, 20}, Cell{60, 25}, Cell{45, 50}, Cell{97, 50}}) {
+    const Eigen::Vector2d world = g.geometry().cell_center(c);
+    const auto in_cut = cut.geometry().world_to_cell(world);
+    ASSERT_TRUE(in_cut.has_value());
+    EXPECT_LT((cut.geometry().cell_center(*in_cut) - world).norm(), 1e-9);
+    EXPECT_EQ(cut.state(*in_cut), g.state(c));
+  }
+  // Nothing known: nothing to cut to.
+  const OccupancyGrid unknown(GridGeometry(0.1, 20, 10));
+  EXPECT_EQ(crop_to_known(unknown, 5).geometry(), unknown.geometry());
+}
+
 }  // namespace
 }  // namespace fleetmap::mapping

@@ -112,10 +112,32 @@ TEST(SweepResults, AppenderWritesWholeRowsAndReadsBack) {
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4);
 }
 
+// What Python's csv module writes: CR LF line ends and True / False.
+TEST(SweepResults, RowsWrittenAsPythonsCsvModuleWritesThemAreRead) {
+  TempDir dir;
+  const RunRecord r = sample("market", 4, 2), s = [] {
+    RunRecord n = sample("market", 4, 3);
+    n.finished = false;
+    return n;
+  }();
+  std::string python = results_header() + "\r\n";
+  for (const auto& record : {r, s}) {
+    std::string line = format_record(record);
+    for (const auto& [from, to] : {std::pair<std::string, std::string>{",true,", ",True,"}, {",false,", ",False,"}}) {
+      if (const auto at = line.find(from); at != std::string::npos) line.replace(at, from.size(), to);
+    }
+    python += line + "\r\n";
+  }
+  const auto table = read_results(dir.write("python.csv", python));
+  ASSERT_EQ(table.records.size(), 2u);
+  EXPECT_EQ(format_record(table.records[0]), format_record(r));
+  EXPECT_EQ(format_record(table.records[1]), format_record(s));
+}
+
 TEST(SweepResults, ForeignFilesAndConflictsAreRefused) {
   TempDir dir;
   const auto foreign = dir.write("foreign.csv", "a,b,c\n1,2,3\n");
-  expect_input_error([&] { read_results(foreign); }, {"foreign.csv:1", "not a results table"});
+  expect_input_error([&] { read_results(foreign); }, {"foreign.csv:1", "not a results table", "column 1 is 'a', expected 'map'"});
   EXPECT_THROW(ResultsAppender a(foreign), InputError);
   const std::string header = results_header() + "\n";
   RunRecord r = sample("market", 1, 1);
