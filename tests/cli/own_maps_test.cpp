@@ -125,7 +125,7 @@ TEST(OwnMaps, ATransparentBackgroundIsUnknownNotWall) {
   const auto merge = run_fleetmap("merge lab.png lab_rgba.png --resolution 0.1 --json m.json --out m.png", dir);
   ASSERT_EQ(merge.exit_code, 0) << merge.err << merge.out;
   const auto t = nlohmann::json::parse(slurp(dir / "m.json"))["transforms"][0];
-  EXPECT_NEAR(t["tx"].get<double>(), 0.0, 0.05);
+  EXPECT_NEAR(t["tx_m"].get<double>(), 0.0, 0.005);
   EXPECT_NEAR(t["theta_deg"].get<double>(), 0.0, 0.05);
 }
 
