@@ -264,12 +264,10 @@ int run_bench(const BenchFlags& f) {
   for (const auto& r : runs) {
     if (!done.count(sweep::run_key(r))) todo.push_back(r);
   }
-  if (!f.quiet) {
-    for (const auto& source : sweep.maps) {  // the inputs are good: how each map file was read
-      io::MapLoadOptions load;
-      load.default_resolution = sweep.base.map_resolution_m;
-      print_map_notes(source, load, f.sweep.resolution || f.sweep.scenario || !f.sweep_file.empty());
-    }
+  for (const auto& source : sweep.maps) {  // the inputs are good: how each map file was read
+    io::MapLoadOptions load;
+    load.default_resolution = sweep.base.map_resolution_m;
+    print_map_notes(source, load, f.sweep.resolution || f.sweep.scenario || !f.sweep_file.empty());
   }
   folder.claim();
   sweep::write_sweep_definition(out, sweep);

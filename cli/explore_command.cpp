@@ -166,18 +166,21 @@ void print_summary(const sim::RunResult& result, const std::string& label) {
   } else if (sc.merging != "known") {
     int made = 0;
     double worst_deg = 0.0, worst_m = 0.0;
+    const sim::MergeRecord* worst = nullptr;
     for (const auto& m : result.merges) {
       if (!m.merged) continue;
       ++made;
       worst_deg = std::max(worst_deg, m.rotation_error_deg);
-      worst_m = std::max(worst_m, m.position_error_m);
+      if (!worst || m.position_error_m > worst_m) worst_m = m.position_error_m, worst = &m;
     }
     const long refused = long(result.merges.size()) - made;
     if (made == 0) {
       fmt::print("merging ({}): no merge made, {} refused\n", sc.merging, refused);
     } else {
-      fmt::print("merging ({}): {} made, {} refused; worst error against the truth {:.2f} deg, {:.3f} m\n", sc.merging,
-                 counted(made, "merge"), refused, worst_deg, worst_m);
+      fmt::print("merging ({}): {} made, {} refused; worst error against the truth {:.2f} deg, {:.3f} m (robot {} into "
+                 "robot {}'s map at step {})\n",
+                 sc.merging, counted(made, "merge"), refused, worst_deg, worst_m, worst->sender + 1, worst->receiver + 1,
+                 worst->step);
     }
   }
 }
@@ -258,10 +261,19 @@ io::MapLoadOptions truth_load_options(const ExploreFlags& f, const sim::Scenario
 // The true map; one with no free cell is refused.
 mapping::OccupancyGrid load_truth(const ExploreFlags& f, const sim::Scenario& s) {
   const io::MapLoadOptions load = truth_load_options(f, s);
-  auto truth = maps::load_map_source(s.map, load);
+  mapping::OccupancyGrid truth;
+  try {
+    truth = maps::load_map_source(s.map, load);
+  } catch (const InputError& e) {
+    if (f.map || f.scenario.empty()) throw;
+    throw InputError(f.scenario + ": map: " + e.what());  // the map the scenario names
+  }
   bool any_free = false;
   for (int i = 0; i < truth.width() * truth.height() && !any_free; ++i) any_free = truth.state_at(i) == mapping::CellState::Free;
-  if (!any_free) throw InputError(s.map + ": the map has no free cell: nowhere for a robot to start");
+  if (!any_free) {
+    throw InputError(s.map + ": the map has no free cell: nowhere for a robot to start" +
+                     map_notes_suffix(s.map, load, f.resolution || !f.scenario.empty()));
+  }
   return truth;
 }
 
@@ -347,10 +359,11 @@ int run_explore(const ExploreFlags& f) {
   try {
     made.emplace(s, std::move(truth), std::move(setup));
   } catch (const InputError& e) {
-    throw InputError((f.scenario.empty() ? s.map : f.scenario) + ": " + e.what());
+    throw InputError((f.scenario.empty() ? s.map : f.scenario) + ": " + e.what() +
+                     map_notes_suffix(s.map, truth_load_options(f, s), f.resolution || !f.scenario.empty()));
   }
   // The input is good: how the map was read, said before the run.
-  if (!f.quiet) print_map_notes(s.map, truth_load_options(f, s), f.resolution || !f.scenario.empty());
+  print_map_notes(s.map, truth_load_options(f, s), f.resolution || !f.scenario.empty());
   folder.claim();
   if (attempts) attempts->claim();
   sim::Simulation& simulation = *made;

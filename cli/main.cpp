@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <exception>
 #include <filesystem>
 #include <new>
@@ -15,6 +16,7 @@
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/format.h"
 #include "core/memory.h"
 #include "core/suggest.h"
 #include "io/file_io.h"
@@ -49,25 +51,52 @@ struct UnknownCommand : std::runtime_error {
   std::string where;
 };
 
-// CLI11 reports an unknown subcommand as "a subcommand is required"; name the word instead.
-void check_subcommand_words(const CLI::App& app, int argc, char** argv) {
+// "--name", "--name=value", "-n" or "-nvalue": a token CLI11 reads as a flag (a negative number
+// or "-" is a value).
+bool looks_like_flag(const std::string& w) {
+  const auto letter = [](char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0; };
+  return w.size() >= 2 && w[0] == '-' && (letter(w[1]) || (w[1] == '-' && w.size() > 2 && letter(w[2])));
+}
+
+// Every spelling of every flag of `app` ("--robots", "-h", ...).
+std::vector<std::string> flag_names(const CLI::App& app) {
+  std::vector<std::string> names;
+  for (const CLI::Option* o : app.get_options()) {
+    for (const auto& n : o->get_lnames()) names.push_back("--" + n);
+    for (const auto& n : o->get_snames()) names.push_back("-" + n);
+  }
+  return names;
+}
+
+// Command words and flags are checked before CLI11 parses, so that a mistake is named as typed:
+// CLI11 reports an unknown command as "a subcommand is required", hands an unknown flag's value to
+// a positional argument ("File does not exist: x"), and lists leftovers last to first.
+void check_words_and_flags(const CLI::App& app, int argc, char** argv) {
   const CLI::App* current = &app;
   for (int i = 1; i < argc; ++i) {
     const std::string word = argv[i];
-    if (word.empty() || word[0] == '-') return;
+    if (word == "--") return;  // everything after is a value
+    if (looks_like_flag(word)) {
+      // A long flag up to '='; a short one is its first letter (CLI11 reads "-ovalue" as -o value).
+      const std::string flag = word[1] == '-' ? word.substr(0, word.find('=')) : word.substr(0, 2);
+      const std::vector<std::string> names = flag_names(*current);
+      if (std::find(names.begin(), names.end(), flag) == names.end()) {
+        throw UnknownCommand(command_path(current), "unknown flag '" + flag + "'" + fleetmap::core::did_you_mean(flag, names) +
+                                                        " (see --help)");
+      }
+      continue;
+    }
     const auto subs = current->get_subcommands([](const CLI::App*) { return true; });
-    if (subs.empty()) return;
+    if (subs.empty()) continue;  // a value or a positional argument
     const CLI::App* next = nullptr;
-    std::string names;
+    std::vector<std::string> words;
     for (const CLI::App* s : subs) {
       if (s->get_name() == word) next = s;
-      names += (names.empty() ? "" : ", ") + s->get_name();
+      words.push_back(s->get_name());
     }
     if (next == nullptr) {
-      std::vector<std::string> words;
-      for (const CLI::App* s : subs) words.push_back(s->get_name());
       throw UnknownCommand(command_path(current), "unknown command '" + word + "'" + fleetmap::core::did_you_mean(word, words) +
-                                                      " (commands: " + names + ")");
+                                                      " (commands: " + fleetmap::core::join(words) + ")");
     }
     current = next;
   }
@@ -119,7 +148,7 @@ int main(int argc, char** argv) {
   commands.push_back(fm::cli::add_replay_compare_command(app));
 
   try {
-    check_subcommand_words(app, argc, argv);
+    check_words_and_flags(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);

@@ -18,4 +18,15 @@ void print_map_notes(const std::string& source, const io::MapLoadOptions& option
   }
 }
 
+std::string map_notes_suffix(const std::string& source, const io::MapLoadOptions& options, bool resolution_given) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(source, ec)) return "";
+  const auto notes =
+      io::map_reading_notes(source, options, resolution_given ? std::string() : "the default; --resolution sets it");
+  if (notes.empty()) return "";
+  std::string text;
+  for (const auto& note : notes) text += (text.empty() ? " (" : "; ") + note;
+  return text + ")";
+}
+
 }  // namespace fleetmap::cli

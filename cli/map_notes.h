@@ -11,4 +11,7 @@ namespace fleetmap::cli {
 void print_map_notes(const std::string& source, const io::MapLoadOptions& options, bool resolution_given,
                      const std::string& resolution_source = "the default; --resolution sets it");
 
+// The same notes for the end of an error message about the map (" (note; note)"), or "".
+std::string map_notes_suffix(const std::string& source, const io::MapLoadOptions& options, bool resolution_given);
+
 }  // namespace fleetmap::cli

@@ -283,8 +283,9 @@ int run_merge(const MergeCommandOptions& o) {
     if (!out.path.empty() && !io::is_standard_output(out.path)) fmt::print(report, "wrote {}\n", out.path.string());
   }
   if (placed < int(originals.size())) {
-    fmt::print(stderr, "fleetmap merge: {} of {} maps merged; the others have no reliable overlap\n", placed,
-               originals.size());
+    const std::size_t left = originals.size() - std::size_t(placed);
+    fmt::print(stderr, "fleetmap merge: {} of {} maps merged (the first is the reference); {} not merged: no reliable overlap\n",
+               placed, originals.size(), left == 1 ? std::string("1 map") : std::to_string(left) + " maps");
     return 1;
   }
   return 0;

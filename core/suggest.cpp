@@ -46,7 +46,7 @@ std::optional<std::string> closest_name(std::string_view word, const std::vector
   int best_distance = 0;
   for (const auto& name : names) {
     const int d = edit_distance(word, name);
-    const int allowed = std::max<int>(1, int(std::max(word.size(), name.size())) / 3);
+    const int allowed = int(std::max(word.size(), name.size())) / 3;
     // A prefix either way counts as close, but below any real edit match of the same length.
     const bool prefix = word.size() >= 2 && (starts_with_ignoring_case(name, word) || starts_with_ignoring_case(word, name));
     if (d > allowed && !prefix) continue;

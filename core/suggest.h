@@ -13,7 +13,8 @@ int edit_distance(std::string_view a, std::string_view b);
 
 // The name in `names` nearest to `word`: one within a third of the longer word's length in edits
 // (at least one edit), or one that starts with `word` or that `word` starts with (a cut or
-// lengthened flag). nullopt when nothing is that close, or when `word` is itself a name.
+// lengthened flag; not for a word of one or two letters). nullopt when nothing is that close, or
+// when `word` is itself a name.
 std::optional<std::string> closest_name(std::string_view word, const std::vector<std::string>& names);
 
 // " (did you mean 'robots'?)" for the closest name, or "" when there is none.

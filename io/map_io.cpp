@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <opencv2/core.hpp>
 #include <png.h>
 #include <yaml-cpp/yaml.h>
 #include <zlib.h>
@@ -29,6 +30,12 @@ namespace {
 
 // A pixel less opaque than this is transparent: nothing was drawn there, so it is unknown.
 constexpr int kOpaqueAlpha = 128;
+
+// map_saver writes unknown cells as this grey (and never negates). A trinary map holds only
+// map_saver's three values, so the thresholds merely have to separate them; nav2's map_saver wrote free_thresh 0.25, under
+// which this grey (occ 0.196) reads as free and the unmapped surround becomes floor. In trinary mode
+// it is unknown whatever the thresholds (as nav2's loader decided in 2025, PR #5278).
+constexpr int kSaverUnknown = 205;
 
 // No image side is longer (2^40 pixels); a header declaring more is refused as such.
 constexpr std::int64_t kHugeSide = std::int64_t{1} << 40;
@@ -192,7 +199,21 @@ cv::Mat read_image(const fs::path& path, const MapLoadOptions& options) {
 
 }  // namespace
 
-cv::Mat decode_map_image(const std::string& bytes, const std::string& source, const MapLoadOptions& options) {
+namespace {
+
+// The name of an image format that is not a map format, from its first bytes; "" when unknown.
+std::string image_format_name(const std::string& bytes) {
+  const auto starts = [&](std::string_view magic) { return bytes.compare(0, magic.size(), magic) == 0; };
+  if (starts("\xFF\xD8\xFF")) return "JPEG";
+  if (starts("GIF8")) return "GIF";
+  if (starts("BM")) return "BMP";
+  if (starts(std::string_view("II*\0", 4)) || starts(std::string_view("MM\0*", 4))) return "TIFF";
+  if (starts("RIFF") && bytes.size() >= 12 && bytes.compare(8, 4, "WEBP") == 0) return "WebP";
+  return "";
+}
+
+// The decoded samples, 8- or 16-bit as the file holds them.
+cv::Mat decode_samples(const std::string& bytes, const std::string& source, const MapLoadOptions& options) {
   if (bytes.empty()) throw InputError(source + ": empty file, expected a PNG or PGM image");
   if (bytes.size() > std::size_t{INT32_MAX}) throw InputError(source + ": file too large for an image");
   if (const auto size = peek_image_size(bytes)) check_size(source, size->first, size->second, options);
@@ -201,7 +222,11 @@ cv::Mat decode_map_image(const std::string& bytes, const std::string& source, co
   // PGM/PPM/PBM ("P1".."P6"); other formats OpenCV could decode (JPEG 2000, TIFF, ...) are not map
   // formats, and their decoders log to stderr.
   const bool is_pnm = bytes.size() >= 2 && bytes[0] == 'P' && bytes[1] >= '1' && bytes[1] <= '6';
-  if (!is_png && !is_pnm) throw InputError(source + ": not a PNG or PGM image");
+  if (!is_png && !is_pnm) {
+    const std::string kind = image_format_name(bytes);
+    throw InputError(source + ": " + (kind.empty() ? "not a PNG or PGM image" : "a " + kind + " image; fleetmap reads maps as "
+                                                      "PNG or PGM: convert it to PNG"));
+  }
   cv::Mat image;
   if (is_png) {
     image = decode_png(bytes, source, options);
@@ -210,10 +235,18 @@ cv::Mat decode_map_image(const std::string& bytes, const std::string& source, co
   }
   if (image.empty()) throw InputError(source + ": cannot decode image (not a valid PNG/PGM, or truncated)");
   check_size(source, image.cols, image.rows, options);
-  if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
-  if (image.depth() != CV_8U || image.channels() > 4) {
+  if (image.depth() != CV_8U && image.depth() != CV_16U) {
     throw InputError(source + ": unsupported image format (expected 8- or 16-bit grey, RGB or RGBA)");
   }
+  return image;
+}
+
+}  // namespace
+
+cv::Mat decode_map_image(const std::string& bytes, const std::string& source, const MapLoadOptions& options) {
+  cv::Mat image = decode_samples(bytes, source, options);
+  if (image.depth() == CV_16U) image.convertTo(image, CV_8U, 1.0 / 257.0);
+  if (image.channels() > 4) throw InputError(source + ": unsupported image format (expected 8- or 16-bit grey, RGB or RGBA)");
   return image;
 }
 
@@ -316,6 +349,8 @@ mapping::OccupancyGrid grid_from_image(const cv::Mat& image, const MapYaml& meta
       if (meta.mode == MapMode::Raw) {
         const int v = static_cast<int>(std::lround(colour));
         if (v <= 100) probability = v / 100.0;
+      } else if (meta.mode == MapMode::Trinary && !meta.negate && sum == kSaverUnknown * colour_channels) {
+        // map_saver's unknown grey, whatever the thresholds say (below).
       } else {
         const double occ = (255.0 - colour) / 255.0;
         if (occ > meta.occupied_thresh) probability = 1.0;
@@ -389,9 +424,6 @@ mapping::OccupancyGrid load_map(const fs::path& path, const MapLoadOptions& opti
 
 namespace {
 
-// The grey a threshold puts between two states: occ = (255 - grey) / 255.
-int grey_of(double occ) { return int(std::floor(255.0 * (1.0 - occ))); }
-
 std::string share(std::int64_t n, std::int64_t of) {
   return fmt::format("{} pixel{} ({:.1f}%)", n, n == 1 ? "" : "s", of > 0 ? 100.0 * double(n) / double(of) : 0.0);
 }
@@ -410,20 +442,35 @@ std::vector<std::string> map_reading_notes(const fs::path& path, const MapLoadOp
     meta = parse_map_yaml(io::read_file(path, 1 << 20), path.string());
     image_path = meta.image.is_absolute() ? meta.image : path.parent_path() / meta.image;
   }
-  const cv::Mat image = read_image(image_path, options);
+  cv::Mat image = decode_samples(io::read_file(image_path), image_path.string(), options);
   std::vector<std::string> notes;
   const std::string name = path.string();
   if (bare && !resolution_source.empty()) {
     notes.push_back(fmt::format("{}: a bare image (no map_server YAML), read at {} m per cell, {}", name, meta.resolution,
                                 resolution_source));
   }
+  if (meta.origin.theta != 0.0) {
+    notes.push_back(fmt::format("{}: origin yaw {} rad: coordinates (--from, --start, ...) are turned by it, while pictures "
+                                "draw the map in its own cells, unturned",
+                                name, meta.origin.theta));
+  }
+  if (image.depth() == CV_16U) {
+    double most = 0.0;
+    cv::minMaxLoc(image.reshape(1), nullptr, &most);
+    if (most <= 255.0) {
+      notes.push_back(fmt::format("{}: a 16-bit image whose samples all lie below 256, read on the 16-bit scale (as black): "
+                                  "if they are 8-bit greys, save the image as 8-bit",
+                                  name));
+    }
+    image.convertTo(image, CV_8U, 1.0 / 257.0);
+  }
   if (meta.mode == MapMode::Raw) return notes;
   const int channels = image.channels();
   const bool has_alpha = channels == 2 || channels == 4;
   const int colour_channels = has_alpha ? channels - 1 : channels;
-  std::int64_t pixels = 0, transparent = 0, walls = 0, coloured = 0, grey_unknown = 0;
-  std::int64_t coloured_as[3] = {0, 0, 0};  // wall, free, unknown
-  int darkest = 256, lightest = -1;
+  std::int64_t pixels = 0, transparent = 0, coloured = 0, grey_unknown = 0, saver_unknown = 0;
+  std::int64_t as[3] = {0, 0, 0}, coloured_as[3] = {0, 0, 0};  // wall, free, unknown
+  int darkest = 256, lightest = -1;  // of the grey pixels read as unknown, as they are in the file
   for (int row = 0; row < image.rows; ++row) {
     const std::uint8_t* p = image.ptr<std::uint8_t>(row);
     for (int x = 0; x < image.cols; ++x, p += channels) {
@@ -434,38 +481,60 @@ std::vector<std::string> map_reading_notes(const fs::path& path, const MapLoadOp
       }
       int sum = 0, lo = 255, hi = 0;
       for (int k = 0; k < colour_channels; ++k) sum += p[k], lo = std::min<int>(lo, p[k]), hi = std::max<int>(hi, p[k]);
-      double colour = double(sum) / colour_channels;
-      if (meta.negate) colour = 255.0 - colour;
-      const double occ = (255.0 - colour) / 255.0;
-      const int state = occ > meta.occupied_thresh ? 0 : occ < meta.free_thresh ? 1 : 2;
-      walls += state == 0;
+      const double raw = double(sum) / colour_channels;
+      const double occ = (255.0 - (meta.negate ? 255.0 - raw : raw)) / 255.0;
+      const bool saver = meta.mode == MapMode::Trinary && !meta.negate && sum == kSaverUnknown * colour_channels;
+      const int state = saver ? 2 : occ > meta.occupied_thresh ? 0 : occ < meta.free_thresh ? 1 : 2;
+      ++as[state];
       // A colour is a pixel whose channels differ by more than an eighth of the scale.
       if (hi - lo > 32) {
         ++coloured, ++coloured_as[state];
-      } else if (state == 2 && std::abs(colour - 205.0) > 2.0) {  // grey, but not map_saver's unknown 205
+      } else if (saver) {
+        ++saver_unknown;
+      } else if (state == 2 && std::abs(raw - kSaverUnknown) > 2.0) {
         ++grey_unknown;
-        darkest = std::min(darkest, int(std::lround(colour)));
-        lightest = std::max(lightest, int(std::lround(colour)));
+        darkest = std::min(darkest, int(std::lround(raw)));
+        lightest = std::max(lightest, int(std::lround(raw)));
       }
     }
   }
-  const int wall_grey = grey_of(meta.occupied_thresh), free_grey = grey_of(meta.free_thresh) + 1;
+  // occ = (255 - colour) / 255 with colour the grey, or 255 - the grey when negated.
+  const double wall_colour = 255.0 * (1.0 - meta.occupied_thresh), free_colour = 255.0 * (1.0 - meta.free_thresh);
+  const std::string thresholds = fmt::format("occupied_thresh {}, free_thresh {}{}{}", meta.occupied_thresh,
+                                             meta.free_thresh, meta.negate ? ", negate" : "",
+                                             bare ? ", map_server's defaults" : "");
   const std::string rule =
-      fmt::format("darker than {} is a wall, lighter than {} free: occupied_thresh {}, free_thresh {}{}", wall_grey + 1,
-                  free_grey - 1, meta.occupied_thresh, meta.free_thresh, bare ? ", map_server's defaults" : "");
+      meta.negate ? fmt::format("lighter than {} is a wall, darker than {} free: {}", int(std::floor(255.0 - wall_colour)),
+                                int(std::ceil(255.0 - free_colour)), thresholds)
+                  : fmt::format("darker than {} is a wall, lighter than {} free: {}", int(std::ceil(wall_colour)),
+                                int(std::floor(free_colour)), thresholds);
   if (transparent > 0) {
     notes.push_back(fmt::format("{}: {} are transparent, read as unknown", name, share(transparent, pixels)));
   }
-  if (grey_unknown > 0 && (walls == 0 || 100 * grey_unknown >= pixels)) {
-    const double occ = (255.0 - darkest) / 255.0;
+  const double saver_occ = (255.0 - kSaverUnknown) / 255.0;
+  if (saver_unknown > 0 && (saver_occ < meta.free_thresh || saver_occ > meta.occupied_thresh)) {
+    notes.push_back(fmt::format("{}: {} are map_saver's unknown grey {}, read as unknown as map_saver meant, although the "
+                                "thresholds ({}) would read them as {} (nav2's map_saver wrote free_thresh 0.25)",
+                                name, share(saver_unknown, pixels), kSaverUnknown, thresholds,
+                                saver_occ < meta.free_thresh ? "free" : "walls"));
+  }
+  if (grey_unknown > 0 && (as[0] == 0 || 100 * grey_unknown >= pixels)) {
+    const int wall_grey = meta.negate ? lightest : darkest;
+    const double occ = (255.0 - (meta.negate ? 255.0 - wall_grey : wall_grey)) / 255.0;
     notes.push_back(fmt::format("{}: {} are grey from {} to {}, between the thresholds, and read as unknown ({}); to read "
                                 "grey {} as walls, give a map_server YAML with occupied_thresh below {:.3f}",
-                                name, share(grey_unknown, pixels), darkest, lightest, rule, darkest, occ));
+                                name, share(grey_unknown, pixels), darkest, lightest, rule, wall_grey, occ));
   }
   if (coloured > 0) {
     notes.push_back(fmt::format("{}: {} are coloured, each read by the mean of its red, green and blue ({}): {} as walls, "
                                 "{} as free, {} as unknown",
                                 name, share(coloured, pixels), rule, coloured_as[0], coloured_as[1], coloured_as[2]));
+  }
+  // A building's map has more floor than wall; the other way round, free space may be drawn dark.
+  if (as[0] > as[1]) {
+    notes.push_back(fmt::format("{}: {} read as walls and {} as free; if free space is drawn dark, give a map_server YAML "
+                                "with negate: {}",
+                                name, share(as[0], pixels), share(as[1], pixels), meta.negate ? 0 : 1));
   }
   return notes;
 }

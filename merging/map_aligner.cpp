@@ -131,7 +131,7 @@ core::Registry<MapAlignerFactory>& map_aligner_registry() {
           make<OverlapAligner>());
     r.add("landmarks",
           "robots that can talk associate their estimated landmark maps by RANSAC (map-alignment paper, eq. (2)-(6)) "
-          "and merge once enough agree; needs a localizer that estimates landmarks (ekf-slam)",
+          "and merge once enough agree; needs a localizer that estimates landmarks (ekf-slam, fastslam2)",
           make<LandmarkAligner>());
     return true;
   }();

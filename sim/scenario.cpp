@@ -252,7 +252,11 @@ Scenario parse_scenario(const std::string& text, const std::string& source, cons
     outputs.finish();
   }
   top.finish();
-  validate_scenario(s);
+  try {
+    validate_scenario(s);
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());  // the key is in the message; the file is here
+  }
   return s;
 }
 

@@ -217,6 +217,49 @@ TEST(OwnMaps, ABareImageSaysWhichResolutionItTookAndMergesWithAMapServerMapAtIts
   EXPECT_NE(slurp(dir / "b1" / "scenario.yaml").find("map_resolution: 0.1"), std::string::npos);
 }
 
+TEST(OwnMaps, Nav2MapSaverThresholdsKeepItsUnknownGreyUnknown) {
+  TempDir dir;
+  cv::imwrite((dir / "map.pgm").string(), courtyard_lab());
+  // As nav2's map_saver writes it: trinary, free_thresh 0.25, a negative origin.
+  dir.write("map.yaml", "image: map.pgm\nmode: trinary\nresolution: 0.1\norigin: [-5.0, -5.0, 0]\nnegate: 0\n"
+                        "occupied_thresh: 0.65\nfree_thresh: 0.25\n");
+  const auto grid = io::load_map(dir / "map.yaml");
+  EXPECT_EQ(grid.count(mapping::CellState::Unknown), cv::countNonZero(courtyard_lab() == kLabUnknown));
+  const auto r = run_fleetmap("maps show map.yaml --out show.png", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("are map_saver's unknown grey 205, read as unknown as map_saver meant, although the thresholds "
+                       "(occupied_thresh 0.65, free_thresh 0.25) would read them as free"),
+            std::string::npos)
+      << r.err;
+  // Planning cannot cut through the unmapped courtyard.
+  const auto plan = run_fleetmap("plan --map map.yaml --from 0,15 --to 10,15 --planner astar --out p.png", dir);
+  EXPECT_NE(plan.exit_code, 0) << plan.out;
+  EXPECT_NE(plan.err.find("unknown space"), std::string::npos) << plan.err;
+}
+
+TEST(OwnMaps, MapsDrawnDarkOn16BitsOrTurnedAreSaid) {
+  TempDir dir;
+  cv::Mat dark;
+  cv::bitwise_not(courtyard_lab(), dark);
+  dark.setTo(0, courtyard_lab() == kLabUnknown);  // no unknown: free space black, walls white
+  cv::imwrite((dir / "dark.png").string(), dark);
+  const auto show = run_fleetmap("maps show dark.png --resolution 0.1 --out s.png", dir);
+  EXPECT_NE(show.err.find("if free space is drawn dark, give a map_server YAML with negate: 1"), std::string::npos)
+      << show.err;
+  const auto explore = run_fleetmap("explore --map dark.png --resolution 0.1 --out run", dir);
+  EXPECT_ONE_LINE_ERROR(explore, "negate: 1");
+  cv::Mat sixteen;
+  courtyard_lab().convertTo(sixteen, CV_16U);  // 8-bit greys stored in 16 bits
+  cv::imwrite((dir / "sixteen.png").string(), sixteen);
+  EXPECT_NE(run_fleetmap("maps show sixteen.png --resolution 0.1 --out s16.png", dir)
+                .err.find("a 16-bit image whose samples all lie below 256"),
+            std::string::npos);
+  cv::imwrite((dir / "lab.pgm").string(), courtyard_lab());
+  dir.write("turned.yaml", "image: lab.pgm\nresolution: 0.1\norigin: [0, 0, 0.5]\n");
+  EXPECT_NE(run_fleetmap("maps show turned.yaml --out t.png", dir).err.find("origin yaw 0.5 rad: coordinates"),
+            std::string::npos);
+}
+
 TEST(OwnMaps, TheReadmeChainRunsWithRobotsThatDoNotMerge) {
   TempDir dir;
   // Each robot explores the whole map alone (about 1850 steps, 3 s).
@@ -254,12 +297,25 @@ TEST(OwnMaps, MistypedFlagsValuesAndCommandsGetTheNearestName) {
   EXPECT_ONE_LINE_ERROR(run_fleetmap("plan --map office --planner rrtstr", dir), "(did you mean 'rrtstar'?)");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("bench --merging overlp", dir), "(did you mean 'overlap'?)");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map office 4", dir), "unexpected argument '4'");
+  // A flag whose value repeats an earlier one is still named, and so is a flag before any command.
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --robots 4 --sensor_range 4", dir),
+                        "unknown flag '--sensor_range' (did you mean '--sensor-range'?)");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("--verison", dir), "unknown flag '--verison' (did you mean '--version'?)");
+  // A mistyped flag is named, not its value taken for a file.
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("replay-compare a.html b.html --lable x y", dir),
+                        "unknown flag '--lable' (did you mean '--label'?)");
   // Scenario files: keys and values.
   dir.write("s.yaml", "map: office\nrobots: {cuont: 2}\n");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario s.yaml", dir),
                         "unknown key 'robots.cuont' (did you mean 'count'?) (valid in 'robots': count, random, starts");
   dir.write("t.yaml", "map: office\nexploration: {strategy: tuor}\n");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario t.yaml", dir), "unknown value 'tuor' (did you mean 'tour'?)");
+  // Errors found after reading still name the file.
+  dir.write("u.yaml", "map: office\nlocalization: {method: ekf_slam}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario u.yaml", dir),
+                        "u.yaml: localization: unknown value 'ekf_slam' (did you mean 'ekf-slam'?)");
+  dir.write("v.yaml", "map: ofice\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario v.yaml", dir), "v.yaml: map: unknown map 'ofice' (did you mean 'office'?)");
 }
 
 }  // namespace

@@ -209,9 +209,16 @@ TEST(MapIo, TrinaryThresholdsAsMapServer) {
                             S::Free, S::Free, S::Free}));
   meta.occupied_thresh = 0.5;
   meta.free_thresh = 0.3;
+  // map_saver's unknown grey 205 stays unknown in trinary mode whatever free_thresh says (nav2's
+  // map_saver wrote 0.25); scale mode and negated maps keep the thresholds' reading.
   EXPECT_EQ(states(grid_from_image(row, meta)),
-            (std::vector<S>{S::Occupied, S::Occupied, S::Occupied, S::Occupied, S::Unknown, S::Free, S::Free,
+            (std::vector<S>{S::Occupied, S::Occupied, S::Occupied, S::Occupied, S::Unknown, S::Unknown, S::Free,
                             S::Free, S::Free, S::Free}));
+  meta.mode = MapMode::Scale;
+  EXPECT_EQ(grid_from_image(row, meta).state({5, 0}), S::Free);
+  meta.mode = MapMode::Trinary;
+  meta.negate = true;  // 205 reads as 50: occ 0.80, a wall
+  EXPECT_EQ(grid_from_image(row, meta).state({5, 0}), S::Occupied);
 }
 
 TEST(MapIo, NegateInvertsColours) {
@@ -313,7 +320,7 @@ TEST(MapIoBadInput, EmptyAndUndecodableImages) {
   std::vector<std::uint8_t> jpeg;
   cv::imencode(".jpg", cv::Mat(50, 50, CV_8UC1, cv::Scalar(254)), jpeg);
   expect_input_error([&] { load_map(dir.write("photo.png", std::string(jpeg.begin(), jpeg.end()))); },
-                     {"photo.png", "not a PNG or PGM image"});
+                     {"photo.png", "a JPEG image; fleetmap reads maps as PNG or PGM: convert it to PNG"});
 }
 
 TEST(MapIoBadInput, ImageOverTheSizeLimit) {
