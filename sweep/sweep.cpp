@@ -12,6 +12,7 @@
 #include "core/format.h"
 #include "core/error.h"
 #include "io/file_io.h"
+#include "io/file_kind.h"
 #include "io/yaml_reader.h"
 
 namespace fleetmap::sweep {
@@ -270,6 +271,7 @@ double parse_comm_range(const std::string& text, const std::string& what) {
 Sweep parse_sweep(const std::string& text, const std::string& source, const fs::path& base_dir) {
   const YAML::Node root = io::parse_yaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty sweep file");
+  io::check_yaml_file_kind(root, source, io::YamlFileKind::Sweep);
   io::YamlMap top(root, source);
   Sweep sweep;
   if (const auto scenario = top.node("scenario")) {
