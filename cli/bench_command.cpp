@@ -22,6 +22,7 @@
 #include "core/format.h"
 #include "core/error.h"
 #include "io/file_io.h"
+#include "io/yaml_reader.h"
 #include "io/map_io.h"
 #include "exploration/strategy.h"
 #include "localization/localizer.h"
@@ -38,6 +39,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+constexpr const char* kCompareMetric = "steps_to_99";
+
 struct BenchFlags {
   std::string sweep_file;
   SweepFlags sweep;
@@ -46,7 +49,7 @@ struct BenchFlags {
   std::string out;
   std::vector<std::string> combine;
   std::vector<std::string> compare;
-  std::string metric = "steps_to_99";
+  std::optional<std::string> metric;  // of --compare
   bool quiet = false;
   bool html = false;
 };
@@ -85,6 +88,33 @@ std::optional<sweep::Sweep> sweep_of(const fs::path& dir) {
                e.what());
     return std::nullopt;
   }
+}
+
+// The first top-level key whose value differs between two YAML texts, with both values as
+// flow YAML ("(none)" where a text lacks the key); nullopt when every key is the same.
+struct KeyDifference {
+  std::string key, a, b;
+};
+std::optional<KeyDifference> first_differing_key(const std::string& a_text, const std::string& a_source,
+                                                 const std::string& b_text, const std::string& b_source) {
+  const YAML::Node a = io::parse_yaml(a_text, a_source), b = io::parse_yaml(b_text, b_source);
+  const auto flow = [](const YAML::Node& root, const std::string& key) {
+    if (!root.IsMap() || !root[key]) return std::string("(none)");
+    YAML::Emitter out;
+    out << YAML::Flow << root[key];
+    return std::string(out.c_str());
+  };
+  std::vector<std::string> keys;
+  for (const auto& root : {a, b}) {
+    if (!root.IsMap()) continue;
+    for (const auto& kv : root) {
+      if (std::find(keys.begin(), keys.end(), kv.first.Scalar()) == keys.end()) keys.push_back(kv.first.Scalar());
+    }
+  }
+  for (const auto& key : keys) {
+    if (flow(a, key) != flow(b, key)) return KeyDifference{key, flow(a, key), flow(b, key)};
+  }
+  return std::nullopt;
 }
 
 // The first line where two texts differ, for messages: "seeds: 6" against "seeds: 4".
@@ -139,11 +169,12 @@ void print_outputs(const fs::path& out, const std::vector<fs::path>& reports) {
 
 int run_compare(const BenchFlags& f) {
   if (any_sweep_flag(f) || !f.combine.empty()) throw InputError("--compare A B DIR takes no sweep flags and no --combine");
+  if (f.metric) sweep::find_report_metric(*f.metric, "--metric");
   const fs::path path = results_of(f.compare[2], "--compare");
   const auto table = sweep::read_results(path);
   const auto comparison = [&] {
     try {
-      return sweep::compare_strategies(table.records, f.compare[0], f.compare[1], f.metric);
+      return sweep::compare_strategies(table.records, f.compare[0], f.compare[1], f.metric.value_or(kCompareMetric));
     } catch (const InputError& e) {
       throw InputError(std::string(e.what()).rfind("metric", 0) == 0 ? "--" + std::string(e.what())
                                                                      : "--compare: " + std::string(e.what()));
@@ -160,13 +191,32 @@ int run_combine(const BenchFlags& f) {
   std::map<sweep::RunKey, std::pair<std::size_t, fs::path>> seen;
   std::string settings;
   fs::path settings_from;
-  std::optional<sweep::Sweep> sweep;
+  // Shards of one sweep have the same sweep.yaml, compared as text (so that one a strategy
+  // registered in Python wrote, which does not load here, is compared too).
+  std::string definition;
+  std::optional<fs::path> definition_from;
   for (const auto& dir : f.combine) {
     const fs::path path = results_of(dir, "--combine");
     auto table = sweep::read_results(path);
     if (settings.empty() && !table.records.empty()) settings = table.records.front().settings, settings_from = path;
     sweep::check_settings(table.records, settings, path);
-    if (!sweep) sweep = sweep_of(dir);
+    const fs::path yaml = fs::path(dir) / "sweep.yaml";
+    const std::optional<std::string> text =
+        io::is_regular_file(yaml) ? std::optional(io::read_file(yaml, std::size_t{1} << 20)) : std::nullopt;
+    if (dir == f.combine.front()) {
+      definition_from = text ? std::optional(fs::path(dir)) : std::nullopt;
+      definition = text.value_or("");
+    } else if (text.has_value() != definition_from.has_value()) {
+      const std::string with = text ? dir : f.combine.front(), without = text ? f.combine.front() : dir;
+      throw InputError("--combine: " + with + " has a sweep.yaml and " + without +
+                       " none, so they cannot be shards of one sweep; combine the shards of one sweep only");
+    } else if (text) {
+      if (const auto d = first_differing_key(definition, (*definition_from / "sweep.yaml").string(), *text, yaml.string())) {
+        throw InputError("--combine: " + definition_from->string() + " and " + dir + " are results of different sweeps (" +
+                         "their sweep.yaml has '" + d->key + ": " + io::printable(d->a) + "' against '" + d->key + ": " +
+                         io::printable(d->b) + "'); combine the shards of one sweep only");
+      }
+    }
     for (auto& r : table.records) {
       if (const auto it = seen.find(r.key); it != seen.end()) {
         if (sweep::record_without_wall_time(records[it->second.first]) != sweep::record_without_wall_time(r)) {
@@ -179,6 +229,7 @@ int run_combine(const BenchFlags& f) {
       records.push_back(std::move(r));
     }
   }
+  const std::optional<sweep::Sweep> sweep = definition_from ? sweep_of(*definition_from) : std::nullopt;
   const fs::path out = f.out;
   std::vector<fs::path> inputs;
   for (const auto& dir : f.combine) inputs.push_back(fs::path(dir) / "results.csv");
@@ -213,6 +264,7 @@ int run_combine(const BenchFlags& f) {
 }
 
 int run_bench(const BenchFlags& f) {
+  if (f.metric && f.compare.empty()) throw InputError("--metric goes with --compare A B DIR: it names the metric compared");
   if (f.compare.size() == 3) return run_compare(f);
   if (!f.combine.empty()) return run_combine(f);
 
@@ -305,9 +357,11 @@ int run_bench(const BenchFlags& f) {
     fmt::print("{}\n", results.string());
     return 0;
   }
-  fmt::print("{} runs of {} x {} x {} x {}", all_runs.size(), counted(sweep.maps.size(), "map"),
+  std::size_t variants = 1;
+  for (const auto& axis : sweep.axes) variants *= axis.values.size();
+  fmt::print("{} runs of {} x {} x {}{} x {}", all_runs.size(), counted(sweep.maps.size(), "map"),
              counted(sweep.strategies.size(), "strategy", "strategies"), counted(sweep.robots.size(), "team size"),
-             counted(std::size_t(sweep.seeds), "seed"));
+             sweep.axes.empty() ? "" : " x " + counted(variants, "variant"), counted(std::size_t(sweep.seeds), "seed"));
   if (shard) fmt::print("; shard {}/{}: {} runs", shard->index, shard->count, runs.size());
   fmt::print("\nran {} in {:.1f} s with {} job{}; {} already in results.csv\n", counted(todo.size(), "run"), elapsed,
              std::max(1, std::min<int>(f.jobs, int(std::max<std::size_t>(1, todo.size())))),
@@ -376,7 +430,7 @@ Command add_bench_command(CLI::App& root) {
   app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")
       ->check(in_range(sweep::kJobsRange));
   app->add_option("--shard", f->shard, "Run only the K-th of N slices of the sweep, K/N (for clusters; see bench/slurm/)");
-  app->add_option("--out", f->out,
+  app->add_option("--out,-o", f->out,
                   "Output folder: new, empty, or of an earlier run of the very same sweep, which is resumed "
                   "[default: out/bench]");
   app->add_option("--combine", f->combine, "Join the results of these output folders (shards) into --out")->expected(1, -1);
@@ -385,8 +439,8 @@ Command add_bench_command(CLI::App& root) {
                   "(robots=2 robots=4, beams=90 beams=360: any --vary axis); runs pair when all else is equal")
       ->expected(3);
   app->add_option("--metric", f->metric,
-                  "Metric of --compare: steps_to_95, steps_to_99, distance_m, redundancy, bytes_sent, efficiency, coverage")
-      ->capture_default_str();
+                  std::string("Metric of --compare: steps_to_95, steps_to_99, distance_m, redundancy, bytes_sent, efficiency, "
+                              "coverage [default: ") + kCompareMetric + "]");
   app->add_flag("--quiet,-q", f->quiet, "Print only the path of results.csv; no progress bar");
   app->add_flag("--html", f->html,
                 "Also write each run's replay page (replay_<map>_<strategy>_<robots>r_s<seed>.html, as explore --html), "

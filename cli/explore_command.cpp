@@ -488,7 +488,7 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--plan-time", f->plan_time, "Time budget of that plan, seconds")
       ->capture_default_str()
       ->check(in_range(planning::kTimeBudgetRange));
-  app->add_option("--out", f->out,
+  app->add_option("--out,-o", f->out,
                   "Output folder: new, empty, or of an earlier explore run (its files are replaced) [default: out/<map>]");
   app->add_flag("--animate", f->animate, "Also write run.mp4 (H.264), a frame per step");
   app->add_flag("--html", f->html,

@@ -43,6 +43,9 @@ int run_compare(const CompareOptions& o) {
   if (o.pages.size() < 2 || o.pages.size() > 4) throw InputError("replay-compare: give two to four replay pages (replay.html)");
   if (!o.labels.empty() && o.labels.size() != o.pages.size())
     throw InputError(fmt::format("--label: give one per page ({} pages, {} labels)", o.pages.size(), o.labels.size()));
+  if (!io::is_standard_output(o.out) && fs::path(o.out).extension() != ".html") {
+    throw InputError("--out " + io::printable(o.out) + ": the comparison is an HTML page; give a name ending in .html (or - for the standard output)");
+  }
   std::vector<fs::path> inputs(o.pages.begin(), o.pages.end());
   const std::vector<OutputFile> outputs = {{"--out", o.out}};
   check_outputs(outputs, inputs);
@@ -78,7 +81,7 @@ Command add_replay_compare_command(CLI::App& root) {
       ->required()
       ->check(CLI::ExistingFile);
   app->add_option("--label", opts->labels, "a name per page, in order (default: each page's folder name)");
-  app->add_option("--out", opts->out, "the comparison page to write (default compare.html)");
+  app->add_option("--out,-o", opts->out, "the comparison page to write, NAME.html, or - for the standard output (default compare.html)");
   return {app, [opts] { return run_compare(*opts); }};
 }
 

@@ -34,7 +34,7 @@ struct SlamFlags {
   std::string scenario;
   std::optional<int> runs;
   std::optional<std::uint64_t> seed;
-  int jobs = 1;
+  std::optional<int> jobs;
   std::string out;
   bool quiet = false;
   bool sampled_start = false;
@@ -43,12 +43,29 @@ struct SlamFlags {
 
 std::string method_names() { return core::join(experiments::slam_method_names()); }
 
+// Refuses each of `unused` that was given: the scenario's experiment has no use for it.
+void refuse_unused_flags(const SlamFlags& f, const std::string& experiment, const std::vector<std::string>& unused) {
+  const std::pair<const char*, bool> given[] = {
+      {"--runs", f.runs.has_value()}, {"--jobs", f.jobs.has_value()}, {"--sampled-start", f.sampled_start}, {"--exact-start", f.exact_start}};
+  for (const auto& [flag, set] : given) {
+    if (set && std::find(unused.begin(), unused.end(), flag) != unused.end()) {
+      throw InputError(std::string(flag) + " does not apply to the " + experiment + " experiment of " + f.scenario);
+    }
+  }
+}
+
 int run_slam(const SlamFlags& f) {
   const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
   // The corridor loop of León et al. (experiment: leon_corridor) has its own runner.
-  if (is_corridor_scenario_file(f.scenario)) return run_corridor_scenario(f.scenario, out, f.seed, f.quiet);
+  if (is_corridor_scenario_file(f.scenario)) {
+    refuse_unused_flags(f, "leon_corridor", {"--runs", "--jobs", "--sampled-start", "--exact-start"});
+    return run_corridor_scenario(f.scenario, out, f.seed, f.quiet);
+  }
   // The map-alignment paper's experiments (experiment: landmark_alignment) too.
-  if (is_landmark_scenario_file(f.scenario)) return run_landmark_scenario(f.scenario, out, f.runs, f.seed, f.jobs, f.quiet);
+  if (is_landmark_scenario_file(f.scenario)) {
+    refuse_unused_flags(f, "landmark_alignment", {"--sampled-start", "--exact-start"});
+    return run_landmark_scenario(f.scenario, out, f.runs, f.seed, f.jobs.value_or(1), f.quiet);
+  }
   experiments::SlamScenario s = experiments::load_slam_scenario(f.scenario);
   if (f.runs) s.runs = *f.runs;
   if (f.seed) s.seed = *f.seed;
@@ -71,7 +88,7 @@ int run_slam(const SlamFlags& f) {
   int done = 0;
   bar.update(0, total, "runs");
   core::parallel_for(
-      total, f.jobs,
+      total, f.jobs.value_or(1),
       [&](int job) {
         if (job < s.runs) {
           campaign.team[std::size_t(job)] = experiments::run_slam(setup, job, s.exchange);
@@ -108,10 +125,12 @@ Command add_slam_command(CLI::App& root) {
       "\n  polynomial: D'Alfonso et al.'s polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
       "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso\n\n"
       "Scenarios with `experiment: leon_corridor` (scenarios/leon_corridor.yaml) run León et al.'s corridor comparison\n"
-      "and merging by detection instead (--runs and --jobs do not apply); README.md, \"Grid SLAM and MCL (León et al.)\".\n\n"
+      "and merging by detection instead (--runs, --jobs, --sampled-start and --exact-start do not apply);\n"
+      "README.md, \"Grid SLAM and MCL (León et al.)\".\n\n"
       "Scenarios with `experiment: landmark_alignment` (scenarios/landmark_alignment.yaml) run the map-alignment paper's\n"
       "experiments: FastSLAM 2.0 landmark maps aligned by data association or inter-robot observations, Tables I-III,\n"
-      "Fig. 2 and the leader/follower merges; README.md, \"Landmark map alignment (map-alignment paper)\".");
+      "Fig. 2 and the leader/follower merges (--sampled-start and --exact-start do not apply); README.md,\n"
+      "\"Landmark map alignment (map-alignment paper)\".");
   auto f = std::make_shared<SlamFlags>();
   app->add_option("--scenario", f->scenario, "SLAM scenario YAML (see scenarios/dalfonso_3robots.yaml)")
       ->required()
@@ -122,7 +141,7 @@ Command add_slam_command(CLI::App& root) {
       ->check(seed_number());
   app->add_option("--jobs", f->jobs, "Runs computed in parallel, one thread each; results do not depend on it [default: 1]")
       ->check(in_range(sweep::kJobsRange));
-  app->add_option("--out", f->out,
+  app->add_option("--out,-o", f->out,
                   "Output folder: new, empty, or of an earlier slam run (its files are replaced) "
                   "[default: out/slam_<scenario name>]");
   auto* sampled = app->add_flag("--sampled-start", f->sampled_start,

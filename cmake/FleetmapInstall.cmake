@@ -11,7 +11,7 @@ set(FLEETMAP_MODULES core mapping io viz maps localization merging planning expl
 # nlohmann::json) in their declarations, and only fleetmap's own sources and the CLI need them.
 # The pictures (viz/, the run, sweep and experiment reports) are OpenCV images throughout.
 set(FLEETMAP_INTERNAL_HEADERS
-  sim/video_module.h io/yaml_reader.h io/map_image.h maps/generated_maps.h merging/grid_level.h merging/hamming.h mapping/state_mask.h sim/scenario_yaml.h sim/run_output.h sim/run_replay.h
+  sim/video_module.h io/yaml_reader.h io/file_kind.h io/map_image.h maps/generated_maps.h merging/grid_level.h merging/hamming.h mapping/state_mask.h sim/scenario_yaml.h sim/run_output.h sim/run_replay.h
   sweep/sweep_report.h experiments/slam_output.h experiments/corridor_output.h)
 file(GLOB viz_headers RELATIVE ${PROJECT_SOURCE_DIR} CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/viz/*.h)
 list(APPEND FLEETMAP_INTERNAL_HEADERS ${viz_headers})

@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "experiments/slam_experiment.h"
 #include "io/file_io.h"
+#include "io/file_kind.h"
 #include "io/yaml_reader.h"
 #include "sim/scenario.h"
 #include "sim/scenario_yaml.h"
@@ -72,6 +73,7 @@ std::vector<mapping::WallSegment> room_walls(const SlamRoom& room) {
 SlamScenario parse_slam_scenario(const std::string& text, const std::string& source) {
   const YAML::Node root = io::parse_yaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
+  io::check_yaml_file_kind(root, source, io::YamlFileKind::SlamScenario);
   io::YamlMap top(root, source);
   SlamScenario s;
   s.method = top.choice("method", s.method, slam_method_names());

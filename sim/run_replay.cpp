@@ -251,6 +251,7 @@ std::string RunReplay::html(const RunResult& result, const std::string& map_labe
   r.merged = merged_.layer;
   for (const auto& o : own_) r.robot_maps.push_back(o.layer);
   r.robots = robots_;
+  for (std::size_t i = 0; i < r.robots.size() && i < result.robots.size(); ++i) r.robots[i].distance_m = result.robots[i].distance_m;
   for (const auto& e : result.events) r.events.push_back({e.step, e.kind, e.robot, e.other, e.detail, std::nullopt});
   for (const auto& m : result.merges) {
     if (m.merged) continue;  // a merge made is an event of the run already

@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/suggest.h"
 #include "io/file_io.h"
+#include "io/file_kind.h"
 #include "io/map_io.h"
 #include "io/yaml_reader.h"
 #include "exploration/strategy.h"
@@ -228,6 +229,7 @@ void read_merging(io::YamlMap& top, Scenario& s) {
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
   const YAML::Node root = io::parse_yaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty scenario file");
+  io::check_yaml_file_kind(root, source, io::YamlFileKind::ExploreScenario);
   io::YamlMap top(root, source);
   Scenario s;
   s.base_dir = base_dir;

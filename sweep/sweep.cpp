@@ -11,7 +11,9 @@
 #include <fmt/format.h>
 #include "core/format.h"
 #include "core/error.h"
+#include "core/suggest.h"
 #include "io/file_io.h"
+#include "io/file_kind.h"
 #include "io/yaml_reader.h"
 
 namespace fleetmap::sweep {
@@ -72,6 +74,42 @@ const std::vector<std::pair<std::string, std::string>>& axis_aliases() {
       {"steps", "steps"},                        {"noise_position", "noise.position"},
   };
   return kAliases;
+}
+
+std::vector<std::string> short_names() {
+  std::vector<std::string> names;
+  for (const auto& [alias, full] : axis_aliases()) names.push_back(alias);
+  return names;
+}
+
+// The short names, and every key of a scenario file that holds one value, dotted
+// ("sensors.range.beams"): the settings an axis can vary.
+const std::vector<std::string>& axis_settings() {
+  static const std::vector<std::string> kSettings = [] {
+    std::vector<std::string> names = short_names();
+    const auto walk = [&](const auto& self, const YAML::Node& node, const std::string& prefix) -> void {
+      for (const auto& kv : node) {
+        const std::string key = prefix + kv.first.Scalar();
+        if (kv.second.IsMap()) self(self, kv.second, key + ".");
+        else names.push_back(key);
+      }
+    };
+    walk(walk, YAML::Load(sim::scenario_to_yaml(sim::Scenario{})), "");
+    return names;
+  }();
+  return kSettings;
+}
+
+// "(valid: beams, sensor_range, ..., or a scenario file's key, dotted, such as sensors.range.noise)".
+std::string valid_settings_text() {
+  return "(valid: " + join(short_names()) + ", or a scenario file's key, dotted, such as sensors.range.noise)";
+}
+
+// "what: unknown strategy 'x' (did you mean 'y'?) (valid: ...)".
+InputError unknown_strategy(const std::string& what, const std::string& name) {
+  const auto valid = exploration::strategy_names();
+  return InputError(what + ": unknown strategy '" + name + "'" + core::did_you_mean(name, valid) + " (valid: " + join(valid) +
+                    ", or all on its own)");
 }
 
 // Sets the dotted `path` of a YAML mapping to a scalar, making the mappings on the way.
@@ -137,16 +175,15 @@ SweepAxis make_axis(const std::string& key, const std::vector<std::string>& valu
   const std::string& k = axis.scenario_key;
   if (k.empty() || k.find_first_of(" =,\"'") != std::string::npos || k.front() == '.' || k.back() == '.' ||
       k.find("..") != std::string::npos) {
-    throw InputError(what + ": '" + key + "' is not a setting; give a scenario key such as sensors.range.beams, or one of " +
-                     [] {
-                       std::string names;
-                       for (const auto& [alias, full] : axis_aliases()) names += (names.empty() ? "" : ", ") + alias;
-                       return names;
-                     }());
+    throw InputError(what + ": '" + key + "' is not a setting " + valid_settings_text());
   }
   if (k == "map" || k == "seed" || k == "robots" || k.rfind("robots.", 0) == 0 || k == "exploration.strategy" ||
       k == "strategy") {
     throw InputError(what + ": '" + key + "' is an axis of every sweep already; use maps, robots, strategies or seeds");
+  }
+  if (const auto& settings = axis_settings(); std::find(settings.begin(), settings.end(), k) == settings.end()) {
+    throw InputError(what + ": unknown setting '" + axis.name + "'" + core::did_you_mean(axis.name, settings) + " " +
+                     valid_settings_text());
   }
   if (values.empty()) throw InputError(what + ": '" + key + "' needs at least one value");
   for (const auto& v : values) {
@@ -208,6 +245,12 @@ std::string variant_without(const std::string& variant, const std::string& name)
   return out;
 }
 
+std::vector<std::string> variant_names(const std::string& variant) {
+  std::vector<std::string> names;
+  for (const auto& item : variant_items(variant)) names.push_back(item.substr(0, item.find('=')));
+  return names;
+}
+
 void use_base(Sweep& sweep, sim::Scenario base) {
   if (base.placement == sim::Placement::List) base.placement = sim::Placement::Cluster, base.starts.clear();
   sweep.base = std::move(base);
@@ -228,9 +271,8 @@ std::vector<std::string> parse_strategy_list(const std::string& text, const std:
   if (trim(text) == "all") return valid;
   auto names = split_list(text, what);
   for (const auto& n : names) {
-    if (std::find(valid.begin(), valid.end(), n) == valid.end()) {
-      throw InputError(what + ": unknown strategy '" + n + "' (valid: " + join(valid) + ", or all)");
-    }
+    if (n == "all") throw InputError(what + ": 'all' stands alone (every strategy); give all, or a list of strategies without it");
+    if (std::find(valid.begin(), valid.end(), n) == valid.end()) throw unknown_strategy(what, n);
   }
   check_unique(names, what);
   return names;
@@ -270,6 +312,7 @@ double parse_comm_range(const std::string& text, const std::string& what) {
 Sweep parse_sweep(const std::string& text, const std::string& source, const fs::path& base_dir) {
   const YAML::Node root = io::parse_yaml(text, source);
   if (!root || root.IsNull()) throw InputError(source + ": empty sweep file");
+  io::check_yaml_file_kind(root, source, io::YamlFileKind::Sweep);
   io::YamlMap top(root, source);
   Sweep sweep;
   if (const auto scenario = top.node("scenario")) {
@@ -347,9 +390,7 @@ void validate_sweep(const Sweep& sweep) {
   }
   const auto valid = exploration::strategy_names();
   for (const auto& s : sweep.strategies) {
-    if (std::find(valid.begin(), valid.end(), s) == valid.end()) {
-      throw InputError("strategies: unknown strategy '" + s + "' (valid: " + join(valid) + ", or all)");
-    }
+    if (std::find(valid.begin(), valid.end(), s) == valid.end()) throw unknown_strategy("strategies", s);
   }
   for (int n : sweep.robots) {
     if (n < 1 || n > 64) throw InputError("robots: team size " + std::to_string(n) + ": expected 1 to 64");

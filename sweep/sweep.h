@@ -89,6 +89,8 @@ std::string variant_label(const std::vector<SweepAxis>& axes, const std::vector<
 std::optional<std::string> variant_value(const std::string& variant, const std::string& name);
 // The label without `name=...`.
 std::string variant_without(const std::string& variant, const std::string& name);
+// The setting names of a variant label, in order ("beams", "comm_range").
+std::vector<std::string> variant_names(const std::string& variant);
 
 // Every run, in the fixed order map, strategy, team size, axes, seed (seed varies fastest).
 std::vector<SweepRun> sweep_runs(const Sweep& sweep);

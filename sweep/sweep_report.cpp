@@ -11,6 +11,8 @@
 
 #include "core/format.h"
 #include "core/error.h"
+#include "core/suggest.h"
+#include "exploration/strategy.h"
 #include "io/file_io.h"
 #include "io/map_image.h"
 #include "io/map_io.h"
@@ -121,7 +123,7 @@ const ReportMetric& find_report_metric(const std::string& name, const std::strin
     if (m.name == name) return m;
     names.push_back(m.name);
   }
-  throw InputError(what + ": unknown metric '" + name + "' (valid: " + join(names) + ")");
+  throw InputError(what + ": unknown metric '" + name + "'" + core::did_you_mean(name, names) + " (valid: " + join(names) + ")");
 }
 
 std::vector<GroupSummary> summarize_groups(const std::vector<RunRecord>& records) {
@@ -386,13 +388,24 @@ RunKey partner_key(const RunRecord& r, const std::string& axis) {
   return k;
 }
 
-std::string values_present(const std::vector<RunRecord>& records, const std::string& axis) {
+std::vector<std::string> values_present(const std::vector<RunRecord>& records, const std::string& axis) {
   std::vector<std::string> values;
   for (const auto& r : records) {
     const auto v = value_on(r, axis);
     if (v && std::find(values.begin(), values.end(), *v) == values.end()) values.push_back(*v);
   }
-  return values.empty() ? std::string("none") : join(values);
+  return values;
+}
+
+// The settings runs can be compared on: robots, map, and the axes the sweep varied.
+std::vector<std::string> axes_present(const std::vector<RunRecord>& records) {
+  std::vector<std::string> axes = {"robots", "map"};
+  for (const auto& r : records) {
+    for (const auto& name : variant_names(r.key.variant)) {
+      if (std::find(axes.begin(), axes.end(), name) == axes.end()) axes.push_back(name);
+    }
+  }
+  return axes;
 }
 
 }  // namespace
@@ -409,13 +422,18 @@ StrategyComparison compare_strategies(const std::vector<RunRecord>& records, con
   for (const auto& x : {a, b}) {
     const bool present = std::any_of(records.begin(), records.end(), [&](const RunRecord& r) { return value_on(r, axis) == x.value; });
     if (present) continue;
+    const auto values = values_present(records, axis);
+    const std::string there = values.empty() ? std::string("none") : join(values);
     if (axis == "strategy") {
-      throw InputError("no runs of strategy '" + x.value + "' in the results (strategies there: " +
-                       values_present(records, axis) + ")");
+      // A strategy that exists but was not run is no typo.
+      const auto known = exploration::strategy_names();
+      const bool exists = std::find(known.begin(), known.end(), x.value) != known.end();
+      throw InputError("no runs of strategy '" + x.value + "' in the results" + (exists ? "" : core::did_you_mean(x.value, values)) +
+                       " (strategies there: " + there + ")");
     }
-    throw InputError("no runs with " + axis + "=" + x.value + " in the results (" + axis + " there: " +
-                     values_present(records, axis) + "; settings to compare: strategy names, robots=N, map=NAME, or an "
-                     "axis the sweep varied)");
+    const std::string hint = values.empty() ? core::did_you_mean(axis, axes_present(records)) : core::did_you_mean(x.value, values);
+    throw InputError("no runs with " + axis + "=" + x.value + " in the results" + hint + " (" + axis + " there: " + there +
+                     "; settings to compare: strategy names, robots=N, map=NAME, or an axis the sweep varied)");
   }
   if (a.value == b.value) {
     throw InputError(axis == "strategy" ? "give two different strategies, got '" + a.value + "' twice"

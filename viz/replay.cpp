@@ -187,7 +187,8 @@ json replay_json(const Replay& r) {
                 {"plans", std::move(plans)},
                 {"plan", robot.plan},
                 {"passed", robot.passed},
-                {"finished", std::move(finished)}};
+                {"finished", std::move(finished)},
+                {"distance", robot.distance_m}};
     if (r.estimates) one["estimate"] = poses_json(robot.estimate);
     one["decisions"] = decisions_json(robot.decisions, notes);
     j["robots"].push_back(std::move(one));

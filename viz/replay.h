@@ -107,6 +107,7 @@ struct ReplayRobot {
   std::vector<std::vector<Eigen::Vector2d>> plans;
   std::vector<int> plan, passed;
   std::vector<char> finished;  // per step: no reachable frontier left (for now)
+  double distance_m = 0.0;     // the path length the run reports (metrics.json's distance_m)
   std::vector<ReplayDecision> decisions;  // oldest first
 };
 

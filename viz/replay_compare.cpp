@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
 
 #include "core/error.h"
 #include "viz/html.h"
@@ -40,27 +41,28 @@ json summary(const ComparedReplay& run) {
   }
   if (!d.contains("coverage") || !d.contains("robots") || !d.contains("facts"))
     throw InputError(run.label + ": not a fleetmap replay page (its data has no coverage, robots or facts)");
-  double distance = 0.0;
+  // The distance the run reported (metrics.json's), which a page written before pages carried it lacks.
+  std::optional<double> distance = 0.0;
   for (const auto& r : d["robots"]) {
-    const auto& p = r["truth"];
-    for (std::size_t k = 3; k + 2 < p.size(); k += 3)
-      distance += std::hypot(p[k].get<double>() - p[k - 3].get<double>(), p[k + 1].get<double>() - p[k - 2].get<double>()) / 100.0;
+    if (!r.contains("distance") || !r["distance"].is_number()) distance.reset();
+    if (distance) *distance += r["distance"].get<double>();
   }
   std::map<std::string, int> events;
   for (const auto& e : d["events"]) ++events[e["kind"].get<std::string>()];
   int decisions = 0;
   for (const auto& r : d["robots"])
     if (r.contains("decisions")) decisions += int(r["decisions"].size());
-  return {{"label", run.label},
-          {"title", d.value("title", "")},
-          {"facts", d["facts"]},
-          {"coverage", d["coverage"]},
-          {"period", d.value("period", 1.0)},
-          {"robots", d["robots"].size()},
-          {"strategy", d.contains("scores") ? d["scores"].value("strategy", "") : ""},
-          {"distance", std::round(distance * 10.0) / 10.0},
-          {"events", events},
-          {"decisions", decisions}};
+  json out = {{"label", run.label},
+             {"title", d.value("title", "")},
+             {"facts", d["facts"]},
+             {"coverage", d["coverage"]},
+             {"period", d.value("period", 1.0)},
+             {"robots", d["robots"].size()},
+             {"strategy", d.contains("scores") ? d["scores"].value("strategy", "") : ""},
+             {"events", events},
+             {"decisions", decisions}};
+  if (distance) out["distance"] = std::round(*distance * 10.0) / 10.0;
+  return out;
 }
 
 constexpr std::string_view kStyle = R"HTML(</title>

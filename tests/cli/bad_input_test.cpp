@@ -75,5 +75,38 @@ TEST(BadInputTable, HasARowForEveryKindTheIssueNames) {
   }
 }
 
+// A scenario, sweep or map file given to a command that reads another kind is named as what it is,
+// with the command that reads it, instead of failing on one of its keys; nothing is written.
+TEST(WrongKindOfFile, IsNamedWithTheCommandThatReadsIt) {
+  TempDir dir;
+  const std::string src = std::string(FLEETMAP_SOURCE_DIR) + "/";
+  const std::string explore = src + "scenarios/office_rendezvous.yaml", slam = src + "scenarios/dalfonso_3robots.yaml",
+                    corridor = src + "scenarios/leon_corridor.yaml", sweep = src + "scenarios/sweeps/burgard.yaml",
+                    map = src + "maps/office.yaml";
+  const struct {
+    std::string args, message;
+  } cases[] = {
+      {"slam --scenario " + explore, explore + " is an exploration scenario, not a SLAM scenario: use fleetmap explore --scenario " + explore},
+      {"slam --scenario " + map, map + " is a map (map_server YAML), not a SLAM scenario: use fleetmap explore --map " + map},
+      {"slam --scenario " + sweep, sweep + " is a sweep file, not a SLAM scenario: use fleetmap bench --sweep " + sweep},
+      {"explore --scenario " + slam, slam + " is a SLAM scenario, not an exploration scenario: use fleetmap slam --scenario " + slam},
+      {"explore --scenario " + corridor, corridor + " is a SLAM scenario, not an exploration scenario: use fleetmap slam"},
+      {"explore --scenario " + sweep, sweep + " is a sweep file, not an exploration scenario: use fleetmap bench --sweep " + sweep},
+      {"explore --scenario " + map, map + " is a map (map_server YAML), not an exploration scenario"},
+      {"bench --sweep " + explore, explore + " is an exploration scenario, not a sweep file: use fleetmap explore --scenario"},
+      {"bench --sweep " + slam, slam + " is a SLAM scenario, not a sweep file: use fleetmap slam --scenario " + slam},
+      {"bench --scenario " + sweep, sweep + " is a sweep file, not an exploration scenario: use fleetmap bench --sweep " + sweep},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_fleetmap(c.args + " --out out", dir);
+    EXPECT_ONE_LINE_ERROR(r, c.message);
+    EXPECT_EQ(r.exit_code, 2) << c.args;
+    EXPECT_FALSE(std::filesystem::exists(dir / "out")) << c.args;
+  }
+  // A file of the expected kind with a mistake still gets the message about its key.
+  dir.write("typo.yaml", "map: office\nrobots: 2\nmaps: [office]\nstrategies: [market]\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario typo.yaml --out out", dir), "unknown key 'maps'");
+}
+
 }  // namespace
 }  // namespace fleetmap::cli

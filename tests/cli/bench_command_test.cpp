@@ -250,6 +250,39 @@ TEST(BenchCommand, ShardsCombineIntoTheFullRun) {
   EXPECT_NE(part.out.find("are missing"), std::string::npos) << part.out;
 }
 
+TEST(BenchCommand, CombineRefusesFoldersOfDifferentSweeps) {
+  BenchDir b;
+  const std::string one = "--maps hall.yaml --strategies uncoordinated --robots 1,2 --seeds 2 --steps 20 -o ";
+  ASSERT_EQ(b.bench(one + "s1 --shard 1/2").exit_code, 0);
+  ASSERT_EQ(b.bench(one + "s2 --shard 2/2").exit_code, 0);
+  // Another sweep with the same settings: other maps, team sizes and seeds.
+  ASSERT_EQ(b.bench("--maps room.yaml --strategies uncoordinated --robots 1 --seeds 3 --steps 20 --out other").exit_code, 0);
+  const auto r = b.bench("--combine s1 other --out c");
+  EXPECT_ONE_LINE_ERROR(r, "--combine: s1 and other are results of different sweeps (their sweep.yaml has 'maps: [");
+  EXPECT_EQ(r.out, "");
+  EXPECT_FALSE(std::filesystem::exists(b / "c"));
+  std::filesystem::remove(b / "other" / "sweep.yaml");
+  EXPECT_ONE_LINE_ERROR(b.bench("--combine s1 other --out c"), "--combine: s1 has a sweep.yaml and other none");
+  EXPECT_FALSE(std::filesystem::exists(b / "c"));
+
+  // The shards of one sweep whose sweep.yaml does not load here (a strategy a Python program
+  // registered): compared as text, combined with a note.
+  for (const char* shard : {"s1", "s2"}) {
+    std::string yaml = slurp(b / shard / "sweep.yaml");
+    yaml.replace(yaml.find("strategies: [uncoordinated]"), 27, "strategies: [my_python_strategy]");
+    b.dir.write(std::string(shard) + "/sweep.yaml", yaml);
+  }
+  const auto python = b.bench("--combine s1 s2 --out c");
+  ASSERT_EQ(python.exit_code, 0) << python.err;
+  EXPECT_NE(python.out.find("combined 4 runs from 2 folders"), std::string::npos) << python.out;
+  EXPECT_NE(python.err.find("unknown strategy 'my_python_strategy'"), std::string::npos) << python.err;
+  EXPECT_EQ(fleetmap::testing::line_count(python.err), 1) << python.err;
+  std::string yaml = slurp(b / "s2" / "sweep.yaml");
+  yaml.replace(yaml.find("seeds: 2"), 8, "seeds: 5");
+  b.dir.write("s2/sweep.yaml", yaml);
+  EXPECT_ONE_LINE_ERROR(b.bench("--combine s1 s2 --out c2"), "(their sweep.yaml has 'seeds: 2' against 'seeds: 5')");
+}
+
 TEST(BenchCommand, PairedComparisonOfTwoStrategies) {
   BenchDir b;
   ASSERT_EQ(b.bench(kSweep + " --jobs 2 --out out").exit_code, 0);
@@ -281,6 +314,12 @@ TEST(BenchCommand, BadInputGetsOneLine) {
   BenchDir b;
   const std::string small = " --maps hall.yaml --strategies uncoordinated --robots 1 --seeds 1 --steps 20";
   EXPECT_ONE_LINE_ERROR(b.bench("--strategies uncoordinated,best --out x"), "unknown strategy 'best'");
+  EXPECT_ONE_LINE_ERROR(b.bench("--strategies coordinated,uncordinated --out x"),
+                        "--strategies: unknown strategy 'uncordinated' (did you mean 'uncoordinated'?) (valid: ");
+  EXPECT_ONE_LINE_ERROR(b.bench("--strategies all,tour --out x"), "--strategies: 'all' stands alone");
+  // --metric picks the metric of --compare: alone it is refused, not ignored.
+  EXPECT_ONE_LINE_ERROR(b.bench(small + " --metric distance_m --out x"), "--metric goes with --compare");
+  EXPECT_ONE_LINE_ERROR(b.bench(small + " --metric bogus --out x"), "--metric goes with --compare");
   EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml,atlantis --strategies uncoordinated --out x"), "atlantis");
   EXPECT_ONE_LINE_ERROR(b.bench(small + " --shard 5/4 --out x"), "--shard '5/4'");
   EXPECT_ONE_LINE_ERROR(b.bench(small + " --shard 0/3 --out x"), "--shard '0/3'");
@@ -310,7 +349,11 @@ TEST(BenchCommand, BadInputGetsOneLine) {
   b.dir.write("foreign/results.csv", "name,score\nx,1\n");
   EXPECT_ONE_LINE_ERROR(b.bench(small + " --out foreign"), "holds a file that no earlier 'fleetmap bench' run wrote ('results.csv')");
   EXPECT_ONE_LINE_ERROR(b.bench("--combine done foreign --out c"), "not a results table");
-  EXPECT_ONE_LINE_ERROR(b.bench("--compare coordinated market done"), "no runs of strategy 'coordinated'");
+  EXPECT_ONE_LINE_ERROR(b.bench("--compare coordinated market done"), "no runs of strategy 'coordinated' in the results (strategies");
+  EXPECT_ONE_LINE_ERROR(b.bench("--compare uncordinated uncoordinated done"),
+                        "no runs of strategy 'uncordinated' in the results (did you mean 'uncoordinated'?)");
+  EXPECT_ONE_LINE_ERROR(b.bench("--compare coordinated uncoordinated done --metric steps_to99"),
+                        "--metric: unknown metric 'steps_to99' (did you mean 'steps_to_99'?)");
   // A sweep file with a mistake.
   b.dir.write("bad.yaml", "maps: [hall.yaml]\nrobot: [1, 2]\n");
   EXPECT_ONE_LINE_ERROR(b.bench("--sweep bad.yaml --out x"), "bad.yaml:2: unknown key 'robot'");
@@ -339,6 +382,7 @@ TEST(BenchCommand, VaryAnySettingAndCompareItsValues) {
                             "--vary beams=8,360 --vary sensor_range=2,4";
   const auto r = b.bench(sweep + " --out v");
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("8 runs of 1 map x 1 strategy x 1 team size x 4 variants x 2 seeds"), std::string::npos) << r.out;
   const CsvTable t = read_csv(b / "v" / "results.csv");
   ASSERT_EQ(t.rows.size(), 2u * 2u * 2u);
   std::set<std::string> variants;
@@ -363,6 +407,12 @@ TEST(BenchCommand, VaryAnySettingAndCompareItsValues) {
   EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml --vary beams --out x"), "--vary beams: expected SETTING=VALUE");
   EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml --vary beams=0 --out x"), "axis beams=0");
   EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml --vary robots=1,2 --out x"), "already");
+  // A mistyped setting: the short names listed, the nearest short name or key suggested.
+  const auto beam = b.bench("--maps hall.yaml --vary beam=45,360 --out x");
+  EXPECT_ONE_LINE_ERROR(beam, "--vary beam=45,360: unknown setting 'beam' (did you mean 'beams'?) (valid: beams, sensor_range, comm_range, ");
+  EXPECT_ONE_LINE_ERROR(beam, "noise_position");
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml --vary noise_positon=0.1 --out x"), "(did you mean 'noise_position'?)");
+  EXPECT_ONE_LINE_ERROR(b.bench("--maps hall.yaml --vary sensors.range.beam=8 --out x"), "(did you mean 'sensors.range.beams'?)");
   EXPECT_FALSE(std::filesystem::exists(b / "x"));
 }
 

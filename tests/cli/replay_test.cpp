@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <regex>
@@ -73,20 +74,34 @@ TEST(ReplayPage, RecordingTheReasonsChangesNoResult) {
   }
 }
 
-TEST(ReplayCompare, WritesOnePageAndRefusesWhatIsNotAReplay) {
+// The comparison page: both runs, their distances as the runs report them (metrics.json), not
+// re-measured from the page's poses; what is not a replay, or not an .html name, refused.
+TEST(ReplayCompare, WritesOnePageWithTheRunsOwnNumbersAndRefusesWhatIsNotAReplay) {
   TempDir dir;
-  ASSERT_EQ(run_fleetmap(kRun + "--steps 4 --html --out a", dir).exit_code, 0);
-  ASSERT_EQ(run_fleetmap(kRun + "--steps 6 --strategy market --html --out b", dir).exit_code, 0);
-  const auto r = run_fleetmap("replay-compare a/replay.html b/replay.html --out cmp.html", dir);
+  ASSERT_EQ(run_fleetmap(kRun + "--steps 60 --html -o a", dir).exit_code, 0);
+  ASSERT_EQ(run_fleetmap(kRun + "--steps 60 --strategy market --html --out b", dir).exit_code, 0);
+  const auto r = run_fleetmap("replay-compare a/replay.html b/replay.html -o cmp.html", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::string page = slurp(dir / "cmp.html");
   EXPECT_NE(page.find("<title>Comparing a and b</title>"), std::string::npos);
   EXPECT_EQ(page.find("http"), std::string::npos);
-  // Not a replay page, or a label per page missing: one line, nothing written.
+  const std::size_t start = page.find(">", page.find("id=\"summary\"")) + 1;
+  const auto summary = nlohmann::json::parse(page.substr(start, page.find("</script>", start) - start));
+  ASSERT_EQ(summary.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const auto metrics = nlohmann::json::parse(slurp(dir / (i == 0 ? "a" : "b") / "metrics.json"));
+    const double distance = metrics["distance_m"].get<double>();
+    ASSERT_GT(distance, 1.0);
+    EXPECT_DOUBLE_EQ(summary[i]["distance"].get<double>(), std::round(distance * 10.0) / 10.0) << i;
+  }
+  // Not a replay page, a label per page missing, or not an .html name: one line, nothing written.
   EXPECT_ONE_LINE_ERROR(run_fleetmap("replay-compare a/replay.html a/map.yaml --out x.html", dir), "a/map.yaml: not a fleetmap replay page");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("replay-compare a/replay.html b/replay.html --label one --out x.html", dir), "--label");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("replay-compare a/replay.html --out x.html", dir), "two to four");
   EXPECT_FALSE(std::filesystem::exists(dir / "x.html"));
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("replay-compare a/replay.html b/replay.html --out c.png", dir),
+                        "--out c.png: the comparison is an HTML page; give a name ending in .html");
+  EXPECT_FALSE(std::filesystem::exists(dir / "c.png"));
 }
 
 TEST(ReplayPage, ScenarioKeyAsksForThePage) {

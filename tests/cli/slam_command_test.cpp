@@ -65,6 +65,26 @@ TEST(SlamCommand, BadInputGetsOneLine) {
   EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario wall.yaml", dir), "within its radius of a wall");
 }
 
+// --runs, --jobs, --sampled-start and --exact-start only where the scenario's experiment uses them.
+TEST(SlamCommand, FlagsTheExperimentDoesNotUseAreRefused) {
+  TempDir dir;
+  const std::string src = std::string(FLEETMAP_SOURCE_DIR) + "/scenarios/";
+  for (const std::string flag : {"--runs 5", "--jobs 2", "--sampled-start", "--exact-start"}) {
+    const auto r = run_fleetmap("slam --scenario " + src + "leon_corridor.yaml " + flag + " --out out", dir);
+    EXPECT_ONE_LINE_ERROR(r, flag.substr(0, flag.find(' ')) + " does not apply to the leon_corridor experiment of " + src +
+                                 "leon_corridor.yaml");
+  }
+  for (const std::string flag : {"--sampled-start", "--exact-start"}) {
+    const auto r = run_fleetmap("slam --scenario " + src + "landmark_alignment.yaml " + flag + " --out out", dir);
+    EXPECT_ONE_LINE_ERROR(r, flag + " does not apply to the landmark_alignment experiment");
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "out"));
+  // Where they apply they run, and -o names the output folder as --out does.
+  const auto r = run_fleetmap("slam --scenario " + scenario() + " --runs 1 --jobs 1 --sampled-start -q -o short", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "short/table1.md\n");
+}
+
 TEST(SlamCommand, ExploreUsesThePolynomialLocalizer) {
   // The same filter as `explore --localization polynomial`: it learns polynomials from the scan
   // and keeps every robot within 3 sigma of P0 (0.05 m) of the truth over a short run.

@@ -78,6 +78,9 @@ TEST(Sweep, ListsFromFlags) {
             (std::vector<std::string>{"coordinated", "uncoordinated"}));
   expect_input_error([] { parse_strategy_list("coordinated,greedy", "--strategies"); },
                      {"--strategies", "unknown strategy 'greedy'", "uncoordinated"});
+  expect_input_error([] { parse_strategy_list("coordinated,uncordinated", "--strategies"); },
+                     {"--strategies: unknown strategy 'uncordinated' (did you mean 'uncoordinated'?) (valid: "});
+  expect_input_error([] { parse_strategy_list("all,tour", "--strategies"); }, {"--strategies: 'all' stands alone"});
   EXPECT_EQ(parse_map_list("office, maps/lab.png", "--maps"), (std::vector<std::string>{"office", "maps/lab.png"}));
   EXPECT_EQ(map_label("maps/lab.png"), "lab");
   EXPECT_EQ(map_label("office"), "office");
@@ -129,6 +132,12 @@ TEST(Sweep, SweepFileErrorsNameTheFileLineAndKey) {
   expect_input_error([&] { load_sweep(dir.write("h.yaml", "maps: {office: 1}\n")); }, {"h.yaml:1", "maps", "expected a list"});
   expect_input_error([&] { load_sweep(dir.write("i.yaml", "localization: psychic\n")); }, {"i.yaml", "localization", "psychic"});
   expect_input_error([&] { load_sweep(dir.write("j.yaml", "merging: telepathy\n")); }, {"j.yaml:1", "merging", "telepathy"});
+  // A mistyped strategy or setting gets the nearest name.
+  expect_input_error([&] { load_sweep(dir.write("k.yaml", "strategies: [coordinated, uncordinated]\n")); },
+                     {"k.yaml:1: key 'strategies': unknown strategy 'uncordinated' (did you mean 'uncoordinated'?)"});
+  expect_input_error([&] { load_sweep(dir.write("l.yaml", "strategies: [all, tour]\n")); }, {"l.yaml:1", "'all' stands alone"});
+  expect_input_error([&] { load_sweep(dir.write("m.yaml", "vary:\n  comm_rnage: [5, inf]\n")); },
+                     {"m.yaml:2: key 'vary.comm_rnage': unknown setting 'comm_rnage' (did you mean 'comm_range'?)"});
 }
 
 TEST(Sweep, ReadySweepFiles) {
@@ -248,8 +257,14 @@ TEST(SweepAxes, BadAxesAreRefusedBeforeAnyRun) {
   // A value the scenario refuses, or a key it does not know, names the axis and the key.
   s.axes = {parse_axis("beams=90,0", "--vary")};
   expect_input_error([&] { validate_sweep(s); }, {"axis beams=0", "sensors.range.beams", "1 to 100000"});
-  s.axes = {parse_axis("sensors.range.beam=90", "--vary")};
-  expect_input_error([&] { validate_sweep(s); }, {"axis sensors.range.beam=90", "beam"});
+  // A setting no scenario has: the nearest short name or scenario key suggested, the short names listed.
+  expect_input_error([] { parse_axis("sensors.range.beam=90", "--vary"); },
+                     {"--vary: unknown setting 'sensors.range.beam' (did you mean 'sensors.range.beams'?)",
+                      "(valid: beams, sensor_range, comm_range, localization, merging, path_planner, steps, noise_position, or "});
+  expect_input_error([] { parse_axis("beam=45,360", "--vary"); }, {"unknown setting 'beam' (did you mean 'beams'?)"});
+  expect_input_error([] { parse_axis("noise_positon=0.1", "--vary"); }, {"(did you mean 'noise_position'?)"});
+  expect_input_error([] { parse_axis("sensors=1", "--vary"); }, {"unknown setting 'sensors'"});
+  EXPECT_EQ(parse_axis("exploration.safety_margin=0.1,0.2", "--vary").scenario_key, "exploration.safety_margin");
   s.axes = {parse_axis("localization=odometry,magic", "--vary")};
   expect_input_error([&] { validate_sweep(s); }, {"axis localization=magic", "magic"});
   s.axes = {parse_axis("beams=90", "--vary"), parse_axis("sensors.range.beams=45", "--vary")};

@@ -221,6 +221,7 @@ TEST(ReplayPage, DecisionsKeepTheirCandidatesAndNotesOnce) {
 // is fetched, and no run's text can close the page's scripts.
 TEST(ReplayCompare, HoldsEveryRunAndItsSummary) {
   Replay a = tiny_replay(), b = tiny_replay();
+  a.robots[0].distance_m = 0.1234;  // the run's own, which the poses (0.1 m apart) need not match
   a.facts = {{"steps", "2"}, {"95%", "never"}};
   b.facts = {{"steps", "2"}, {"95%", "step 1"}};
   b.coverage = {0.1, 0.96};
@@ -244,6 +245,15 @@ TEST(ReplayCompare, HoldsEveryRunAndItsSummary) {
   EXPECT_NEAR(summary[0]["distance"].get<double>(), 0.1, 1e-9);
   EXPECT_EQ(script("page0").get<std::string>(), runs[0].page);
   EXPECT_EQ(script("page1").get<std::string>(), runs[1].page);
+  // A page written before pages carried the run's distance: none shown rather than one re-measured.
+  std::string old_page = runs[1].page;
+  const std::size_t at = old_page.find("\"distance\":0.0,");
+  ASSERT_NE(at, std::string::npos);
+  old_page.erase(at, std::string("\"distance\":0.0,").size());
+  const std::string old_compare = replay_comparison_html({runs[0], {"old", old_page}});
+  const std::size_t start = old_compare.find(">", old_compare.find("id=\"summary\"")) + 1;
+  const auto old_summary = nlohmann::json::parse(old_compare.substr(start, old_compare.find("</script>", start) - start));
+  EXPECT_FALSE(old_summary[1].contains("distance"));
 }
 
 TEST(ReplayCompare, RefusesWhatIsNotAReplay) {
