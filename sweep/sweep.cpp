@@ -177,8 +177,10 @@ SweepAxis make_axis(const std::string& key, const std::vector<std::string>& valu
       k.find("..") != std::string::npos) {
     throw InputError(what + ": '" + key + "' is not a setting " + valid_settings_text());
   }
-  if (k == "map" || k == "seed" || k == "robots" || k.rfind("robots.", 0) == 0 || k == "exploration.strategy" ||
-      k == "strategy") {
+  // The team (its size and where it starts) is the robots axis; the robots' radius, speed and the
+  // like are settings like any other.
+  if (k == "map" || k == "seed" || k == "robots" || k == "robots.count" || k == "robots.random" || k == "robots.starts" ||
+      k == "exploration.strategy" || k == "strategy") {
     throw InputError(what + ": '" + key + "' is an axis of every sweep already; use maps, robots, strategies or seeds");
   }
   if (const auto& settings = axis_settings(); std::find(settings.begin(), settings.end(), k) == settings.end()) {

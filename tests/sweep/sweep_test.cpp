@@ -251,6 +251,11 @@ TEST(SweepAxes, BadAxesAreRefusedBeforeAnyRun) {
   s.maps = {"office"};
   expect_input_error([] { parse_axis("beams", "--vary beams"); }, {"--vary beams", "SETTING=VALUE"});
   expect_input_error([] { parse_axis("robots=2,4", "--vary"); }, {"'robots' is an axis of every sweep already"});
+  expect_input_error([] { parse_axis("robots.count=2,4", "--vary"); }, {"already"});
+  // The robots' size is a setting like any other: a sweep over it is valid.
+  s.axes = {parse_axis("robots.radius=0.15,0.25", "--vary")};
+  EXPECT_NO_THROW(validate_sweep(s));
+  s.axes.clear();
   expect_input_error([] { parse_axis("strategy=market", "--vary"); }, {"already"});
   expect_input_error([] { parse_axis("beams=90,90", "--vary"); }, {"'90' is listed twice"});
   expect_input_error([] { parse_axis("beams=90,", "--vary"); }, {"empty item"});
