@@ -134,14 +134,15 @@ int run_plan(const PlanCommandOptions& o) {
   if (r.status == PlanStatus::GoalOutsideMap || r.status == PlanStatus::GoalInObstacle) {
     throw InputError(goal.flag + " " + goal.text + ": " + r.detail);
   }
-  print_map_notes(o.map, load, o.resolution_given);  // the input is good: how the map was read
 
   if (!o.json.empty()) write_output(o.json, result_json(o, r, start, goal).dump(2) + "\n");
   if (!o.out.empty()) write_picture(o.out, picture(o, grid, space, r, start, goal));
   if (!r.success()) {
-    fmt::print(stderr, "fleetmap plan: no path on {}: {}\n", o.map, r.detail);
+    // How the map was read may be why (a resolution that makes doors too narrow): said in the same line.
+    fmt::print(stderr, "fleetmap plan: no path on {}: {}{}\n", o.map, r.detail, map_notes_suffix(o.map, load, o.resolution_given));
     return 1;
   }
+  print_map_notes(o.map, load, o.resolution_given);  // how the map was read
   fmt::print(report, "{}: {:.2f} m in {} waypoints; first path after {:.3f} s, {:.3f} s in all\n", r.planner, r.length_m,
              r.path.size(), r.first_solution_s.value_or(r.time_s), r.time_s);
   for (const auto& out : outputs) {

@@ -445,9 +445,16 @@ std::vector<std::string> map_reading_notes(const fs::path& path, const MapLoadOp
   cv::Mat image = decode_samples(io::read_file(image_path), image_path.string(), options);
   std::vector<std::string> notes;
   const std::string name = path.string();
-  if (bare && !resolution_source.empty()) {
-    notes.push_back(fmt::format("{}: a bare image (no map_server YAML), read at {} m per cell, {}", name, meta.resolution,
-                                resolution_source));
+  if (bare) {
+    // The defaults a bare image takes, said once: its resolution (unless the user gave it) and the
+    // thresholds, in greys.
+    const std::string resolution =
+        resolution_source.empty() ? "" : fmt::format(", read at {} m per cell, {};", meta.resolution, resolution_source);
+    notes.push_back(fmt::format("{}: a bare image (no map_server YAML){} walls darker than {}, free lighter than {} "
+                                "(map_server's default thresholds)",
+                                name, resolution.empty() ? ":" : resolution,
+                                int(std::ceil(255.0 * (1.0 - meta.occupied_thresh))),
+                                int(std::floor(255.0 * (1.0 - meta.free_thresh)))));
   }
   if (meta.origin.theta != 0.0) {
     notes.push_back(fmt::format("{}: origin yaw {} rad: coordinates (--from, --start, ...) are turned by it, while pictures "

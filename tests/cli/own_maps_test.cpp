@@ -195,9 +195,15 @@ TEST(OwnMaps, ABareImageSaysWhichResolutionItTookAndMergesWithAMapServerMapAtIts
   const auto explore = run_fleetmap("explore --map a.png --robots 1 --steps 2 --out run", dir);
   ASSERT_EQ(explore.exit_code, 0) << explore.err;
   EXPECT_NE(explore.err.find("fleetmap: note: a.png: a bare image (no map_server YAML), read at 0.05 m per cell, the "
-                             "default; --resolution sets it"),
+                             "default; --resolution sets it; walls darker than 90, free lighter than 205 (map_server's "
+                             "default thresholds)"),
             std::string::npos)
       << explore.err;
+  // Given the resolution, the thresholds are still said: they were taken silently.
+  const auto given = run_fleetmap("maps show a.png --resolution 0.1 --out s.png", dir);
+  EXPECT_NE(given.err.find("a.png: a bare image (no map_server YAML): walls darker than 90, free lighter than 205"),
+            std::string::npos)
+      << given.err;
   // In a merge, the bare image takes the resolution of the map_server map: the same map, in place.
   const auto merge = run_fleetmap("merge b.yaml a.png --json m.json --out m.png", dir);
   ASSERT_EQ(merge.exit_code, 0) << merge.err << merge.out;
