@@ -1,14 +1,21 @@
-// Exploration on real floor plans: every strategy with 1, 3 and 6 robots on the HouseExpo plans
-// (Li et al. 2019; 60 of them in ../shared/datasets/houseexpo/, 0.05 m per cell), each run required
-// to reach 99% of the observable space and to stop by itself. Prints, per strategy and team size, the
-// runs below 99%, the efficiency (lower bound / steps to 99%) with its 95% confidence interval, and
-// every run that fell short with what it left (metrics.json's "unexplored"). Exit status 1 when a run
-// fell short, 2 on bad arguments. Results: bench/README.md, "## Real floor plans".
+// Exploration on real maps: every strategy with 1, 3 and 6 robots on the HouseExpo floor plans
+// (Li et al. 2019; 60 of them in ../shared/datasets/houseexpo/, 0.05 m per cell) or on real laser
+// maps (bench/real_maps/), each run required to reach 99% of the observable space and to stop by
+// itself. Prints, per strategy and team size, the runs below 99% or not finished, the efficiency
+// (lower bound / steps to 99%) as mean with its 95% confidence interval and as median, the median
+// ratio of the step a run ended at to the step it reached 99%, the median share of robot-steps
+// blocked, and every run that fell short with what it left (metrics.json's "unexplored"). Exit
+// status 1 when a run fell short, 2 on bad arguments. Results: bench/README.md, "## Real floor
+// plans" and "## Exploring real laser maps".
 //
-//   fleetmap_bench_floor_plans [FOLDER] [--maps N] [--strategies all] [--robots 1,3,6] [--seeds 1] [--jobs 1]
+//   fleetmap_bench_floor_plans [FOLDER | --list A.yaml,B.yaml,...] [--maps N] [--strategies all]
+//                              [--robots 1,3,6] [--seeds 1] [--starts cluster|random] [--steps 2000] [--jobs 1]
 //
-// FOLDER holds <id>.yaml map_server maps (default: the dataset beside the source tree); --maps N
-// takes the first N plans in name order, to keep a run within minutes.
+// FOLDER holds <id>.yaml map_server maps (default: the dataset beside the source tree); --list
+// names the maps instead (each at its own resolution); --maps N takes the first N in name order, to
+// keep a run within minutes. --starts random places the robots at random in the largest region
+// they can reach, 4 m apart where room allows (as `fleetmap explore --starts random
+// --min-separation 4`).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -19,6 +26,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/format.h"
 #include "core/parallel.h"
 #include "maps/builtin_maps.h"
 #include "sim/simulation.h"
@@ -36,6 +44,9 @@ struct Options {
   std::vector<int> robots = {1, 3, 6};
   int seeds = 1;
   int jobs = 1;
+  std::vector<std::filesystem::path> list;  // --list: these maps instead of the folder's
+  bool random_starts = false;
+  int steps = 2000;
 };
 
 Options parse(int argc, char** argv) {
@@ -62,6 +73,14 @@ Options parse(int argc, char** argv) {
     else if (a == "--robots") o.robots = sweep::parse_team_sizes(value(), a);
     else if (a == "--seeds") o.seeds = count(value(), 1, 1000);
     else if (a == "--jobs") o.jobs = count(value(), 1, 1024);
+    else if (a == "--steps") o.steps = count(value(), 1, 10'000'000);
+    else if (a == "--list") {
+      for (const auto& item : core::split_list(value(), a)) o.list.emplace_back(item);
+    } else if (a == "--starts") {
+      const std::string v = value();
+      if (v != "cluster" && v != "random") throw InputError(a + " " + v + ": expected cluster or random");
+      o.random_starts = v == "random";
+    }
     else if (!a.empty() && a[0] == '-') throw InputError(a + ": unknown option (see the comment at the top of floor_plans_bench.cpp)");
     else o.folder = a;
   }
@@ -76,14 +95,25 @@ struct Run {
   double coverage = 0.0;
   bool finished = false;
   std::optional<double> efficiency;
+  std::optional<double> end_over_99;  // the step it ended at / the step it reached 99%
+  double blocked_share = 0.0;         // blocked moves per robot-step
   std::string left;  // what a run that fell short left
 };
 
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 int run(const Options& o) {
-  std::vector<std::filesystem::path> plans;
-  if (!std::filesystem::is_directory(o.folder)) throw InputError(o.folder.string() + ": not a folder");
-  for (const auto& e : std::filesystem::directory_iterator(o.folder))
-    if (e.path().extension() == ".yaml") plans.push_back(e.path());
+  std::vector<std::filesystem::path> plans = o.list;
+  if (plans.empty()) {
+    if (!std::filesystem::is_directory(o.folder)) throw InputError(o.folder.string() + ": not a folder");
+    for (const auto& e : std::filesystem::directory_iterator(o.folder))
+      if (e.path().extension() == ".yaml") plans.push_back(e.path());
+  }
   std::sort(plans.begin(), plans.end());
   if (o.maps > 0 && plans.size() > o.maps) plans.resize(o.maps);
   if (plans.empty()) throw InputError(o.folder.string() + ": no .yaml map in it");
@@ -94,7 +124,7 @@ int run(const Options& o) {
   for (const auto& [map, grid] : grids)
     for (const auto& strategy : o.strategies)
       for (const int robots : o.robots)
-        for (int s = 0; s < o.seeds; ++s) runs.push_back({map, strategy, robots, std::uint64_t(1 + s), 0.0, false, {}, {}});
+        for (int s = 0; s < o.seeds; ++s) runs.push_back({map, strategy, robots, std::uint64_t(1 + s), 0.0, false, {}, {}, 0.0, {}});
   int done = 0;
   const auto progress = [&](int) {
     if (++done % 25 == 0 || done == int(runs.size())) fmt::print(stderr, "{} of {} runs\n", done, runs.size());
@@ -106,6 +136,8 @@ int run(const Options& o) {
     s.robot_count = r.robots;
     s.seed = r.seed;
     s.exploration.strategy = r.strategy;
+    s.steps = o.steps;
+    if (o.random_starts) s.placement = sim::Placement::Random, s.min_separation_m = 4.0;
     const mapping::OccupancyGrid& truth = grids.at(r.map);
     sim::Simulation simulation(s, truth);
     const sim::RunResult result = simulation.run();
@@ -119,6 +151,10 @@ int run(const Options& o) {
     for (const auto& t : result.robots) starts.push_back(t.truth.front().position());
     const sim::World world(truth, {});
     r.efficiency = sweep::exploration_efficiency(sweep::exploration_lower_bound(world, starts, lb).steps(), result.steps_to_99);
+    if (result.steps_to_99 && *result.steps_to_99 > 0) r.end_over_99 = double(result.steps) / double(*result.steps_to_99);
+    int blocked = 0;
+    for (const auto& t : result.robots) blocked += t.blocked_moves;
+    r.blocked_share = double(blocked) / (double(std::max(1, result.steps)) * double(result.robots.size()));
     if (!result.unexplored.empty() && (r.coverage < 0.99 || !r.finished)) {
       const auto& u = result.unexplored.front();
       r.left = fmt::format("largest region left {:.2f} m2 at ({:.1f}, {:.1f}): {}", u.area_m2, u.centre_m.x(), u.centre_m.y(), u.reason);
@@ -126,10 +162,11 @@ int run(const Options& o) {
   }, progress);
 
   int short_runs = 0;
-  fmt::print("| strategy | robots | runs | below 99% or not finished | lowest coverage | efficiency (mean, 95% CI) |\n|---|---|---|---|---|---|\n");
+  fmt::print("| strategy | robots | runs | below 99% or not finished | lowest coverage | efficiency (mean, 95% CI) | "
+             "efficiency (median) | end / step of 99% (median) | blocked share (median) |\n|---|---|---|---|---|---|---|---|---|\n");
   for (const auto& strategy : o.strategies) {
     for (const int robots : o.robots) {
-      std::vector<double> efficiency;
+      std::vector<double> efficiency, end_ratio, blocked;
       int n = 0, bad = 0;
       double lowest = 2.0;
       std::string lowest_map;
@@ -138,12 +175,15 @@ int run(const Options& o) {
         ++n;
         bad += r.coverage < 0.99 || !r.finished;
         if (r.coverage < lowest) lowest = r.coverage, lowest_map = r.map;
-        if (r.efficiency) efficiency.push_back(*r.efficiency);
+        efficiency.push_back(r.efficiency.value_or(0.0));  // a run that never reached 99% counts as 0
+        if (r.end_over_99) end_ratio.push_back(*r.end_over_99);
+        blocked.push_back(r.blocked_share);
       }
       short_runs += bad;
       const auto e = sweep::summarize(efficiency);
-      fmt::print("| {} | {} | {} | {} | {:.2f}% ({}) | {:.3f} [{:.3f}, {:.3f}] |\n", strategy, robots, n, bad, 100.0 * lowest,
-                 lowest_map, e.mean, e.ci_low, e.ci_high);
+      fmt::print("| {} | {} | {} | {} | {:.2f}% ({}) | {:.3f} [{:.3f}, {:.3f}] | {:.3f} | {:.2f} | {:.3f} |\n", strategy, robots, n,
+                 bad, 100.0 * lowest, lowest_map, e.mean, e.ci_low, e.ci_high, median(efficiency), median(end_ratio),
+                 median(blocked));
     }
   }
   for (const auto& r : runs) {

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "core/angle.h"
+#include "localization/localizer.h"
 
 namespace fleetmap::sim {
 
@@ -40,7 +41,58 @@ bool segment_clear(const mapping::OccupancyGrid& map, const Eigen::Vector2d& a, 
   return true;
 }
 
+// Along the arc a robot at `from` drives with (v, omega) for `period_s`, sampled as finely as the
+// simulator checks a move, the disc stays radius + a hundredth of a cell from every occupied cell of
+// `map` (an arc that grazes a wall at exactly the radius is one the simulator stops), except the
+// cells it already overlaps at `from`: on the robot's own map those are noise (a range reading
+// that fell short marks the free cell before a wall) or what it touched; moving away must stay
+// possible.
+bool arc_clear(const mapping::OccupancyGrid& map, const core::Pose2& from, double v, double omega, double period_s,
+               double radius_m) {
+  const double res = map.resolution();
+  const double need = radius_m + 0.01 * res;
+  const Eigen::Vector2d start = map.geometry().world_to_grid(from.position());
+  const double overlap = radius_m / res;  // in cells
+  const auto overlapped = [&](const core::Cell& c) {
+    const double ex = std::max({double(c.x) - start.x(), 0.0, start.x() - double(c.x + 1)});
+    const double ey = std::max({double(c.y) - start.y(), 0.0, start.y() - double(c.y + 1)});
+    return ex * ex + ey * ey < overlap * overlap;
+  };
+  const int samples = std::max(1, int(std::ceil(std::abs(v) * period_s / (0.25 * res))));
+  const int r = int(std::ceil(need / res)) + 1;
+  for (int k = 1; k <= samples; ++k) {
+    const double f = double(k) / samples;
+    const Eigen::Vector2d q = map.geometry().world_to_grid(
+        localization::integrate_motion(from, {v * f, omega * f, period_s}).position());
+    const int cx = int(std::floor(q.x())), cy = int(std::floor(q.y()));
+    for (int dy = -r; dy <= r; ++dy) {
+      for (int dx = -r; dx <= r; ++dx) {
+        const core::Cell c{cx + dx, cy + dy};
+        if (map.state(c) != mapping::CellState::Occupied || overlapped(c)) continue;
+        const double ex = std::max({double(c.x) - q.x(), 0.0, q.x() - double(c.x + 1)});
+        const double ey = std::max({double(c.y) - q.y(), 0.0, q.y() - double(c.y + 1)});
+        if ((ex * ex + ey * ey) * res * res < need * need) return false;
+      }
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+Command clear_on_map(Command c, const core::Pose2& estimate, const mapping::OccupancyGrid& own_map, const RobotOptions& robot,
+                     double period_s) {
+  const double v = c.v;
+  c.v = 0.0;
+  for (double scale : {1.0, 0.75, 0.5, 0.25, 0.1}) {
+    if (v == 0.0) break;
+    if (arc_clear(own_map, estimate, v * scale, c.omega, period_s, robot.radius_m)) {
+      c.v = v * scale;
+      break;
+    }
+  }
+  return c;
+}
 
 Command follow_path(const core::Pose2& estimate, const std::vector<Eigen::Vector2d>& path,
                     const mapping::OccupancyGrid& own_map, const RobotOptions& robot, double period_s, double lookahead_m) {
@@ -60,7 +112,7 @@ Command follow_path(const core::Pose2& estimate, const std::vector<Eigen::Vector
   if (std::abs(error) <= std::numbers::pi / 3.0) {
     c.v = std::min({robot.max_speed_mps, dist_to_end / period_s, d.norm() / period_s}) * std::cos(error);
   }
-  return c;
+  return clear_on_map(c, estimate, own_map, robot, period_s);
 }
 
 Command escape_command(const core::Pose2& estimate, const mapping::OccupancyGrid& own_map, double period_s) {
@@ -124,6 +176,17 @@ MoveResult move_robot(const World& world, int self, const std::vector<core::Pose
     }
   }
   out.blocked = v != 0.0 && speed != v;
+  if (out.blocked) {
+    // The first sub-step of the full move that failed: if a wall stopped it, that is the contact.
+    const int substeps = std::max(1, int(std::ceil(std::abs(v) * period_s / (0.25 * res))));
+    for (int k = 1; k <= substeps; ++k) {
+      const double f = double(k) / substeps;
+      const Eigen::Vector2d q = localization::integrate_motion(start, {v * f, w * f, period_s}).position();
+      if (valid(q)) continue;
+      if (!world.disc_free(q, robot.radius_m)) out.contact = world.nearest_blocked_point(q, robot.radius_m);
+      break;
+    }
+  }
   out.odometry = {speed, w, period_s};
   out.pose = localization::integrate_motion(start, out.odometry);
   out.distance_m = std::abs(speed) * period_s;

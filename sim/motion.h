@@ -2,6 +2,7 @@
 // Differential-drive robots: a path-following controller and the motion itself, with process
 // noise, stopped by walls and by other robots.
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "core/random.h"
@@ -42,9 +43,18 @@ struct Command {
   double omega = 0.0;
 };
 
+// `command` as far as the robot's own map lets it drive: the forward speed lowered along the same
+// turn (to 0.75, 0.5, 0.25, 0.1 of it, then turning in place) until the arc keeps the disc clear of
+// every occupied cell of `own_map` (the walls it saw, or found by touching them), or no closer to
+// one than it already is. The simulator would cut the move short there anyway; a robot that looks
+// first does not drive into what it knows.
+Command clear_on_map(Command command, const core::Pose2& estimate, const mapping::OccupancyGrid& own_map,
+                     const RobotOptions& robot, double period_s);
+
 // Pure pursuit: head for the farthest path point within `lookahead_m` that the robot's disc can
 // reach in a straight line on its own map (so it never cuts a corner into a door jamb); turn in
-// place when it is more than 60 degrees off, and slow down near the end of the path.
+// place when it is more than 60 degrees off, and slow down near the end of the path; then
+// clear_on_map.
 Command follow_path(const core::Pose2& estimate, const std::vector<Eigen::Vector2d>& path,
                     const mapping::OccupancyGrid& own_map, const RobotOptions& robot, double period_s, double lookahead_m);
 
@@ -57,6 +67,10 @@ struct MoveResult {
   localization::Odometry odometry;  // the motion actually executed (what wheel encoders report)
   bool blocked = false;          // the move was cut short by a wall or a robot
   double distance_m = 0.0;       // path length travelled
+  // Where the robot's body touched a wall when the move was cut short by one (a bumper's contact,
+  // world frame): the point of the blocked cell nearest to the disc where the full move first
+  // failed. Empty when nothing was hit, or only another robot.
+  std::optional<Eigen::Vector2d> contact;
 };
 
 // Executes `command` for one period along the exact arc, checked in small sub-steps against walls

@@ -82,6 +82,8 @@ json per_robot_json(const RunResult& r, const RunTotals& totals) {
                   {"start", {t.truth.front().x, t.truth.front().y, core::rad2deg(t.truth.front().theta)}},
                   {"distance_m", t.distance_m},
                   {"blocked_moves", t.blocked_moves},
+                  {"blocked_share", t.truth.size() > 1 ? double(t.blocked_moves) / double(t.truth.size() - 1) : 0.0},
+                  {"contacts_marked", t.contacts_marked},
                   {"position_rmse_m", loc.position_rmse},
                   {"heading_rmse_deg", core::rad2deg(loc.heading_rmse)},
                   // Standard NEES (e^T P^-1 e) averaged over the steps with a positive-definite P,
@@ -177,6 +179,7 @@ json metrics_json(const RunResult& r, const std::string& map_label) {
   j["distance_m"] = totals.distance_m;
   j["position_rmse_m"] = totals.position_rmse_m;
   j["blocked_moves"] = totals.blocked_moves;
+  j["blocked_share"] = r.steps > 0 && !r.robots.empty() ? double(totals.blocked_moves) / (double(r.steps) * double(r.robots.size())) : 0.0;
   j["redundancy"] = r.redundancy;
   j["bytes_sent"] = r.bytes_sent;
   j["meetings"] = r.meetings;

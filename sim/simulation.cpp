@@ -396,7 +396,8 @@ void Simulation::step() {
     if (robot.driver) {
       cmd = robot.command.value_or(Command{});
     } else {
-      cmd = streak >= 2 ? escape_command(loc.pose(), robot.map, scenario_.period_s)
+      cmd = streak >= 2 ? clear_on_map(escape_command(loc.pose(), robot.map, scenario_.period_s), loc.pose(), robot.map,
+                                       scenario_.robot, scenario_.period_s)
                         : follow_path(loc.pose(), explorer_.path(i), robot.map, scenario_.robot, scenario_.period_s,
                                       scenario_.lookahead_m);
     }
@@ -414,11 +415,13 @@ void Simulation::step() {
     if (streak > 3) streak = 0;  // the escape did not help either: follow the path again
     if (mv.blocked) {
       ++t.blocked_moves;
-      events_.push_back({step_, "blocked", i, -1, "move stopped by a wall or a robot"});
+      events_.push_back({step_, "blocked", i, -1,
+                         mv.contact ? "move stopped by a wall at " + core::format_point(*mv.contact) : "move stopped by a robot"});
     }
     const auto t_predict = Clock::now();
     loc.predict(mv.odometry);
     t.localization_s += seconds_since(t_predict);
+    if (mv.contact) mark_contact(robot, *mv.contact);
   }
   timing_.motion += seconds_since(t0);
   sense_and_map();
@@ -426,6 +429,23 @@ void Simulation::step() {
   decide();
   measure();
   timing_.total += seconds_since(t_step);
+}
+
+// A bumper: what stopped the robot is a wall on its own map, where its estimate puts the contact,
+// so that its paths go around it from now on. The scan may never see it (a speck between two beams,
+// something below the laser's plane).
+void Simulation::mark_contact(Robot& robot, const Eigen::Vector2d& contact) {
+  const Eigen::Vector2d offset = contact - robot.truth.position();
+  if (offset.norm() < 1e-9) return;
+  // A little past the contact, inside the square that was touched.
+  const Eigen::Vector2d inside = offset + 0.25 * world_.geometry().resolution() * offset.normalized();
+  const double c = std::cos(robot.truth.theta), s = std::sin(robot.truth.theta);
+  const Eigen::Vector2d relative(c * inside.x() + s * inside.y(), -s * inside.x() + c * inside.y());  // the robot's frame
+  const Eigen::Vector2d at = robot.localizer->pose().transform(relative);
+  if (const auto cell = robot.map.geometry().world_to_cell(at)) {
+    if (robot.map.state(*cell) != mapping::CellState::Occupied) ++robot.track.contacts_marked;
+    robot.map.set_state(*cell, mapping::CellState::Occupied);
+  }
 }
 
 void Simulation::run_to_end(const ProgressCallback& progress, const std::function<void(const Simulation&)>& on_step) {

@@ -37,6 +37,7 @@ struct RobotTrack {
   std::vector<localization::Odometry> odometry;  // what its encoders reported, one per step from step 1
   double distance_m = 0.0;
   int blocked_moves = 0;
+  int contacts_marked = 0;  // walls the robot found by touching them, marked on its map
   double localization_s = 0.0;  // the localizer's time: predict and every update
 
   std::vector<std::pair<std::string, double>> localizer_counters;
@@ -235,6 +236,8 @@ class Simulation {
     bool was_finished = false;
     int blocked_streak = 0;  // consecutive blocked moves
   };
+  // What stopped robot's move at `contact` (world frame) becomes a wall on its own map.
+  void mark_contact(Robot& robot, const Eigen::Vector2d& contact);
 
   Scenario scenario_;
   SimulationSetup setup_;

@@ -48,6 +48,26 @@ double World::clearance(const Eigen::Vector2d& p, double horizon_m) const {
   return std::sqrt(best2);
 }
 
+std::optional<Eigen::Vector2d> World::nearest_blocked_point(const Eigen::Vector2d& p, double horizon_m) const {
+  const auto& g = geometry();
+  const Eigen::Vector2d q = g.world_to_grid(p);
+  const Cell c{int(std::floor(q.x())), int(std::floor(q.y()))};
+  const int r = int(std::ceil(horizon_m / g.resolution())) + 1;
+  double best2 = (horizon_m / g.resolution()) * (horizon_m / g.resolution()) + 1e-9;
+  std::optional<Eigen::Vector2d> best;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      const Cell n{c.x + dx, c.y + dy};
+      if (!blocked(n)) continue;
+      // The point of the square [n.x, n.x+1] x [n.y, n.y+1] nearest to q, in cells.
+      const Eigen::Vector2d near(std::clamp(q.x(), double(n.x), double(n.x + 1)), std::clamp(q.y(), double(n.y), double(n.y + 1)));
+      const double d2 = (near - q).squaredNorm();
+      if (d2 < best2) best2 = d2, best = g.grid_to_world(near);
+    }
+  }
+  return best;
+}
+
 bool World::disc_free(const Eigen::Vector2d& p, double radius_m) const {
   return clearance(p, radius_m + 1e-9) > radius_m;
 }

@@ -3,6 +3,7 @@
 // not free in the map blocks robots and sensors.
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "core/random.h"
@@ -55,6 +56,9 @@ class World {
   double clearance(const Eigen::Vector2d& p, double horizon_m) const;
   // A disc of radius r at p touches no blocked cell and lies inside the map.
   bool disc_free(const Eigen::Vector2d& p, double radius_m) const;
+  // The point of the blocked cells (their squares; the map's outside counts) nearest to p, within
+  // horizon_m; nullopt when none is that near.
+  std::optional<Eigen::Vector2d> nearest_blocked_point(const Eigen::Vector2d& p, double horizon_m) const;
 
   // Where a robot of radius `robot_radius_m` can be, region by region.
   ReachableRegions reachable_regions(double robot_radius_m) const;

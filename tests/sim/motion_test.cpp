@@ -82,6 +82,43 @@ TEST(Motion, NoRobotEverPassesThroughAWallOrARobot) {
   EXPECT_GT(blocked, steps / 20) << "the random commands should run into walls and robots often";
 }
 
+// A robot does not drive into what its own map shows: a move toward a wall it knows is cut to what
+// stays clear, down to turning in place; away from it, the move is whole.
+TEST(Motion, CommandsKeepClearOfWhatTheRobotsMapShows) {
+  auto map = testing::walled_room(40, 40);
+  RobotOptions robot;
+  // 0.3 m from the east wall's face (x = 3.9 m), facing it: 0.1 m is all there is.
+  const Command toward = clear_on_map({0.5, 0.0}, core::Pose2(3.6, 2.0, 0.0), map, robot, 1.0);
+  EXPECT_GT(toward.v, 0.0);
+  EXPECT_LE(3.6 + toward.v, 3.9 - robot.radius_m);
+  EXPECT_EQ(clear_on_map({0.5, 0.3}, core::Pose2(3.69, 2.0, 0.0), map, robot, 1.0).v, 0.0);  // turn in place
+  EXPECT_EQ(clear_on_map({-0.3, 0.0}, core::Pose2(3.69, 2.0, 0.0), map, robot, 1.0).v, -0.3);  // backing away
+  // A speck the robot found by touching it is avoided like any wall.
+  auto open = testing::walled_room(40, 40);
+  EXPECT_EQ(clear_on_map({0.5, 0.0}, core::Pose2(1.0, 2.0, 0.0), open, robot, 1.0).v, 0.5);
+  open.set_state({15, 20}, mapping::CellState::Occupied);  // the square [1.5, 1.6] x [2.0, 2.1]
+  EXPECT_LE(clear_on_map({0.5, 0.0}, core::Pose2(1.0, 2.0, 0.0), open, robot, 1.0).v, 0.3 + 1e-9);
+  // A cell the robot already overlaps on its map (a short range reading's mark) does not pin it.
+  open.set_state({10, 21}, mapping::CellState::Occupied);
+  EXPECT_EQ(clear_on_map({-0.5, 0.0}, core::Pose2(1.05, 2.05, 0.0), open, robot, 1.0).v, -0.5);
+}
+
+// A bumper: a blocked move reports where the body touched the wall.
+TEST(Motion, ABlockedMoveSaysWhereItTouchedTheWall) {
+  const World world(testing::walled_room(40, 40), {});
+  core::Random rng(1);
+  const MoveResult m = move_robot(world, 0, {core::Pose2(3.6, 2.0, 0.0)}, RobotOptions{}, {0.5, 0.0}, 1.0, {0.0, 0.0}, rng);
+  ASSERT_TRUE(m.blocked);
+  ASSERT_TRUE(m.contact.has_value());
+  EXPECT_NEAR(m.contact->x(), 3.9, 1e-9);  // the east wall's face
+  EXPECT_NEAR(m.contact->y(), 2.0, 0.06);
+  // Stopped by another robot: no wall was touched.
+  const MoveResult r = move_robot(world, 0, {core::Pose2(2.0, 2.0, 0.0), core::Pose2(2.5, 2.0, 0.0)}, RobotOptions{},
+                                  {0.5, 0.0}, 1.0, {0.0, 0.0}, rng);
+  EXPECT_TRUE(r.blocked);
+  EXPECT_FALSE(r.contact.has_value());
+}
+
 TEST(Motion, EscapeHeadsAwayFromTheWall) {
   auto map = testing::walled_room(40, 40);
   // Facing the east wall, 0.21 m from it: the escape drives backwards.

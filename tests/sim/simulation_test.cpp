@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <opencv2/imgproc.hpp>
 
 #include "core/angle.h"
@@ -62,6 +64,31 @@ TEST(Simulation, ExploresASmallMapAndStopsWhenDone) {
   EXPECT_GT(r.bytes_sent, 0);
   EXPECT_GT(r.redundancy, 0.0);
   EXPECT_LT(r.redundancy, 1.0);
+}
+
+// Specks the scan misses (a room strewn with 5 cm posts, and a robot with 4 beams): a robot that
+// touches one marks it on its map and never drives into it again; without that it pushes against
+// the same post step after step. Every blocked move at a wall is a first touch.
+TEST(Simulation, ARobotLearnsFromTouchingWhatItsScanMissed) {
+  auto room = testing::walled_room(120, 120);  // 6 x 6 m
+  core::Random rng(7);
+  for (int k = 0; k < 80; ++k) room.set_state({rng.uniform_int(10, 110), rng.uniform_int(10, 110)}, mapping::CellState::Occupied);
+  Scenario s;
+  s.map = "room_with_posts";
+  s.robot_count = 1;
+  s.range.beams = 4;  // 90 degrees apart: most posts stay unseen until touched
+  s.steps = 800;
+  const RunResult r = Simulation(s, room).run();
+  ASSERT_EQ(r.robots.size(), 1u);
+  std::set<std::string> touched;
+  int wall_blocks = 0;
+  for (const auto& e : r.events) {
+    if (e.kind != "blocked" || e.detail.find("wall at") == std::string::npos) continue;
+    ++wall_blocks;
+    EXPECT_TRUE(touched.insert(e.detail).second) << "step " << e.step << ": " << e.detail << " again";
+  }
+  EXPECT_GE(wall_blocks, 1) << "the robot should have touched some post";
+  EXPECT_EQ(r.robots[0].contacts_marked, wall_blocks);
 }
 
 // A map finer than the planning resolution: the explorer decides on coarser cells, and the team
