@@ -12,8 +12,9 @@ namespace fleetmap::core {
 // This asks the C library to serve blocks below `heap_block_bytes` from its heap and to keep up to
 // `retain_bytes` of freed heap for reuse (glibc's M_MMAP_THRESHOLD and M_TRIM_THRESHOLD; the
 // memory kept is mostly reused: measured, a Python loop's peak unchanged, an exploration's 14 MB
-// higher, bench/README.md "Freed memory kept for reuse"). Process-wide: call it once,
-// early, from a program's main (the `fleetmap` program and the Python module do). Returns false
+// higher, bench/README.md "Freed memory kept for reuse"). Process-wide, so the application's choice:
+// call it once, early, from a program's main (the `fleetmap` program does; from Python,
+// fleetmap.keep_freed_memory()); linking or importing fleetmap never does. Returns false
 // where the C library has no such settings (not glibc, or an allocator a sanitizer replaced).
 bool keep_freed_memory(std::size_t heap_block_bytes = std::size_t(32) << 20,
                        std::size_t retain_bytes = std::size_t(128) << 20);

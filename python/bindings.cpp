@@ -372,9 +372,14 @@ void register_python_strategy(const std::string& name, const py::object& cls, co
 
 PYBIND11_MODULE(_fleetmap, m) {
   m.doc() = "fleetmap's C++ core; use the package `fleetmap`, which wraps it.";
-  // A script merges or explores over and over: each merge would fault its images' pages in again
-  // (core/memory.h; measured from Python, 4000 faults per merge of two 1000 x 1000 maps).
-  core::keep_freed_memory();
+  // Importing the module changes no process-wide setting: a script that merges in a loop asks for
+  // the allocator setting itself (core/memory.h).
+  m.def(
+      "keep_freed_memory", [] { return core::keep_freed_memory(); },
+      "Asks the C library to keep freed memory for reuse, for the whole process (glibc's M_MMAP_THRESHOLD "
+      "32 MiB and M_TRIM_THRESHOLD 128 MiB). Call it once in a script that merges or explores large maps over "
+      "and over: without it every merge of two 1000 x 1000 maps faults its pages in again. Returns False "
+      "where the C library has no such settings.");
   // pybind11 tries the most recently registered translator first: InputError (an Error) goes last.
   py::register_exception<Error>(m, "Error", PyExc_RuntimeError).doc() =
       "A failure inside fleetmap other than bad input (a RuntimeError).";

@@ -53,12 +53,13 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
     merge_method_names,
     planner_names,
     strategy_names,
+    keep_freed_memory,
 )
 
 __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
     "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
-    "map_names", "strategy_names", "planner_names", "merge_method_names",
+    "map_names", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
 ]
 
 # The built-in maps ship beside the installed package (share/fleetmap/maps); the C++ side looks
