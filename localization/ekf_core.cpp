@@ -136,6 +136,16 @@ bool update_with_robot(EkfCore& filter, const RobotObservation& o, const Eigen::
   return true;
 }
 
+void RobotDetectionUpdates::apply(EkfCore& filter, const RobotObservation& o, const Eigen::Matrix2d& measurement_noise,
+                                  const LocalizerOptions& options) {
+  if (!options.use_robot_detections) return;
+  ++(update_with_robot(filter, o, measurement_noise, options.association_gate) ? updates_ : rejected_);
+}
+
+std::vector<std::pair<std::string, double>> RobotDetectionUpdates::counters() const {
+  return {{"robot_updates", static_cast<double>(updates_)}, {"rejected_robot_detections", static_cast<double>(rejected_)}};
+}
+
 NearestNeighbourAssociation associate_nearest_neighbour(const Eigen::MatrixXd& d2, double gate) {
   const Eigen::Index readings = d2.rows(), candidates = d2.cols();
   NearestNeighbourAssociation out;

@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 
 #include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "core/transform2.h"
@@ -80,6 +82,20 @@ class EkfCore {
 // the reading passes the chi-square `gate`; returns whether it was.
 bool update_with_robot(EkfCore& filter, const RobotObservation& observation, const Eigen::Matrix2d& measurement_noise,
                        double gate);
+
+// Robot-robot detections applied to an EKF localizer's filter (when the localizer's options use
+// them), and counted as metrics.json's "robot_updates" and "rejected_robot_detections": `ekf` and
+// `ekf-slam` share it.
+class RobotDetectionUpdates {
+ public:
+  void apply(EkfCore& filter, const RobotObservation& observation, const Eigen::Matrix2d& measurement_noise,
+             const LocalizerOptions& options);
+  std::vector<std::pair<std::string, double>> counters() const;
+
+ private:
+  long updates_ = 0;
+  long rejected_ = 0;
+};
 
 // Global nearest neighbour: every (reading, candidate) pair in increasing squared Mahalanobis
 // distance is accepted while both are still free and the distance is within `gate`. `d2` has one

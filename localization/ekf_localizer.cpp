@@ -65,14 +65,7 @@ class EkfLocalizer final : public Localizer {
     }
   }
 
-  void update_robot(const RobotObservation& o) override {
-    if (!options_.use_robot_detections) return;
-    if (update_with_robot(filter_, o, r_, options_.association_gate)) {
-      ++robot_updates_;
-    } else {
-      ++rejected_robot_detections_;
-    }
-  }
+  void update_robot(const RobotObservation& o) override { detections_.apply(filter_, o, r_, options_); }
 
   core::Pose2 pose() const override { return filter_.pose(); }
   Eigen::Matrix3d covariance() const override { return filter_.pose_covariance(); }
@@ -86,10 +79,10 @@ class EkfLocalizer final : public Localizer {
   }
 
   std::vector<std::pair<std::string, double>> counters() const override {
-    return {{"landmark_updates", static_cast<double>(landmark_updates_)},
-            {"rejected_associations", static_cast<double>(rejected_associations_)},
-            {"robot_updates", static_cast<double>(robot_updates_)},
-            {"rejected_robot_detections", static_cast<double>(rejected_robot_detections_)}};
+    auto out = detections_.counters();
+    out.insert(out.begin(), {{"landmark_updates", static_cast<double>(landmark_updates_)},
+                             {"rejected_associations", static_cast<double>(rejected_associations_)}});
+    return out;
   }
 
  private:
@@ -123,8 +116,7 @@ class EkfLocalizer final : public Localizer {
   std::map<int, std::size_t> by_id_;
   long landmark_updates_ = 0;
   long rejected_associations_ = 0;
-  long robot_updates_ = 0;
-  long rejected_robot_detections_ = 0;
+  RobotDetectionUpdates detections_;
 };
 
 }  // namespace

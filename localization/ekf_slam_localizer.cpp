@@ -78,27 +78,20 @@ class EkfSlamLocalizer final : public Localizer {
     }
   }
 
-  void update_robot(const RobotObservation& o) override {
-    if (!options_.use_robot_detections) return;
-    if (update_with_robot(filter_, o, r_, options_.association_gate)) {
-      ++robot_updates_;
-    } else {
-      ++rejected_robot_detections_;
-    }
-  }
+  void update_robot(const RobotObservation& o) override { detections_.apply(filter_, o, r_, options_); }
 
   core::Pose2 pose() const override { return filter_.pose(); }
   Eigen::Matrix3d covariance() const override { return filter_.pose_covariance(); }
   void change_frame(const core::Transform2& t) override { filter_.change_frame(t); }
 
   std::vector<std::pair<std::string, double>> counters() const override {
-    return {{"landmark_updates", static_cast<double>(landmark_updates_)},
-            {"rejected_associations", static_cast<double>(rejected_associations_)},
-            {"robot_updates", static_cast<double>(robot_updates_)},
-            {"rejected_robot_detections", static_cast<double>(rejected_robot_detections_)},
-            {"landmarks_in_state", static_cast<double>(filter_.landmark_count())},
-            {"landmarks_added", static_cast<double>(landmarks_added_)},
-            {"landmarks_removed", static_cast<double>(landmarks_removed_)}};
+    auto out = detections_.counters();
+    out.insert(out.begin(), {{"landmark_updates", static_cast<double>(landmark_updates_)},
+                             {"rejected_associations", static_cast<double>(rejected_associations_)}});
+    out.insert(out.end(), {{"landmarks_in_state", static_cast<double>(filter_.landmark_count())},
+                           {"landmarks_added", static_cast<double>(landmarks_added_)},
+                           {"landmarks_removed", static_cast<double>(landmarks_removed_)}});
+    return out;
   }
 
   bool estimates_landmarks() const override { return true; }
@@ -190,8 +183,7 @@ class EkfSlamLocalizer final : public Localizer {
   int next_id_ = 0;
   long landmark_updates_ = 0;
   long rejected_associations_ = 0;
-  long robot_updates_ = 0;
-  long rejected_robot_detections_ = 0;
+  RobotDetectionUpdates detections_;
   long landmarks_added_ = 0;
   long landmarks_removed_ = 0;
 };
