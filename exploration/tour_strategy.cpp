@@ -22,7 +22,7 @@ namespace {
 // first target; a robot with an empty tour drives ahead to where unknown space will open
 // (drive_ahead).
 //
-// Why not the min-max split (the longest tour as short as possible, plan_tours): measured on the
+// Why not the min-max split (the longest tour as short as possible): measured on the
 // wave-algorithm paper's maps it was slower than Burgard's utility reduction (bench/README.md,
 // "Tour strategy"): once one tour is the longest, the others are free to grow up to it, so robots
 // drove across the map to targets idle robots stood beside, and every frontier piece counted the
