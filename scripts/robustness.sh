@@ -23,12 +23,12 @@ ctest --test-dir build-asan -j"$jobs" --output-on-failure -LE slow
 # libFuzzer needs clang: a second build with only the fuzz targets and what they link.
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DFLEETMAP_FUZZ=ON -DFLEETMAP_BUILD_BENCH=OFF \
   -DFLEETMAP_BUILD_TESTS=OFF
-cmake --build build-fuzz --target fuzz_map_image fuzz_map_yaml fuzz_scenario fuzz_sweep fuzz_slam_scenario
+cmake --build build-fuzz --target fuzz_map_image fuzz_map_yaml fuzz_scenario fuzz_sweep fuzz_slam_scenario fuzz_laser_log
 
 # Fuzz from a copy of the seed corpus, so that the repository's corpus stays as committed.
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-for target in map_image map_yaml scenario sweep slam_scenario; do
+for target in map_image map_yaml scenario sweep slam_scenario laser_log; do
   mkdir -p "$work/$target" "$work/artifacts"
   cp fuzz/corpus/$target/* "$work/$target/"
   echo "robustness: fuzzing $target for ${seconds} s"
