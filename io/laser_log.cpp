@@ -363,8 +363,9 @@ std::vector<Relation> parse_relations(const std::string& text, const std::string
     r.t2_text = std::string(line.word(1));
     r.t1 = line.finite(0, "t1");
     r.t2 = line.finite(1, "t2");
-    r.t1_tolerance = half_last_digit(r.t1_text);
-    r.t2_tolerance = half_last_digit(r.t2_text);
+    // Plus a few units in the last place of the double, which rounding the text may have cost.
+    r.t1_tolerance = half_last_digit(r.t1_text) + 4.0 * (std::nextafter(r.t1, INFINITY) - r.t1);
+    r.t2_tolerance = half_last_digit(r.t2_text) + 4.0 * (std::nextafter(r.t2, INFINITY) - r.t2);
     r.motion = core::Pose2(line.finite(2, "x"), line.finite(3, "y"), line.finite(7, "yaw"));
     for (std::size_t i : {4u, 5u, 6u}) line.finite(i, i == 4 ? "z" : (i == 5 ? "roll" : "pitch"));
     out.push_back(std::move(r));
