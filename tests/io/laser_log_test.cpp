@@ -195,7 +195,8 @@ TEST(Relations, ReadWithTheToleranceTheirDigitsGive) {
   ASSERT_EQ(r.size(), 1u);
   EXPECT_EQ(r[0].line, 2u);
   EXPECT_EQ(r[0].t1_text, "1134864645.90321");
-  EXPECT_NEAR(r[0].t1_tolerance, 0.000005, 1e-8);
+  // Half the last digit, and four units in the last place of a double near 1.1e9 (2.4e-7 each).
+  EXPECT_NEAR(r[0].t1_tolerance, 0.000005 + 4 * 2.384185791015625e-07, 1e-12);
   EXPECT_NEAR(r[0].motion.x, 0.31293, 1e-12);
   EXPECT_NEAR(r[0].motion.theta, 0.24198, 1e-12);
   expect_input_error([] { parse_relations("1 2 3\n", "rel.txt"); }, {"rel.txt:1:", "8 numbers"});
