@@ -463,7 +463,8 @@ Command add_explore_command(CLI::App& root) {
       ->check(one_of(exploration::strategy_names()));
   app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]")
       ->check(one_of(localization::localizer_names()));
-  app->add_option("--merging", f->merging, "known, none, rendezvous, overlap or landmarks (see below) [default: known]")
+  app->add_option("--merging", f->merging, "How robots bring teammates' maps into their frame: " + core::join(sim::merging_names()) +
+                      " (see below) [default: known]")
       ->check(one_of(sim::merging_names()));
   app->add_option("--comm-range", f->comm_range,
                   "Communication range in metres; 0 = only when robots see each other; inf = always [default: inf]")
@@ -474,7 +475,7 @@ Command add_explore_command(CLI::App& root) {
       ->check(in_range(sim::limits::kSensorRange));
   app->add_option("--beams", f->beams, "Laser beams over 360 degrees [default: 360]")->check(in_range(sim::limits::kBeams));
   app->add_option("--landmarks", f->landmarks,
-                  "Point landmarks placed along the walls, per metre of wall, for --localization ekf or ekf-slam "
+                  "Point landmarks placed along the walls, per metre of wall, for --localization ekf, ekf-slam or fastslam2 "
                   "[default: 0]")
       ->check(in_range(sim::limits::kLandmarksPerMetre));
   app->add_option("--path-planner", f->path_planner,
