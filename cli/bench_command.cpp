@@ -424,7 +424,13 @@ Command add_bench_command(CLI::App& root) {
   app->add_option("--vary", s.vary,
                   "A further sweep axis, SETTING=V1,V2,... (repeat for more): a scenario key such as "
                   "sensors.range.beams or communication.range, or beams, sensor_range, comm_range, localization, merging, "
-                  "path_planner, steps, noise_position; e.g. --vary beams=90,360 --vary comm_range=5,inf")
+                  "path_planner, steps, noise_position, or a strategy parameter strategy.KEY (the strategies that do not "
+                  "declare it run once per value unchanged); e.g. --vary beams=90,360 --vary strategy.beta=0.5,2")
+      ->expected(1)
+      ->take_all();
+  app->add_option("--set", s.set,
+                  "A strategy parameter in every run, strategy.KEY=VALUE (repeat for more), e.g. --set strategy.beta=0.5; "
+                  "it applies to the strategies that declare it (see `fleetmap plugins`)")
       ->expected(1)
       ->take_all();
   app->add_option("--jobs,-j", f->jobs, "Runs at once (threads) [default: the number of cores]")

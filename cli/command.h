@@ -22,5 +22,6 @@ Command add_slam_command(CLI::App& root);
 Command add_explore_command(CLI::App& root);
 Command add_bench_command(CLI::App& root);
 Command add_replay_compare_command(CLI::App& root);
+Command add_plugins_command(CLI::App& root);
 
 }  // namespace fleetmap::cli

@@ -39,6 +39,7 @@ struct ExploreFlags {
   std::string scenario;
   std::optional<std::string> map, strategy, localization, comm_range, path_planner, merging, starts, cluster_at;
   std::vector<std::string> start;  // --start x,y[,heading_deg], once per robot
+  std::vector<std::string> set;    // --set FAMILY.KEY=VALUE
   std::optional<double> min_separation, resolution;
   std::string plan_from, plan_to, planner = "astar";
   double plan_time = 1.0;
@@ -95,7 +96,12 @@ sim::Scenario scenario_from(const ExploreFlags& f) {
     s.cluster_at = Eigen::Vector2d(p->first, p->second);
   }
   if (f.min_separation) s.min_separation_m = *f.min_separation;
-  if (f.strategy) s.exploration.strategy = *f.strategy;
+  if (f.strategy && *f.strategy != s.exploration.strategy) {
+    s.exploration.strategy = *f.strategy;
+    // The scenario's settings were for its own strategy: the new one keeps those it declares too.
+    s.exploration.strategy_settings = exploration::declared_settings(*f.strategy, s.exploration.strategy_settings);
+  }
+  for (const auto& text : f.set) sim::set_parameter(s, text, "--set " + text);
   if (f.localization) s.localization = *f.localization;
   if (f.comm_range) s.communication.range_m = *core::parse_in_range(*f.comm_range, sim::limits::kCommRange);
   if (f.merging) s.merging = *f.merging;
@@ -461,6 +467,11 @@ Command add_explore_command(CLI::App& root) {
       ->check(in_range(sim::limits::kSeparation));
   app->add_option("--strategy", f->strategy, "Coordination strategy [default: directional]")
       ->check(one_of(exploration::strategy_names()));
+  app->add_option("--set", f->set,
+                  "A parameter of the strategy, FAMILY.KEY=VALUE (repeat for more), e.g. --set strategy.beta=0.5; "
+                  "each strategy's parameters and defaults are listed below and by `fleetmap plugins`")
+      ->expected(1)
+      ->take_all();
   app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]")
       ->check(one_of(localization::localizer_names()));
   app->add_option("--merging", f->merging, "How robots bring teammates' maps into their frame: " + core::join(sim::merging_names()) +

@@ -146,6 +146,7 @@ int main(int argc, char** argv) {
   commands.push_back(fm::cli::add_plan_command(app));
   commands.push_back(fm::cli::add_slam_command(app));
   commands.push_back(fm::cli::add_replay_compare_command(app));
+  commands.push_back(fm::cli::add_plugins_command(app));
 
   try {
     check_words_and_flags(app, argc, argv);

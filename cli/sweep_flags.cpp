@@ -33,6 +33,7 @@ void apply_sweep_flags(sweep::Sweep& sweep, const SweepFlags& f) {
   if (f.comm_range) sweep.base.communication.range_m = sweep::parse_comm_range(*f.comm_range, "--comm-range");
   if (f.sensor_range) sweep.base.range.max_range_m = *f.sensor_range;
   if (f.resolution) sweep.base.map_resolution_m = *f.resolution;
+  for (const auto& text : f.set) sim::set_parameter(sweep.base, text, "--set " + text);
   if (!f.vary.empty()) {
     sweep.axes.clear();
     for (const auto& text : f.vary) sweep.axes.push_back(sweep::parse_axis(text, "--vary " + text));

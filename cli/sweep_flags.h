@@ -21,10 +21,11 @@ struct SweepFlags {
   std::optional<double> sensor_range;
   std::optional<double> resolution;  // metres per cell of bare image maps
   std::vector<std::string> vary;  // "SETTING=V1,V2", each a further axis (replacing the file's)
+  std::vector<std::string> set;   // "FAMILY.KEY=VALUE", a member's parameter in every run
 
   bool any() const {
     return maps || strategies || robots || seeds || first_seed || scenario || steps || localization || merging ||
-           comm_range || sensor_range || resolution || !vary.empty();
+           comm_range || sensor_range || resolution || !vary.empty() || !set.empty();
   }
 };
 

@@ -1,6 +1,7 @@
 #pragma once
 // One open registry per family of variants: coordination strategies, localizers, map aligners,
-// merge methods, planners, built-in maps. Each member has a name, a line of help and a factory.
+// merge methods, planners, built-in maps. Each member has a name, a line of help, the parameters
+// it declares (core/params.h) and a factory.
 // The built-in members are added when the family is first used; a program that links fleetmap
 // adds its own through the family's public register_* call, and the command line, scenario files
 // and test harnesses then reach it by name like the built-in ones (as Nav2's plugins or OMPL's
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/params.h"
 #include "core/suggest.h"
 
 namespace fleetmap::core {
@@ -23,13 +25,15 @@ class Registry {
     std::string name;
     std::string help;  // one line: what the member does and its source
     Factory make;
+    std::vector<ParamSpec> params;  // what the member can be given, with defaults
   };
 
   // `family` names the members in messages ("strategy", "localization", "planner").
   explicit Registry(std::string family) : family_(std::move(family)) {}
 
   // Throws Error for an empty name, a name with spaces or commas, or a name already taken.
-  void add(std::string name, std::string help, Factory make) {
+  // Throws Error as Params does for an unusable declaration.
+  void add(std::string name, std::string help, Factory make, std::vector<ParamSpec> params = {}) {
     if (name.empty() || name.find_first_of(" ,\t\n") != std::string::npos) {
       throw Error("register " + family_ + ": '" + name + "' is not a usable name (no spaces or commas)");
     }
@@ -37,7 +41,8 @@ class Registry {
     for (const auto& e : entries_) {
       if (e.name == name) throw Error("register " + family_ + ": '" + name + "' is already registered");
     }
-    entries_.push_back({std::move(name), std::move(help), std::move(make)});
+    Params check(family_ + " '" + name + "'", params);
+    entries_.push_back({std::move(name), std::move(help), std::move(make), std::move(params)});
   }
 
   // Throws InputError naming the valid names (and the nearest one) for an unknown one.
@@ -50,6 +55,12 @@ class Registry {
     std::string list;
     for (const auto& e : entries_) names.push_back(e.name), list += (list.empty() ? "" : ", ") + e.name;
     throw InputError("unknown " + family_ + " '" + std::string(name) + "'" + did_you_mean(name, names) + " (valid: " + list + ")");
+  }
+
+  // The member's parameters at their defaults (throws as get() for an unknown name).
+  Params params(std::string_view name) const {
+    const auto& e = get(name);
+    return Params(family_ + " '" + e.name + "'", e.params);
   }
 
   bool contains(std::string_view name) const {
@@ -68,11 +79,14 @@ class Registry {
     return out;
   }
 
-  // "  name: help" per member, for --help and README.
+  // "  name: help" per member, then "      key = default (accepted): doc" per parameter, for --help.
   std::string help() const {
     const std::lock_guard<std::mutex> lock(mutex_);
     std::string out;
-    for (const auto& e : entries_) out += "  " + e.name + ": " + e.help + "\n";
+    for (const auto& e : entries_) {
+      out += "  " + e.name + ": " + e.help + "\n";
+      for (const auto& p : e.params) out += "      " + p.describe() + "\n";
+    }
     return out;
   }
 

@@ -14,7 +14,7 @@ namespace {
 // chosen one would likely reveal (within the sensor range).
 class Coordinated final : public CoordinationStrategy {
  public:
-  explicit Coordinated(const StrategyOptions& o) : beta_(o.beta) {}
+  explicit Coordinated(const StrategyOptions& o) : beta_(o.number("beta")) {}
   std::string name() const override { return "coordinated"; }
   bool joint() const override { return true; }
 

@@ -17,7 +17,7 @@ namespace {
 // direction)) / 2.
 class Directional final : public CoordinationStrategy {
  public:
-  explicit Directional(const StrategyOptions& o) : weight_(o.directional_weight) {}
+  explicit Directional(const StrategyOptions& o) : weight_(o.number("weight")) {}
   std::string name() const override { return "directional"; }
   bool joint() const override { return false; }
 

@@ -14,7 +14,7 @@ namespace {
 // together (wave-algorithm paper, Fig. 4). Solved exactly as an assignment problem with the Hungarian method.
 class Optimized final : public CoordinationStrategy {
  public:
-  explicit Optimized(const StrategyOptions& o) : beta_(o.beta) {}
+  explicit Optimized(const StrategyOptions& o) : beta_(o.number("beta")) {}
   std::string name() const override { return "optimized"; }
   bool joint() const override { return true; }
 

@@ -15,15 +15,19 @@ core::Registry<StrategyFactory>& strategy_registry() {
   static const bool built_in = [] {
     auto& r = registry;
     r.add("uncoordinated", "each robot to its nearest frontier by wave cost (Yamauchi 1998)", make_uncoordinated_strategy);
+    const auto beta = core::ParamSpec::number(
+        "beta", 1.0, {0, 1e6}, "", "weight of travel cost against utility, costs scaled to [0, 1]");
     r.add("coordinated", "greedy utility minus beta * cost, utility reduced around assigned targets (Burgard et al. 2005)",
-          make_coordinated_strategy);
+          make_coordinated_strategy, {beta});
     r.add("optimized",
           "assignment minimising squared costs minus utility, solved exactly (Hungarian method; the wave "
           "algorithm paper's eq. (3))",
-          make_optimized_strategy);
+          make_optimized_strategy, {beta});
     r.add("directional", "nearest frontier with a preference for each robot's own direction (the wave algorithm's "
                          "directional priority)",
-          make_directional_strategy);
+          make_directional_strategy,
+          {core::ParamSpec::number("weight", 0.5, {0, 1e6}, "",
+                                   "how strongly a robot prefers targets in its own direction (0: not at all)")});
     r.add("market", "sequential single-item auction, min-max bids on wave cost (Koenig et al. 2006; Zlot et al. 2002)",
           make_market_strategy);
     r.add("tour",
@@ -37,16 +41,31 @@ core::Registry<StrategyFactory>& strategy_registry() {
   return registry;
 }
 
-void register_strategy(std::string name, std::string help, StrategyFactory make) {
-  strategy_registry().add(std::move(name), std::move(help), std::move(make));
+void register_strategy(std::string name, std::string help, StrategyFactory make, std::vector<core::ParamSpec> params) {
+  strategy_registry().add(std::move(name), std::move(help), std::move(make), std::move(params));
 }
 
 std::vector<std::string> strategy_names() { return strategy_registry().names(); }
 
 std::string strategy_help() { return strategy_registry().help(); }
 
-std::unique_ptr<CoordinationStrategy> make_strategy(const std::string& name, const StrategyOptions& options) {
-  return strategy_registry().get(name).make(options);
+StrategyOptions strategy_options(const std::string& name, const StrategySettings& settings) {
+  auto options = strategy_registry().params(name);
+  for (const auto& [key, value] : settings) options.set(key, value);
+  return options;
+}
+
+StrategySettings declared_settings(const std::string& name, const StrategySettings& settings) {
+  const auto options = strategy_registry().params(name);
+  StrategySettings out;
+  for (const auto& s : settings) {
+    if (options.declares(s.first)) out.push_back(s);
+  }
+  return out;
+}
+
+std::unique_ptr<CoordinationStrategy> make_strategy(const std::string& name, const StrategySettings& settings) {
+  return strategy_registry().get(name).make(strategy_options(name, settings));
 }
 
 double visibility_overlap(double distance_m, double sensor_range_m) {

@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/registry.h"
@@ -13,12 +14,12 @@
 
 namespace fleetmap::exploration {
 
-struct StrategyOptions {
-  // Weight of travel cost against utility (Burgard et al. 2005's beta; the wave-algorithm paper, eq. (3)).
-  double beta = 1.0;
-  // `directional`: how strongly a robot prefers targets in its own direction (0: not at all).
-  double directional_weight = 0.5;
-};
+// A strategy's parameters with their values: those it declared when it was registered, each at
+// its default unless a scenario file, `--set strategy.KEY=VALUE` or a sweep axis set it.
+using StrategyOptions = core::Params;
+// Settings by name, as written in a scenario file ({beta: "0.5"}), applied over the defaults of
+// whichever strategy is made: a sweep gives each run's strategy those it declares.
+using StrategySettings = std::vector<std::pair<std::string, std::string>>;
 
 // What a strategy weighed when it chose targets, for a replay to show why (a robot's candidates and
 // their score terms). Strategies fill it only when AssignmentInput::scores asks: no cost otherwise.
@@ -86,13 +87,20 @@ using StrategyFactory = std::function<std::unique_ptr<CoordinationStrategy>(cons
 core::Registry<StrategyFactory>& strategy_registry();
 // Adds a strategy: `--strategy NAME`, scenario files, sweeps and the test harnesses reach it.
 // Throws Error when the name is taken or unusable.
-void register_strategy(std::string name, std::string help, StrategyFactory make);
+// `params` are the settings the strategy accepts (core/params.h); its factory gets their values.
+void register_strategy(std::string name, std::string help, StrategyFactory make,
+                       std::vector<core::ParamSpec> params = {});
 
 std::vector<std::string> strategy_names();
 // One line per strategy with its source, for --help and README.
 std::string strategy_help();
-// Throws InputError listing the valid names for an unknown one.
-std::unique_ptr<CoordinationStrategy> make_strategy(const std::string& name, const StrategyOptions& options = {});
+// The strategy's declared parameters with `settings` applied. Throws InputError for an unknown
+// strategy (listing the valid names), a setting it does not declare or a value out of its range.
+StrategyOptions strategy_options(const std::string& name, const StrategySettings& settings = {});
+// The settings among `settings` that strategy `name` declares (a sweep's runs of several strategies).
+StrategySettings declared_settings(const std::string& name, const StrategySettings& settings);
+// Throws as strategy_options().
+std::unique_ptr<CoordinationStrategy> make_strategy(const std::string& name, const StrategySettings& settings = {});
 
 // ---- helpers shared by the strategies ----
 

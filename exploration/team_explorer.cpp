@@ -70,7 +70,7 @@ void mark_robots(const mapping::OccupancyGrid& map, const std::vector<ExplorerRo
 
 TeamExplorer::TeamExplorer(int robots, const ExplorationOptions& options)
     : options_(options),
-      strategy_(make_strategy(options.strategy, options.strategy_options)),
+      strategy_(make_strategy(options.strategy, options.strategy_settings)),
       robots_(std::size_t(std::max(0, robots))),
       given_up_(robots_.size()) {}
 

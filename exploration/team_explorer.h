@@ -21,7 +21,7 @@ namespace fleetmap::exploration {
 
 struct ExplorationOptions {
   std::string strategy = "directional";
-  StrategyOptions strategy_options;
+  StrategySettings strategy_settings;  // over the strategy's declared defaults
   WaveOptions wave;
   TargetOptions targets;
   TraversabilityOptions traversability;

@@ -139,6 +139,36 @@ std::string YamlMap::choice(const std::string& key, const std::string& fallback,
                    core::join(valid) + ")");
 }
 
+YamlMap::Member YamlMap::member(const std::string& key, const Member& fallback, const std::vector<std::string>& valid,
+                                const std::function<core::Params(const std::string&)>& declared) {
+  const auto n = node(key);
+  if (!n) return fallback;
+  if (n->IsScalar()) return {choice(key, fallback.name, valid), {}};
+  if (!n->IsMap()) throw InputError(where(key) + ": expected a name or {name: NAME, PARAMETER: VALUE, ...}, got " + describe_node(*n));
+  YamlMap m(*n, source_, full_key(key));
+  Member out;
+  out.name = m.choice("name", fallback.name, valid);
+  if (out.name == fallback.name && !m.has("name")) out.settings = fallback.settings;
+  core::Params params = declared(out.name);
+  for (const auto& kv : *n) {
+    const std::string k = kv.first.Scalar();
+    if (k == "name") continue;
+    m.node(k);
+    if (!kv.second.IsScalar()) {
+      throw InputError(m.where(k) + ": expected " + (params.declares(k) ? "a value" : "a parameter") + ", got " +
+                       describe_node(kv.second));
+    }
+    try {
+      params.set(k, kv.second.Scalar());
+    } catch (const InputError& e) {
+      throw InputError(m.where(k) + ": " + e.what());
+    }
+    std::erase_if(out.settings, [&](const auto& s) { return s.first == k; });
+    out.settings.emplace_back(k, params.value_text(k));
+  }
+  return out;
+}
+
 std::vector<double> YamlMap::numbers(const std::string& key, std::size_t size) {
   const auto n = node(key);
   if (!n) return {};

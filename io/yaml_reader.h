@@ -5,11 +5,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "core/params.h"
 #include "core/range.h"
 
 namespace fleetmap::io {
@@ -39,6 +41,16 @@ class YamlMap {
   bool boolean(const std::string& key, bool fallback);
   std::string text(const std::string& key, const std::string& fallback);
   std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& valid);
+  // A registered member chosen by `key`: its name (`strategy: coordinated`) or a mapping of its name
+  // and its own parameters (`strategy: {name: coordinated, beta: 0.5}`). Each parameter is checked
+  // against `declared(name)` (the member's parameters at their defaults); errors name the key.
+  // An absent key gives `fallback`; a mapping without `name` keeps the fallback's member.
+  struct Member {
+    std::string name;
+    std::vector<std::pair<std::string, std::string>> settings;  // in the order written
+  };
+  Member member(const std::string& key, const Member& fallback, const std::vector<std::string>& valid,
+                const std::function<core::Params(const std::string&)>& declared);
   // A list of numbers; `size` 0 accepts any length.
   std::vector<double> numbers(const std::string& key, std::size_t size = 0);
 

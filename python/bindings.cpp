@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -243,8 +244,18 @@ class AssignmentContext {
   }
   int team_size() const { return live().robots.empty() ? 0 : live().robots.front().team_size; }
   double sensor_range() const { return live().sensor_range_m; }
-  double beta() const { return options_.beta; }
-  double directional_weight() const { return options_.directional_weight; }
+  // The strategy's declared parameters with this run's values: numbers as float, flags as bool.
+  py::dict params() const {
+    py::dict out;
+    for (const auto& spec : options_.specs()) {
+      switch (spec.type) {
+        case core::ParamSpec::Type::Number: out[py::str(spec.name)] = options_.number(spec.name); break;
+        case core::ParamSpec::Type::Flag: out[py::str(spec.name)] = options_.flag(spec.name); break;
+        case core::ParamSpec::Type::Text: out[py::str(spec.name)] = options_.text(spec.name); break;
+      }
+    }
+    return out;
+  }
   py::array_t<double> target_costs() const {
     const auto& input = live();
     Eigen::MatrixXd costs;
@@ -352,8 +363,28 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
   exploration::StrategyOptions options_;
 };
 
+// One declared parameter from Python: (name, kind "number" | "flag" | "text", default as text, unit,
+// lowest, highest, whole, choices, doc), as fleetmap.register_strategy builds it.
+using PythonParam = std::tuple<std::string, std::string, std::string, std::string, double, double, bool,
+                               std::vector<std::string>, std::string>;
+
+core::ParamSpec param_spec(const PythonParam& p) {
+  const auto& [name, kind, default_value, unit, lo, hi, whole, choices, doc] = p;
+  core::ParamSpec spec;
+  spec.name = name;
+  spec.type = kind == "flag" ? core::ParamSpec::Type::Flag
+              : kind == "text" ? core::ParamSpec::Type::Text
+                               : core::ParamSpec::Type::Number;
+  spec.default_value = default_value;
+  spec.unit = unit;
+  spec.range = {lo, hi, whole};
+  spec.choices = choices;
+  spec.doc = doc;
+  return spec;
+}
+
 void register_python_strategy(const std::string& name, const py::object& cls, const std::string& help, bool joint,
-                              bool with_context) {
+                              bool with_context, const std::vector<PythonParam>& params) {
   if (!py::hasattr(cls, "assign")) throw InputError("register_strategy '" + name + "': the class has no assign method");
   // The registry keeps its factories for the life of the process, beyond the interpreter's; the
   // class is held by a reference that is never released, so no Python object dies without it.
@@ -365,7 +396,12 @@ void register_python_strategy(const std::string& name, const py::object& cls, co
                                    py::object instance = py::reinterpret_borrow<py::object>(held)();
                                    return std::make_unique<PythonStrategy>(name, joint, with_context,
                                                                            std::move(instance), options);
-                                 });
+                                 },
+                                 [&] {
+                                   std::vector<core::ParamSpec> specs;
+                                   for (const auto& p : params) specs.push_back(param_spec(p));
+                                   return specs;
+                                 }());
 }
 
 }  // namespace
@@ -456,6 +492,36 @@ PYBIND11_MODULE(_fleetmap, m) {
   }, "The built-in maps' names (load_map, scenario key `map`).");
   m.def("strategy_names", &exploration::strategy_names,
         "Every coordination strategy's name, the built-in ones and those registered (scenario exploration.strategy).");
+  m.def(
+      "strategies",
+      [] {
+        py::list out;
+        const auto& registry = exploration::strategy_registry();
+        for (const auto& name : registry.names()) {
+          py::list params;
+          for (const auto& spec : registry.get(name).params) {
+            py::dict p;
+            p["name"] = spec.name;
+            p["kind"] = spec.type == core::ParamSpec::Type::Number ? "number"
+                        : spec.type == core::ParamSpec::Type::Flag ? "flag"
+                                                                    : "text";
+            p["default"] = spec.default_value;
+            p["unit"] = spec.unit;
+            p["accepts"] = spec.expected();
+            p["doc"] = spec.doc;
+            params.append(p);
+          }
+          py::dict member;
+          member["name"] = name;
+          member["help"] = registry.get(name).help;
+          member["params"] = params;
+          out.append(member);
+        }
+        return out;
+      },
+      "Every coordination strategy, built-in and registered: a list of {name, help, params}, each parameter a "
+      "{name, kind, default, unit, accepts, doc} (scenario exploration.strategy: {name: ..., KEY: VALUE}, "
+      "--set strategy.KEY=VALUE).");
   m.def("planner_names", &planning::planner_names, "Every path planner's name (plan_path's `planner`).");
   m.def("merge_method_names", &merging::merge_method_names, "Every merge method's name (merge_maps's `method`).");
 
@@ -568,7 +634,7 @@ PYBIND11_MODULE(_fleetmap, m) {
       py::arg("time_budget"), py::arg("seed"), py::call_guard<py::gil_scoped_release>());
 
   m.def("_register_strategy", &register_python_strategy, py::arg("name"), py::arg("cls"), py::arg("help"),
-        py::arg("joint"), py::arg("with_context"));
+        py::arg("joint"), py::arg("with_context"), py::arg("params"));
 
   py::class_<AssignmentContext>(m, "AssignmentContext",
                                 "What a Python strategy's assign gets as its optional fifth argument; valid only "
@@ -578,10 +644,9 @@ PYBIND11_MODULE(_fleetmap, m) {
       .def_property_readonly("team_size", &AssignmentContext::team_size, "robots in the team")
       .def_property_readonly("sensor_range", &AssignmentContext::sensor_range,
                              "the range sensor's reach, metres (targets this close to a claimed goal see less new)")
-      .def_property_readonly("beta", &AssignmentContext::beta,
-                             "weight of travel cost against utility (scenario exploration.beta; Burgard et al. 2005)")
-      .def_property_readonly("directional_weight", &AssignmentContext::directional_weight,
-                             "scenario exploration.directional_weight")
+      .def_property_readonly("params", &AssignmentContext::params,
+                             "the strategy's declared parameters with this run's values (register_strategy's params, "
+                             "set by scenario exploration.strategy: {name: ..., KEY: VALUE} or --set strategy.KEY=VALUE)")
       .def("target_costs", &AssignmentContext::target_costs,
            "(T, T) wave costs between the targets' goals, metres (inf: not connected); computed when called")
       .def("target_gains", &AssignmentContext::target_gains,

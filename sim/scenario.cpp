@@ -11,6 +11,7 @@
 #include "core/format.h"
 #include "core/angle.h"
 #include "core/error.h"
+#include "core/params.h"
 #include "core/suggest.h"
 #include "io/file_io.h"
 #include "io/file_kind.h"
@@ -195,9 +196,19 @@ void read_communication(io::YamlMap& top, Scenario& s) {
 void read_exploration(io::YamlMap& top, Scenario& s) {
   auto ex = top.map("exploration");
   auto& e = s.exploration;
-  e.strategy = ex.choice("strategy", e.strategy, exploration::strategy_names());
-  e.strategy_options.beta = ex.number("beta", e.strategy_options.beta, limits::kWeight);
-  e.strategy_options.directional_weight = ex.number("directional_weight", e.strategy_options.directional_weight, limits::kWeight);
+  const auto strategy = ex.member("strategy", {e.strategy, e.strategy_settings}, exploration::strategy_names(),
+                                  [](const std::string& name) { return exploration::strategy_options(name); });
+  e.strategy = strategy.name;
+  e.strategy_settings = strategy.settings;
+  // The strategies' settings were keys of `exploration` before each strategy declared its own.
+  for (const auto& [old, key] : {std::pair{"beta", "beta"}, std::pair{"directional_weight", "weight"}}) {
+    if (!ex.has(old)) continue;
+    const std::string name = exploration::strategy_options(e.strategy).declares(key) ? e.strategy
+                             : std::string(key) == "beta"                             ? "coordinated"
+                                                                                      : "directional";
+    throw InputError(ex.where(old) + ": the strategy's own settings moved into it: write 'strategy: {name: " + name +
+                     ", " + key + ": " + (ex.node(old)->IsScalar() ? ex.node(old)->Scalar() : std::string("VALUE")) + "}'");
+  }
   e.wave.eight_connected = ex.boolean("eight_connected", e.wave.eight_connected);
   e.wave.occupancy_weight = ex.number("occupancy_weight", e.wave.occupancy_weight, limits::kWeight);
   e.stall_steps = int(ex.number("stall_steps", e.stall_steps, limits::kCount));
@@ -266,6 +277,22 @@ Scenario load_scenario(const std::filesystem::path& path) {
   return parse_scenario(io::read_file(path, 16 << 20), path.string(), path.parent_path());
 }
 
+void set_parameter(Scenario& s, const std::string& assignment, const std::string& what) {
+  const auto a = core::parse_param_assignment(assignment, what);
+  if (a.family != "strategy") {
+    const std::vector<std::string> families = {"strategy", "localization", "merging", "planner"};
+    if (std::find(families.begin(), families.end(), a.family) == families.end()) {
+      throw InputError(what + ": unknown family '" + a.family + "'" + core::did_you_mean(a.family, families) +
+                       " (--set takes strategy.KEY=VALUE)");
+    }
+    throw InputError(what + ": " + a.family + " settings are scenario keys for now (see --help's scenario keys); "
+                     "--set takes strategy.KEY=VALUE");
+  }
+  auto& settings = s.exploration.strategy_settings;
+  std::erase_if(settings, [&](const auto& kv) { return kv.first == a.key; });
+  settings.emplace_back(a.key, a.value);
+}
+
 void validate_scenario(const Scenario& s) {
   // The same ranges as the parser's, for scenarios made in code or changed by flags.
   const auto check = [](const char* key, double value, const core::Range& range) {
@@ -302,8 +329,6 @@ void validate_scenario(const Scenario& s) {
   check("localization.fastslam_particles", o.fastslam_particles, limits::kRbpfParticles);
   check("communication.range", s.communication.range_m, limits::kCommRange);
   const auto& e = s.exploration;
-  check("exploration.beta", e.strategy_options.beta, limits::kWeight);
-  check("exploration.directional_weight", e.strategy_options.directional_weight, limits::kWeight);
   check("exploration.occupancy_weight", e.wave.occupancy_weight, limits::kWeight);
   check("exploration.stall_steps", e.stall_steps, limits::kCount);
   check("exploration.piece_radius", e.targets.piece_radius_m, limits::kLength);
@@ -322,6 +347,11 @@ void validate_scenario(const Scenario& s) {
                      core::join(valid) + ")");
   };
   check_name("exploration.strategy", s.exploration.strategy, exploration::strategy_names());
+  try {
+    exploration::strategy_options(s.exploration.strategy, s.exploration.strategy_settings);
+  } catch (const InputError& err) {
+    throw InputError(std::string("exploration.strategy: ") + err.what());
+  }
   check_name("localization", s.localization, localization::localizer_names());
   for (int r : s.lost_robots) {
     if (s.localization != "mcl") throw InputError("localization.lost_robots: only 'mcl' can start without its pose, not '" + s.localization + "'");
@@ -428,9 +458,12 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
   }
   y << "communication:\n  range: " << fmt(s.communication.range_m) << "\n  line_of_sight: " << (s.communication.line_of_sight ? "true" : "false") << "\n";
   const auto& e = s.exploration;
-  y << "exploration:\n  strategy: " << e.strategy << "\n  beta: " << fmt(e.strategy_options.beta)
-    << "\n  directional_weight: " << fmt(e.strategy_options.directional_weight)
-    << "\n  eight_connected: " << (e.wave.eight_connected ? "true" : "false") << "\n  occupancy_weight: " << fmt(e.wave.occupancy_weight)
+  y << "exploration:\n  strategy: {name: " << e.strategy;
+  for (const auto& [key, value] : e.strategy_settings) {
+    const bool plain = value.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.+-") == std::string::npos;
+    y << ", " << key << ": " << (plain ? value : io::yaml_quoted(value));
+  }
+  y << "}\n  eight_connected: " << (e.wave.eight_connected ? "true" : "false") << "\n  occupancy_weight: " << fmt(e.wave.occupancy_weight)
     << "\n  stall_steps: " << e.stall_steps << "\n  piece_radius: " << fmt(e.targets.piece_radius_m)
     << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m)
     << "\n  planning_resolution: " << fmt(e.planning_resolution_m) << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s)

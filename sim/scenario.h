@@ -128,6 +128,12 @@ std::string scenario_to_yaml(const Scenario& scenario, const std::filesystem::pa
 // localizer meets). Throws InputError naming the key.
 void validate_scenario(const Scenario& scenario);
 
+// `--set FAMILY.KEY=VALUE`: one declared parameter of the scenario's member of that family, kept
+// until the member is made (so that a sweep checks it against each of its strategies). Families
+// whose members declare parameters: strategy. Throws InputError naming `what` for another family
+// or a malformed assignment; the key and value are checked by validate_scenario (or validate_sweep).
+void set_parameter(Scenario& scenario, const std::string& assignment, const std::string& what);
+
 // The message for a merging that aligns estimated landmarks (MapAligner::needs_landmark_estimates)
 // with a localizer that estimates none, naming the localizers that do.
 std::string landmark_merging_problem(const Scenario& scenario);

@@ -136,12 +136,30 @@ std::string without_place(const std::string& message, const std::string& source)
   return message.substr(at);
 }
 
+// The base for runs of `strategy`: the strategy settings it does not declare dropped.
+sim::Scenario for_strategy(const sim::Scenario& base, const std::string& strategy) {
+  sim::Scenario s = base;
+  s.exploration.strategy = strategy;
+  s.exploration.strategy_settings = exploration::declared_settings(strategy, base.exploration.strategy_settings);
+  return s;
+}
+
+// The parameter an axis sets of the strategy ("exploration.strategy.beta": "beta"), or "".
+std::string strategy_parameter(const std::string& scenario_key) {
+  static const std::string prefix = "exploration.strategy.";
+  return scenario_key.rfind(prefix, 0) == 0 ? scenario_key.substr(prefix.size()) : std::string();
+}
+
+// The base with one value per axis. An axis over a parameter the base's strategy does not declare
+// leaves its runs alone: a sweep of several strategies varies each one's own parameters.
 sim::Scenario with_values(const sim::Scenario& base, const std::vector<SweepAxis>& axes,
                           const std::vector<std::string>& values) {
   if (axes.empty()) return base;
   const std::string what = variant_label(axes, values);
   YAML::Node root = YAML::Load(sim::scenario_to_yaml(base));
+  const auto declared = exploration::strategy_options(base.exploration.strategy);
   for (std::size_t i = 0; i < axes.size(); ++i) {
+    if (const auto key = strategy_parameter(axes[i].scenario_key); !key.empty() && !declared.declares(key)) continue;
     std::vector<std::string> parts;
     std::size_t start = 0;
     for (std::size_t dot; (dot = axes[i].scenario_key.find('.', start)) != std::string::npos; start = dot + 1) {
@@ -172,6 +190,8 @@ SweepAxis make_axis(const std::string& key, const std::vector<std::string>& valu
   for (const auto& [alias, full] : axis_aliases()) {
     if (alias == axis.name) axis.scenario_key = full;
   }
+  // strategy.KEY: a parameter the strategies declare (those that do not declare it ignore it).
+  if (axis.scenario_key.rfind("strategy.", 0) == 0) axis.scenario_key = "exploration." + axis.scenario_key;
   const std::string& k = axis.scenario_key;
   if (k.empty() || k.find_first_of(" =,\"'") != std::string::npos || k.front() == '.' || k.back() == '.' ||
       k.find("..") != std::string::npos) {
@@ -180,10 +200,21 @@ SweepAxis make_axis(const std::string& key, const std::vector<std::string>& valu
   // The team (its size and where it starts) is the robots axis; the robots' radius, speed and the
   // like are settings like any other.
   if (k == "map" || k == "seed" || k == "robots" || k == "robots.count" || k == "robots.random" || k == "robots.starts" ||
-      k == "exploration.strategy" || k == "strategy") {
+      k == "exploration.strategy" || k == "strategy" || k == "exploration.strategy.name") {
     throw InputError(what + ": '" + key + "' is an axis of every sweep already; use maps, robots, strategies or seeds");
   }
-  if (const auto& settings = axis_settings(); std::find(settings.begin(), settings.end(), k) == settings.end()) {
+  if (const auto parameter = strategy_parameter(k); !parameter.empty()) {
+    std::vector<std::string> declared;
+    for (const auto& name : exploration::strategy_names()) {
+      for (const auto& spec : exploration::strategy_registry().get(name).params) {
+        if (std::find(declared.begin(), declared.end(), spec.name) == declared.end()) declared.push_back(spec.name);
+      }
+    }
+    if (std::find(declared.begin(), declared.end(), parameter) == declared.end()) {
+      throw InputError(what + ": no strategy has a parameter '" + parameter + "'" + core::did_you_mean(parameter, declared) +
+                       " (the strategies' parameters: " + join(declared) + ")");
+    }
+  } else if (const auto& settings = axis_settings(); std::find(settings.begin(), settings.end(), k) == settings.end()) {
     throw InputError(what + ": unknown setting '" + axis.name + "'" + core::did_you_mean(axis.name, settings) + " " +
                      valid_settings_text());
   }
@@ -397,22 +428,35 @@ void validate_sweep(const Sweep& sweep) {
   for (int n : sweep.robots) {
     if (n < 1 || n > 64) throw InputError("robots: team size " + std::to_string(n) + ": expected 1 to 64");
   }
-  sim::Scenario probe = sweep.base;
-  probe.robot_count = sweep.robots.front();
-  probe.exploration.strategy = sweep.strategies.front();
-  sim::validate_scenario(probe);
   std::vector<std::string> keys;
   for (const auto& axis : sweep.axes) keys.push_back(axis.scenario_key);
   check_unique(keys, "vary");
-  // Every value of every axis makes a valid scenario (checked one axis at a time, the others at
-  // their first value), before any run starts.
+  // A strategy parameter, set or varied, belongs to at least one strategy of the sweep.
+  std::vector<std::pair<std::string, std::string>> parameters;  // (key, where it was given)
+  for (const auto& [key, value] : sweep.base.exploration.strategy_settings) parameters.emplace_back(key, "strategy." + key);
+  for (const auto& axis : sweep.axes) {
+    if (const auto key = strategy_parameter(axis.scenario_key); !key.empty()) parameters.emplace_back(key, "vary " + axis.name);
+  }
+  for (const auto& [key, where] : parameters) {
+    if (std::none_of(sweep.strategies.begin(), sweep.strategies.end(),
+                     [&](const std::string& s) { return exploration::strategy_options(s).declares(key); })) {
+      throw InputError(where + ": no strategy of this sweep (" + join(sweep.strategies) + ") has a parameter '" + key + "'");
+    }
+  }
+  // Every value of every axis makes a valid scenario for every strategy (checked one axis at a
+  // time, the others at their first value), before any run starts.
   std::vector<std::string> values;
   for (const auto& axis : sweep.axes) values.push_back(axis.values.front());
-  for (std::size_t i = 0; i < sweep.axes.size(); ++i) {
-    std::vector<std::string> v = values;
-    for (const auto& value : sweep.axes[i].values) {
-      v[i] = value;
-      with_values(probe, sweep.axes, v);
+  for (const auto& strategy : sweep.strategies) {
+    sim::Scenario probe = for_strategy(sweep.base, strategy);
+    probe.robot_count = sweep.robots.front();
+    sim::validate_scenario(probe);
+    for (std::size_t i = 0; i < sweep.axes.size(); ++i) {
+      std::vector<std::string> v = values;
+      for (const auto& value : sweep.axes[i].values) {
+        v[i] = value;
+        with_values(probe, sweep.axes, v);
+      }
     }
   }
 }
@@ -471,10 +515,9 @@ std::vector<SweepRun> sweep_runs(const Sweep& sweep) {
 
 sim::Scenario run_scenario(const Sweep& sweep, const SweepRun& run) {
   if (run.values.size() != sweep.axes.size()) throw Error("sweep: a run without a value for every axis");
-  sim::Scenario s = with_values(sweep.base, sweep.axes, run.values);
+  sim::Scenario s = with_values(for_strategy(sweep.base, run.strategy), sweep.axes, run.values);
   s.map = run.map_source;
   s.base_dir.clear();
-  s.exploration.strategy = run.strategy;
   s.robot_count = run.robots;
   s.seed = run.seed;
   return s;

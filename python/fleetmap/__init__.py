@@ -52,6 +52,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
     map_names,
     merge_method_names,
     planner_names,
+    strategies,
     strategy_names,
     keep_freed_memory,
 )
@@ -59,7 +60,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
 __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
     "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
-    "map_names", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
+    "map_names", "strategies", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
 ]
 
 # The built-in maps ship beside the installed package (share/fleetmap/maps); the C++ side looks
@@ -281,7 +282,34 @@ def _takes_context(name: str, cls: Any) -> bool:
     return len(positional) >= 5
 
 
-def register_strategy(name: str, cls: type, help: str = "", joint: bool = True) -> None:
+def _param_declarations(name: str, params) -> list:
+    """register_strategy's `params` as the tuples the C++ side declares them from."""
+    out = []
+    for key, spec in (params or {}).items():
+        if not isinstance(spec, Mapping):
+            spec = {"default": spec}
+        unknown = set(spec) - {"default", "unit", "min", "max", "choices", "doc"}
+        if unknown or "default" not in spec:
+            raise InputError(f"register_strategy '{name}': parameter '{key}' needs a default and takes only "
+                             f"default, unit, min, max, choices, doc (got {sorted(spec)})")
+        default = spec["default"]
+        if isinstance(default, bool):
+            kind, text = "flag", "true" if default else "false"
+        elif isinstance(default, (int, float)):
+            kind, text = "number", repr(float(default)) if isinstance(default, float) else str(default)
+        elif isinstance(default, str):
+            kind, text = "text", default
+        else:
+            raise InputError(f"register_strategy '{name}': parameter '{key}': the default must be a number, "
+                             f"True/False or a word, not {type(default).__name__}")
+        lo = float(spec.get("min", -math.inf))
+        hi = float(spec.get("max", math.inf))
+        out.append((str(key), kind, text, str(spec.get("unit", "")), lo, hi, False,
+                    [str(c) for c in spec.get("choices", [])], str(spec.get("doc", ""))))
+    return out
+
+
+def register_strategy(name: str, cls: type, help: str = "", joint: bool = True, params: Mapping | None = None) -> None:
     """Registers a coordination strategy written in Python under `name`.
 
     `cls` is a class (or any callable) that makes one strategy object per run. Its method
@@ -292,13 +320,19 @@ def register_strategy(name: str, cls: type, help: str = "", joint: bool = True) 
     costs (R, T) in metres (inf: unreachable) and the goals other robots already drive to (K, 2);
     it returns, per robot, a target index or -1 for none. When assign takes a fifth argument it
     also gets an AssignmentContext: each robot's team index and the team size, the sensor range,
-    the strategy options (beta, directional_weight), and, computed when called, the wave costs
+    the strategy's parameters (context.params, a dict), and, computed when called, the wave costs
     between the targets (target_costs(), T x T) and the unknown area behind each target
     (target_gains(), square metres) - what the built-in C++ strategies use. The context is valid
     only during the call. With `joint`, every robot that can talk is reassigned together;
     otherwise only the robot that needs a target. Scenarios and sweeps then use `name` like a
     built-in strategy.
+
+    `params` declares the strategy's own settings, each by name: a default (a number, True/False or
+    a word), or a dict {default, unit, min, max, choices, doc}. A scenario sets them with
+    exploration: {strategy: {name: NAME, KEY: VALUE}}, the command line with --set strategy.KEY=VALUE,
+    a sweep varies them with --vary strategy.KEY=V1,V2; each is checked against its declaration.
     """
     if not hasattr(cls, "assign"):
         raise InputError(f"register_strategy '{name}': the class has no assign method")
-    _fleetmap._register_strategy(name, cls, help, bool(joint), _takes_context(name, cls))
+    _fleetmap._register_strategy(name, cls, help, bool(joint), _takes_context(name, cls),
+                                 _param_declarations(name, params))

@@ -112,10 +112,8 @@ class AssignmentContext:
     def sensor_range(self) -> float:
         """The range sensor's reach, metres."""
     @property
-    def beta(self) -> float:
-        """Weight of travel cost against utility (scenario exploration.beta)."""
-    @property
-    def directional_weight(self) -> float: ...
+    def params(self) -> dict[str, float | bool | str]:
+        """The strategy's declared parameters with this run's values."""
     def target_costs(self) -> npt.NDArray[np.float64]:
         """(T, T) wave costs between the targets' goals, metres (inf: not connected)."""
     def target_gains(self) -> npt.NDArray[np.float64]:
@@ -149,7 +147,9 @@ def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5
     """Aligns b to a as `fleetmap merge a b` does: `transform` in metres and degrees, `map` the fused map."""
 def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: str = "astar",
               robot_radius: float = 0.2, time_budget: float = 1.0, seed: int = 1) -> PlanResult: ...
-def register_strategy(name: str, cls: Any, help: str = "", joint: bool = True) -> None: ...
+def register_strategy(name: str, cls: Any, help: str = "", joint: bool = True,
+                      params: Mapping[str, Any] | None = None) -> None: ...
+def strategies() -> list[dict[str, Any]]: ...
 def map_names() -> list[str]: ...
 def strategy_names() -> list[str]: ...
 def keep_freed_memory() -> bool:

@@ -41,7 +41,7 @@ class Recorder:
         gains = context.target_gains()
         between = context.target_costs()
         Recorder.calls.append((poses.copy(), context.team_indices.copy(), context.team_size, context.sensor_range,
-                               context.beta, targets.shape[0], between, gains))
+                               context.params["beta"], targets.shape[0], between, gains))
         Recorder.kept_context = context
         return [next((t for t in range(costs.shape[1]) if math.isfinite(costs[r, t])), -1)
                 for r in range(costs.shape[0])]
@@ -49,7 +49,8 @@ class Recorder:
 
 fleetmap.register_strategy("py-cheapest", CheapestFree, help="cheapest free target (a Python test's own)")
 fleetmap.register_strategy("py-wrong", WrongLength)
-fleetmap.register_strategy("py-recorder", Recorder)
+fleetmap.register_strategy("py-recorder", Recorder,
+                           params={"beta": {"default": 1.0, "min": 0, "doc": "weight of travel cost"}})
 
 
 class PythonStrategyTest(unittest.TestCase):
@@ -75,8 +76,8 @@ class PythonStrategyTest(unittest.TestCase):
 
     def test_it_gets_headings_and_the_context(self):
         starts = [[1.0, 1.0, 40.0], [8.5, 8.5, -115.0]]  # x, y in metres, heading in degrees
-        run = fleetmap.explore(map="office", robots={"starts": starts}, steps=40, seed=1, strategy="py-recorder",
-                               sensors={"range": {"max_range": 3.5}}, exploration={"beta": 0.7})
+        run = fleetmap.explore(map="office", robots={"starts": starts}, steps=40, seed=1,
+                               strategy={"name": "py-recorder", "beta": 0.7}, sensors={"range": {"max_range": 3.5}})
         self.assertGreater(len(Recorder.calls), 1)
         first_poses, first_indices = Recorder.calls[0][0], Recorder.calls[0][1]
         # The first round gets the start poses, headings included (in radians).
@@ -100,6 +101,19 @@ class PythonStrategyTest(unittest.TestCase):
         self.assertTrue(turned)
         with self.assertRaisesRegex(RuntimeError, "only while assign runs"):
             Recorder.kept_context.target_costs()
+
+    def test_its_parameters_are_declared_and_checked(self):
+        listed = {s["name"]: s for s in fleetmap.strategies()}
+        self.assertEqual([p["name"] for p in listed["coordinated"]["params"]], ["beta"])
+        self.assertEqual([(p["name"], p["default"], p["accepts"]) for p in listed["py-recorder"]["params"]],
+                         [("beta", "1.0", "a number >= 0")])
+        self.assertEqual(listed["market"]["params"], [])
+        with self.assertRaisesRegex(ValueError, "py-recorder' has no parameter 'bta'.*did you mean 'beta'"):
+            fleetmap.explore(map="empty", robots=1, steps=5, strategy={"name": "py-recorder", "bta": 1})
+        with self.assertRaisesRegex(ValueError, "'beta'.*>= 0.*got '-2'"):
+            fleetmap.explore(map="empty", robots=1, steps=5, strategy={"name": "py-recorder", "beta": -2})
+        with self.assertRaisesRegex(ValueError, "py-bad-param.*'beta' needs a default"):
+            fleetmap.register_strategy("py-bad-param", CheapestFree, params={"beta": {"min": 0}})
 
     def test_assign_must_take_the_four_arrays(self):
         class TooFew:

@@ -161,7 +161,7 @@ TEST(OwnMaps, AColouredLineIsSaidToBeReadByItsMean) {
   cv::imwrite((dir / "annotated.png").string(), img);
   std::vector<cv::Mat> channels;
   cv::split(img, channels);
-  const int red = cv::countNonZero(channels[2] == 255 & channels[0] == 0);
+  const int red = cv::countNonZero((channels[2] == 255) & (channels[0] == 0));
   const auto r = run_fleetmap("maps show annotated.png --resolution 0.1 --out show.png", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("are coloured, each read by the mean of its red, green and blue"), std::string::npos) << r.err;

@@ -175,9 +175,7 @@ TEST(Strategies, CoordinatedSpreadsRobotsOverTheSensorRange) {
   in.sensor_range_m = 4.0;
   in.targets = {target_at(0, 0), target_at(0.5, 0), target_at(10, 0)};
   in.robots = {robot(0, 2, {0, 1}, {1, 1, 3}), robot(1, 2, {0, 1}, {1, 1, 3})};
-  StrategyOptions o;
-  o.beta = 0.1;
-  const auto a = make_strategy("coordinated", o)->assign(in);
+  const auto a = make_strategy("coordinated", {{"beta", "0.1"}})->assign(in);
   EXPECT_EQ(std::set<int>(a.begin(), a.end()).count(2), 1u) << "one robot should take the far target";
   // Uncoordinated robots both stay near.
   const auto u = make_strategy("uncoordinated")->assign(in);

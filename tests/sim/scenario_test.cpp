@@ -43,7 +43,7 @@ landmarks:
   along_walls: 0.2
 localization: {method: odometry, robot_detections: true}
 communication: {range: 0, line_of_sight: true}
-exploration: {strategy: optimized, beta: 2, eight_connected: false}
+exploration: {strategy: {name: optimized, beta: 2}, eight_connected: false}
 merging: known
 )");
   EXPECT_EQ(s.seed, 7u);
@@ -63,6 +63,7 @@ merging: known
   EXPECT_TRUE(s.localization_options.use_robot_detections);
   EXPECT_EQ(s.communication.range_m, 0.0);
   EXPECT_EQ(s.exploration.strategy, "optimized");
+  EXPECT_EQ(s.exploration.strategy_settings, (exploration::StrategySettings{{"beta", "2"}}));
   EXPECT_FALSE(s.exploration.wave.eight_connected);
   EXPECT_EQ(parse("robots: {random: 6, min_separation: 1.5}\n").placement, Placement::Random);
   EXPECT_EQ(parse("robots: 9\n").robot_count, 9);
@@ -78,6 +79,9 @@ landmarks: {points: [[1, 2]], along_walls: 0.3}
 communication: {range: 12.5}
 exploration: {strategy: market}
 )");
+  // A strategy's settings survive a round trip.
+  const Scenario c = parse("exploration: {strategy: {name: directional, weight: 0.25}}\n");
+  EXPECT_EQ(parse(scenario_to_yaml(c)).exploration.strategy_settings, c.exploration.strategy_settings);
   const std::string text = scenario_to_yaml(a);
   io::write_file_atomic(dir / "s.yaml", text);
   const Scenario b = load_scenario(dir / "s.yaml");
@@ -110,6 +114,18 @@ TEST(ScenarioBadInput, ErrorsNameTheKeyAndTheLine) {
   expect_input_error([] { parse("communication: {range: -1}\n"); }, {"'communication.range'", "-1"});
   expect_input_error([] { parse("exploration: {strategy: greedy}\n"); },
                      {"'exploration.strategy'", "greedy", "uncoordinated", "market"});
+  // A strategy's own parameters are checked against its declaration.
+  expect_input_error([] { parse("exploration:\n  strategy: {name: coordinated, bta: 2}\n"); },
+                     {"test.yaml:2", "'exploration.strategy.bta'", "strategy 'coordinated' has no parameter 'bta'",
+                      "did you mean 'beta'"});
+  expect_input_error([] { parse("exploration: {strategy: {name: coordinated, beta: -1}}\n"); },
+                     {"'exploration.strategy.beta'", ">= 0", "got '-1'"});
+  expect_input_error([] { parse("exploration: {strategy: {name: market, beta: 1}}\n"); }, {"'market' has no parameter 'beta'", "it has none"});
+  // The keys of before each strategy declared its own say where they went.
+  expect_input_error([] { parse("exploration: {strategy: optimized, beta: 2}\n"); },
+                     {"'exploration.beta'", "strategy: {name: optimized, beta: 2}"});
+  expect_input_error([] { parse("exploration: {directional_weight: 0.3}\n"); },
+                     {"'exploration.directional_weight'", "strategy: {name: directional, weight: 0.3}"});
   expect_input_error([] { parse("localization: gps\n"); }, {"localization", "gps", "ideal", "odometry"});
   expect_input_error([] { parse("robots: {starts: [[1, 2], [3]]}\n"); }, {"'robots.starts'", "[x, y]"});
   expect_input_error([] { parse("steps: many\n"); }, {"'steps'", "many"});

@@ -1,0 +1,81 @@
+// End-to-end: the declared parameters of strategies as a user meets them: `fleetmap plugins`,
+// `--set strategy.KEY=VALUE` on explore and bench, `bench --vary strategy.KEY=...`, and the
+// messages for a mistyped key, a value out of range, and a strategy without that parameter.
+#include <gtest/gtest.h>
+
+#include "tests/cli/bench_test_support.h"
+
+namespace fleetmap::cli {
+namespace {
+
+using namespace fleetmap::testing;
+
+TEST(PluginsCommand, ListsEveryFamilyWithTheDeclaredParameters) {
+  TempDir dir;
+  const auto all = run_fleetmap("plugins", dir);
+  ASSERT_EQ(all.exit_code, 0) << all.err;
+  for (const char* family : {"strategy (", "localization (", "merging (", "merge-method (", "planner (", "map ("}) {
+    EXPECT_NE(all.out.find(family), std::string::npos) << family << " not in:\n" << all.out;
+  }
+  EXPECT_NE(all.out.find("  coordinated: "), std::string::npos);
+  EXPECT_NE(all.out.find("      beta = 1  (a number >= 0 and <= 1000000): weight of travel cost"), std::string::npos) << all.out;
+  EXPECT_NE(all.out.find("      weight = 0.5"), std::string::npos);
+  const auto one = run_fleetmap("plugins --family strategy", dir);
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  EXPECT_EQ(one.out.find("planner ("), std::string::npos);
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("plugins --family strategies", dir), "did you mean 'strategy'");
+  // explore --help lists the strategies' parameters from the same declarations.
+  EXPECT_NE(run_fleetmap("explore --help", dir).out.find("      beta = 1"), std::string::npos);
+}
+
+TEST(PluginsCommand, ExploreSetsAStrategysParameter) {
+  TempDir dir;
+  write_bench_maps(dir);
+  const auto r = run_fleetmap("explore --map hall.yaml --robots 2 --steps 20 --strategy coordinated "
+                              "--set strategy.beta=0.25 --out run", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(slurp(dir / "run" / "scenario.yaml").find("strategy: {name: coordinated, beta: 0.25}"), std::string::npos)
+      << slurp(dir / "run" / "scenario.yaml");
+  // The saved scenario runs again as it was.
+  const auto again = run_fleetmap("explore --scenario run/scenario.yaml --out again", dir);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(slurp(dir / "again" / "scenario.yaml"), slurp(dir / "run" / "scenario.yaml"));
+}
+
+TEST(PluginsCommand, BadSettingsAreOneLineNamingTheSetting) {
+  TempDir dir;
+  write_bench_maps(dir);
+  const std::string run = "explore --map hall.yaml --robots 1 --steps 5 --out out ";
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--strategy coordinated --set strategy.bta=1", dir), "did you mean 'beta'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--strategy coordinated --set strategy.beta=-1", dir), "a number >= 0");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--strategy market --set strategy.beta=1", dir),
+                        "strategy 'market' has no parameter 'beta' (it has none)");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--set beta=1", dir), "--set beta=1: expected FAMILY.KEY=VALUE");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--set strategi.beta=1", dir), "did you mean 'strategy'");
+  EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "nothing written for bad input";
+  const std::string bench = "bench --maps hall.yaml --robots 1 --seeds 1 --steps 5 --out b ";
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(bench + "--strategies coordinated,market --set strategy.weight=1", dir),
+                        "no strategy of this sweep (coordinated, market) has a parameter 'weight'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(bench + "--strategies coordinated --vary strategy.bta=1,2", dir),
+                        "no strategy has a parameter 'bta' (did you mean 'beta'?)");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(bench + "--strategies coordinated --vary strategy.beta=1,-2", dir), "-2");
+  EXPECT_FALSE(std::filesystem::exists(dir / "b"));
+}
+
+TEST(PluginsCommand, BenchVariesAParameterOfTheStrategiesThatDeclareIt) {
+  TempDir dir;
+  write_bench_maps(dir);
+  const auto r = run_fleetmap("bench --maps hall.yaml --strategies coordinated,market --robots 2 --seeds 1 --steps 60 "
+                              "--vary strategy.beta=0,5 --out b", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CsvTable results = read_csv(dir / "b" / "results.csv");
+  ASSERT_EQ(results.rows.size(), 4u);
+  std::map<std::string, std::string> coverage;
+  for (const auto& row : results.rows) coverage[row.at("strategy") + " " + row.at("variant")] = row.at("coverage");
+  ASSERT_EQ(coverage.size(), 4u);
+  // market declares no beta: its two runs are the same run.
+  EXPECT_EQ(coverage.at("market strategy.beta=0"), coverage.at("market strategy.beta=5"));
+}
+
+}  // namespace
+}  // namespace fleetmap::cli
