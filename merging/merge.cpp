@@ -321,6 +321,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   scored.front().first = evaluate_alignment(a, b, scored.front().second->fit.b_to_a, options.quality);
   const auto& [best_q, best] = scored.front();
   result.transform = best->fit.b_to_a;
+  result.covariance = fit_covariance(a, b, result.transform, options.refinement);
   result.method = best->hypothesis.method;
   result.quality = best_q;
   result.acceptance = omega[pick];
@@ -638,6 +639,7 @@ MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b) {
   const auto move = [&](const core::Transform2& t) {
     return core::Transform2(t.translation() + oa - t.rotation_matrix() * ob, t.rotation());
   };
+  if (result.covariance) result.covariance = propagate_covariance(*result.covariance, result.transform, move);
   result.transform = move(result.transform);
   if (result.alternative) result.alternative = move(*result.alternative);
   result.quality.overlap_centre += oa;

@@ -216,6 +216,10 @@ enum class Refusal {
 struct MergeResult {
   bool merged = false;            // confidence >= min_confidence
   core::Transform2 transform;     // b's cells into a's cells; the best candidate even when not merged
+  // The covariance of transform's (tx, ty, theta), cells, cells and radians, from the fit of the
+  // walls around it (fit_covariance in refine.h): how sure the answer is in which direction, as a
+  // pose graph takes a match. nullopt without a candidate or with too few walls in common.
+  std::optional<Eigen::Matrix3d> covariance;
   double acceptance = 0.0;        // omega of the wave-algorithm paper, at `transform`
   double confidence = 0.0;        // in [0, 1]
   double distinctiveness = 0.0;
