@@ -98,7 +98,17 @@ std::vector<double> numbers(const std::string& flag, const std::string& text) {
 Args parse(int argc, char** argv) {
   Args a;
   for (int i = 1; i < argc; ++i) {
-    const std::string k = argv[i];
+    std::string k = argv[i];
+    if (const auto eq = k.find('='); k.rfind("--", 0) == 0 && eq != std::string::npos) {
+      // --model=-1,2: a list that starts with a minus sign.
+      const std::string v = k.substr(eq + 1);
+      k = k.substr(0, eq);
+      if (k == "--model") {
+        a.model = numbers(k, v);
+        continue;
+      }
+      usage(k + ": give its value after a space");
+    }
     if (k == "--fit") {
       a.fit = true;
       continue;
@@ -211,6 +221,7 @@ struct Row {
   double peer_error = -1.0, peer_ms = 0.0;
   std::vector<double> x;
   double p = 0.0;
+  double largest_std = 0.0;  // the covariance's largest standard deviation at the overlap, cells
 };
 
 constexpr double kSuccessCells = 2.0;
@@ -229,6 +240,7 @@ Row run(const std::string& map, double overlap, const mapping::OccupancyGrid& a,
     row.right = row.error < kSuccessCells;
   }
   row.x = features_of(r);
+  row.largest_std = r.features.largest_std_cells;
   const double c1 = bench::thread_seconds();
   const bench::PeerResult peer = bench::orb_peer(a, b);
   row.peer_ms = 1e3 * (bench::thread_seconds() - c1);
@@ -358,8 +370,19 @@ int main(int argc, char** argv) {
     if (r.peer_merged && r.peer_right) err_p.push_back(r.peer_error);
     if (r.overlap > 0.0) ms_f.push_back(r.ms), ms_p.push_back(r.peer_ms);
   }
-  fmt::print("Median error of right merges: fleetmap {:.3f} cells, ORB {:.3f} cells. Median CPU time per pair: fleetmap {:.0f} ms, ORB {:.0f} ms.\n\n",
+  fmt::print("Median error of right merges: fleetmap {:.3f} cells, ORB {:.3f} cells. Median CPU time per pair: fleetmap {:.0f} ms, ORB {:.0f} ms.\n",
              median(err_f), median(err_p), median(ms_f), median(ms_p));
+  // The covariance against the errors: the error (mean displacement of b's cells) over the
+  // largest standard deviation at the overlap. Near or below 1 when the covariance is honest; far
+  // above when it is too small (residuals taken as independent).
+  std::vector<double> ratio;
+  for (const auto& r : rows)
+    if (r.merged && r.right && r.largest_std > 0.0) ratio.push_back(r.error / r.largest_std);
+  std::sort(ratio.begin(), ratio.end());
+  if (!ratio.empty())
+    fmt::print("Right merges' error / the covariance's largest std at the overlap: median {:.2f}, 90th percentile {:.2f}.\n",
+               median(ratio), ratio[std::size_t(0.9 * double(ratio.size() - 1))]);
+  fmt::print("\n");
   if (!model.empty()) {
     fmt::print("Reliability of the model (all pairs: answers at probability p, share right):\n\n| p | answers | right |\n|---|---|---|\n");
     for (int bin = 0; bin < 10; ++bin) {
