@@ -5,7 +5,8 @@
 // overlap for fleetmap's decision, for a logistic model of P(answer right | features), and for the
 // peer; false merges on unrelated pairs; the model's reliability table (answers at probability p,
 // share right). With --fit the model is fitted on these pairs (the training split) and its
-// coefficients printed; otherwise the coefficients given with --model are used.
+// coefficients printed; otherwise the coefficients given with --model are used. The model is
+// measured here only: decide() still decides (bench/README.md says why).
 //
 // The pairs: window a is axis-aligned, window b of the same size turned by a uniform angle and
 // shifted until the stated share of the smaller one's known cells lies in both
@@ -135,8 +136,9 @@ Args parse(int argc, char** argv) {
 
 // What the model reads of an answer, each meaningful on any map (cells, shares, counts):
 // agreement of the walls both maps know, contradiction (walls in the other's open space), the
-// cells' agreement, the evidence, distinctiveness against the best rival, and how well the fit
-// pins the weakest direction (the covariance's largest standard deviation at the overlap).
+// cells' agreement, the evidence, distinctiveness against the best rival (before the shape rules
+// zero it), and how well the fit pins the weakest direction (the covariance's largest standard
+// deviation at the overlap).
 const std::vector<std::string> kFeatureNames = {
     "log((matched + 1) / (contradicted + 1))",
     "log(1 + open_space_walls)",
@@ -150,13 +152,15 @@ const std::vector<std::string> kFeatureNames = {
 std::vector<double> features_of(const merging::MergeResult& r) {
   const auto& q = r.quality;
   const double omega = std::clamp(r.acceptance, 0.0, 1.0);
+  // Without a covariance (too few walls in common) the placement is free in every direction.
+  const double largest_std = r.covariance ? std::min(r.features.largest_std_cells, 1e3) : 1e3;
   return {
       std::log((q.matched + 1.0) / (q.contradicted + 1.0)),
       std::log1p(double(q.open_space_walls)),
       std::log((omega + 1e-3) / (1.0 - omega + 1e-3)),
       std::log1p(r.evidence),
       r.features.distinctiveness,
-      std::log(std::min(r.features.largest_std_cells, 1e3) + 0.01),
+      std::log(largest_std + 0.01),
       std::log(q.residual_rms + 0.05),
   };
 }
@@ -232,6 +236,8 @@ Row run(const std::string& map, double overlap, const mapping::OccupancyGrid& a,
   row.map = map;
   row.overlap = overlap;
   const double c0 = bench::thread_seconds();
+  // As `fleetmap merge` aligns them: the features are what decide() saw (its probes run only on
+  // answers that could be merged, so others' distinctiveness is an upper bound).
   const merging::MergeResult r = merging::align_across_resolutions(a, b, {});
   row.ms = 1e3 * (bench::thread_seconds() - c0);
   row.merged = r.merged;

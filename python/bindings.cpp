@@ -528,7 +528,7 @@ PYBIND11_MODULE(_fleetmap, m) {
             auto m = out.mutable_unchecked<2>();
             for (py::ssize_t i = 0; i < 3; ++i)
               for (py::ssize_t j = 0; j < 3; ++j) m(i, j) = (*r.placement().covariance)(i, j);
-            return std::move(out);
+            return out;
           },
           "The 3 x 3 covariance of `transform`'s (tx, ty, theta) in metres, metres and radians, from the fit of the "
           "walls around the answer (a lower bound: wall cells taken as independent); None without one.")
