@@ -1,6 +1,7 @@
 #pragma once
-// Shared by the merging benchmarks: the thread's CPU time, and the feature-based peer of the ROS `multirobot_map_merge` package (Horner 2016), as the merging
-// benchmarks run it on the same pairs as fleetmap (bench/merging_real_bench.cpp describes it).
+// Shared by the merging benchmarks: the thread's CPU time, and the feature-based peer of the ROS
+// `multirobot_map_merge` package (Horner 2016), as the merging benchmarks run it on the same pairs
+// as fleetmap (bench/merging_real_bench.cpp describes it).
 #include <Eigen/Core>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>

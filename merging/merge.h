@@ -219,8 +219,10 @@ enum class Refusal {
 struct DecisionFeatures {
   double distinctiveness = 0.0;  // 1 - S2 / S1 against the best plausible rival the search and probes found
   bool probed = false;           // the symmetry probes ran (the answer could be merged before them)
-  double largest_std_cells = 0.0;  // from MergeResult::covariance: the largest standard deviation of where b's points land, at the overlap centre (cells)
-  double theta_std_deg = 0.0;      // and of theta
+  // From MergeResult::covariance: the largest standard deviation of where b's points land at the
+  // overlap centre (cells), and theta's (degrees).
+  double largest_std_cells = 0.0;
+  double theta_std_deg = 0.0;
 };
 
 struct MergeResult {
