@@ -63,7 +63,8 @@ struct MergeCommandOptions {
 };
 
 nlohmann::json transform_json(const std::string& map, const merging::Placement& place, const merging::MergeResult& pair,
-                              double confidence, const std::string& method, const std::string& via) {
+                              double confidence, const std::string& method, const std::string& via,
+                              const std::optional<merging::Uncertainty>& uncertainty) {
   nlohmann::json j;
   j["map"] = map;
   j["merged"] = true;
@@ -78,6 +79,18 @@ nlohmann::json transform_json(const std::string& map, const merging::Placement& 
   j["confidence"] = confidence;
   j["method"] = method;
   j["via"] = via;
+  if (place.covariance && uncertainty) {
+    nlohmann::json c = nlohmann::json::array();
+    for (int r = 0; r < 3; ++r) c.push_back({(*place.covariance)(r, 0), (*place.covariance)(r, 1), (*place.covariance)(r, 2)});
+    j["covariance"] = c;
+    j["std_tx_m"] = uncertainty->std_tx;
+    j["std_ty_m"] = uncertainty->std_ty;
+    j["std_theta_deg"] = uncertainty->std_theta_deg;
+    j["overlap_centre_m"] = {uncertainty->at.x(), uncertainty->at.y()};
+    j["std_major_m"] = uncertainty->std_major;
+    j["std_minor_m"] = uncertainty->std_minor;
+    j["major_direction_deg"] = uncertainty->major_deg;
+  }
   return j;
 }
 
@@ -262,8 +275,20 @@ int run_merge(const MergeCommandOptions& o) {
     const merging::Placement& place = *result.placements[i];
     const int parent = merged.parent[i];
     const auto& pair = pair_of(int(i), parent);
+    // Where the pair's walls met (its a's cells), in the first map's metres.
+    std::optional<merging::Uncertainty> uncertainty;
+    const auto pair_a = [&] {
+      for (const auto& p : merged.pairs)
+        if ((p.a == parent && p.b == int(i)) || (p.a == int(i) && p.b == parent)) return p.a;
+      return parent;
+    }();
+    if (place.covariance && merged.to_first[std::size_t(pair_a)]) {
+      const Eigen::Vector2d centre = merged.to_first[std::size_t(pair_a)]->apply(pair.quality.overlap_centre);
+      const Eigen::Vector2d at = originals.front().geometry().grid_to_world(centre + Eigen::Vector2d(0.5, 0.5));
+      uncertainty = merging::describe_uncertainty(*place.covariance, place.metres, at);
+    }
     j["transforms"].push_back(transform_json(name, place, pair, merged.confidence[i], merged.method[i],
-                                             o.maps[std::size_t(parent)]));
+                                             o.maps[std::size_t(parent)], uncertainty));
     const std::string scale = place.scale == 1.0 ? "" : fmt::format(", scale {:.4g}", place.scale);
     fmt::print(report,
                "{}: tx {:.3f} ty {:.3f} m, theta {:.3f} deg (pixels: tx {:.2f} ty {:.2f}, theta {:.3f} deg{}), "
@@ -272,6 +297,13 @@ int run_merge(const MergeCommandOptions& o) {
                core::rad2deg(place.metres.rotation()), place.pixels.translation().x(), place.pixels.translation().y(),
                core::rad2deg(place.pixels.rotation()), scale, pair.acceptance, merged.confidence[i], merged.method[i],
                o.maps[std::size_t(parent)]);
+    if (uncertainty) {
+      fmt::print(report,
+                 "  uncertainty (1 sigma, from the fit of the walls): tx {:.3f} m, ty {:.3f} m, theta {:.3f} deg; where the "
+                 "maps overlap ({:.2f}, {:.2f} m): {:.3f} m along {:.0f} deg, {:.3f} m across\n",
+                 uncertainty->std_tx, uncertainty->std_ty, uncertainty->std_theta_deg, uncertainty->at.x(),
+                 uncertainty->at.y(), uncertainty->std_major, uncertainty->major_deg, uncertainty->std_minor);
+    }
   }
   j["merged_maps"] = placed;
   j["max_loop_gap_px"] = merged.max_loop_gap;
@@ -304,7 +336,9 @@ Command add_merge_command(CLI::App& root) {
                 "the first's.\n"
                 "--json holds `transforms`: per input after the first, map, merged, tx_m, ty_m, theta_deg (metres and\n"
                 "degrees), tx_px, ty_px, theta_px_deg, scale (pixels), acceptance, confidence, method, via (the input it\n"
-                "was aligned to); or merged: false and the reason.\n"
+                "was aligned to), covariance (3 x 3, of tx_m, ty_m, theta in m, m, rad, from the fit of the walls), std_tx_m,\n"
+                "std_ty_m, std_theta_deg, and where the maps overlap (overlap_centre_m) std_major_m along\n"
+                "major_direction_deg and std_minor_m across; or merged: false and the reason.\n"
                 "The picture shows free cells in the tint of the one input that saw them, or white when several did;\n"
                 "walls black, unknown grey; red cells are free in one map, occupied in another; it holds the known cells\n"
                 "and half a metre around them, with metre axes. A map file (--out merged.yaml) holds the fused map as\n"

@@ -1,5 +1,6 @@
 #include "merging/merge.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -321,6 +322,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
   scored.front().first = evaluate_alignment(a, b, scored.front().second->fit.b_to_a, options.quality);
   const auto& [best_q, best] = scored.front();
   result.transform = best->fit.b_to_a;
+  result.covariance = fit_covariance(a, b, result.transform, options.refinement);
   result.method = best->hypothesis.method;
   result.quality = best_q;
   result.acceptance = omega[pick];
@@ -456,6 +458,7 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
                         (best_q.junction_arms >= 3 && !lone_t ? co.full_beyond_corner : 0.0);
   if (options.probe_symmetries && beyond > 0 &&
       agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence) {
+    result.features.probed = true;
     std::tie(result.distinctiveness, result.alternative) =
         distinctiveness(b, other_placements(a, b, result.transform, options, others), best_q, result.transform);
     // b's prepared data, masked and cut (preparing the common part again cost a third of the time
@@ -476,6 +479,17 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
                                                                 alternative->rotation());
       }
     }
+  }
+  result.features.distinctiveness = result.distinctiveness;
+  if (result.covariance) {
+    // Where b's points land at the overlap centre: dt + dtheta perp(centre - t).
+    const Eigen::Vector2d lever = best_q.overlap_centre - result.transform.translation();
+    Eigen::Matrix<double, 2, 3> j;
+    j << 1.0, 0.0, -lever.y(), 0.0, 1.0, lever.x();
+    const Eigen::Matrix2d at_centre = j * *result.covariance * j.transpose();
+    result.features.largest_std_cells =
+        std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(at_centre).eigenvalues()(1)));
+    result.features.theta_std_deg = core::rad2deg(std::sqrt(std::max(0.0, (*result.covariance)(2, 2))));
   }
   // One rectangular room: the common walls are its sides (four lines), and the room turned a half
   // turn (a quarter for a square) fits them as well without contradiction: a smaller share of the
@@ -638,6 +652,7 @@ MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b) {
   const auto move = [&](const core::Transform2& t) {
     return core::Transform2(t.translation() + oa - t.rotation_matrix() * ob, t.rotation());
   };
+  if (result.covariance) result.covariance = propagate_covariance(*result.covariance, result.transform, move);
   result.transform = move(result.transform);
   if (result.alternative) result.alternative = move(*result.alternative);
   result.quality.overlap_centre += oa;

@@ -213,9 +213,25 @@ enum class Refusal {
   LittleFit,          // too little of the common walls fits better than chance
 };
 
+// What the decision saw, before its shape rules (ConfidenceOptions): quantities that mean the same
+// on any map, for fitting and checking a decision model on pairs of known truth
+// (bench/merging_model_bench.cpp).
+struct DecisionFeatures {
+  double distinctiveness = 0.0;  // 1 - S2 / S1 against the best plausible rival the search and probes found
+  bool probed = false;           // the symmetry probes ran (the answer could be merged before them)
+  // From MergeResult::covariance: the largest standard deviation of where b's points land at the
+  // overlap centre (cells), and theta's (degrees).
+  double largest_std_cells = 0.0;
+  double theta_std_deg = 0.0;
+};
+
 struct MergeResult {
   bool merged = false;            // confidence >= min_confidence
   core::Transform2 transform;     // b's cells into a's cells; the best candidate even when not merged
+  // The covariance of transform's (tx, ty, theta), cells, cells and radians, from the fit of the
+  // walls around it (fit_covariance in refine.h): how sure the answer is in which direction, as a
+  // pose graph takes a match. nullopt without a candidate or with too few walls in common.
+  std::optional<Eigen::Matrix3d> covariance;
   double acceptance = 0.0;        // omega of the wave-algorithm paper, at `transform`
   double confidence = 0.0;        // in [0, 1]
   double distinctiveness = 0.0;
@@ -227,6 +243,7 @@ struct MergeResult {
   std::string reason;             // why not merged; empty when merged
   Refusal refusal = Refusal::None; // the same, as a value
   int candidates = 0;             // candidates the methods proposed
+  DecisionFeatures features;
 };
 
 // One pass of a method: proposes candidates for the common pipeline.

@@ -1,8 +1,10 @@
 #include "merging/multi_merge.h"
 
+#include <Eigen/Dense>
 #include <cmath>
 #include <memory>
 
+#include "core/angle.h"
 #include "core/error.h"
 #include "merging/rendezvous.h"
 #include "merging/resolutions.h"
@@ -15,6 +17,7 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
   const int n = int(grids.size());
   MultiMergeResult out;
   out.to_first.assign(std::size_t(n), std::nullopt);
+  out.covariance.assign(std::size_t(n), std::nullopt);
   out.parent.assign(std::size_t(n), -1);
   out.confidence.assign(std::size_t(n), 0.0);
   out.method.assign(std::size_t(n), "");
@@ -37,6 +40,9 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
   const double first = grids[0]->resolution();
   const auto in_first_cells = [&](MergeResult r, double resolution) {
     if (resolution == first) return r;
+    if (r.covariance)
+      r.covariance = propagate_covariance(*r.covariance, r.transform,
+                                          [&](const core::Transform2& t) { return rescale_cells(t, resolution, first); });
     r.transform = rescale_cells(r.transform, resolution, first);
     if (r.alternative) r.alternative = rescale_cells(*r.alternative, resolution, first);
     const Eigen::Vector2d h(0.5, 0.5);
@@ -62,6 +68,7 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
   }
   // Prim's algorithm on the reliable pairs, heaviest confidence first, from the first map.
   out.to_first[0] = core::Transform2::identity();
+  out.covariance[0] = Eigen::Matrix3d::Zero();
   out.confidence[0] = 1.0;
   std::vector<bool> in_tree(std::size_t(n), false);
   in_tree[0] = true;
@@ -80,6 +87,15 @@ MultiMergeResult merge_maps(const std::vector<const mapping::OccupancyGrid*>& gr
     const bool new_is_b = in_tree[std::size_t(p.a)];
     const int from = new_is_b ? p.a : p.b, to = new_is_b ? p.b : p.a;
     const core::Transform2 to_from = new_is_b ? p.result.transform : p.result.transform.inverse();
+    const auto& from_covariance = out.covariance[std::size_t(from)];
+    if (from_covariance && p.result.covariance) {
+      // to_from as a function of the pair's transform (inverted when the new map is a).
+      const auto compose = [&](const core::Transform2& from_first, const core::Transform2& pair) {
+        return from_first * (new_is_b ? pair : pair.inverse());
+      };
+      out.covariance[std::size_t(to)] = propagate_covariance(*from_covariance, *out.to_first[std::size_t(from)],
+                                                             *p.result.covariance, p.result.transform, compose);
+    }
     out.to_first[std::size_t(to)] = *out.to_first[std::size_t(from)] * to_from;
     out.parent[std::size_t(to)] = from;
     out.confidence[std::size_t(to)] = p.result.confidence;
@@ -127,10 +143,14 @@ FusedMap fuse_merged(const std::vector<const mapping::OccupancyGrid*>& grids, co
   return fused;
 }
 
-Placement placement(const core::GridGeometry& first, const core::GridGeometry& input, const core::Transform2& cells) {
+Placement placement(const core::GridGeometry& first, const core::GridGeometry& input, const core::Transform2& cells,
+                    const std::optional<Eigen::Matrix3d>& covariance) {
   const core::GridGeometry seen = mapping::resampled_geometry(input, first.resolution());
   Placement out;
   out.metres = world_from_cells(first, seen, cells);
+  if (covariance)
+    out.covariance = propagate_covariance(*covariance, cells,
+                                          [&](const core::Transform2& t) { return world_from_cells(first, seen, t); });
   // A pixel (u, v) of the input is its cell (u, H - 1 - v), whose centre lies s (u, H - 1 - v) + c (1, 1)
   // in the seen cells (same origin; c = (s - 1) / 2), which is the seen grid's pixel s (u, v) + o;
   // the rigid placement of the seen grid's pixels then gives s R p + (R o + t).
@@ -140,6 +160,26 @@ Placement placement(const core::GridGeometry& first, const core::GridGeometry& i
   out.pixels = core::Transform2(rigid.rotation_matrix() * o + rigid.translation(), rigid.rotation());
   out.scale = s;
   return out;
+}
+
+Uncertainty describe_uncertainty(const Eigen::Matrix3d& covariance, const core::Transform2& transform,
+                                 const Eigen::Vector2d& at) {
+  Uncertainty u;
+  u.std_tx = std::sqrt(std::max(0.0, covariance(0, 0)));
+  u.std_ty = std::sqrt(std::max(0.0, covariance(1, 1)));
+  u.std_theta_deg = core::rad2deg(std::sqrt(std::max(0.0, covariance(2, 2))));
+  u.at = at;
+  // The point of b that lands at `at` moves by dt + dtheta perp(at - t).
+  const Eigen::Vector2d lever = at - transform.translation();
+  Eigen::Matrix<double, 2, 3> j;
+  j << 1.0, 0.0, -lever.y(), 0.0, 1.0, lever.x();
+  const Eigen::Matrix2d c = j * covariance * j.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(c);
+  u.std_minor = std::sqrt(std::max(0.0, eig.eigenvalues()(0)));
+  u.std_major = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
+  const Eigen::Vector2d major = eig.eigenvectors().col(1);
+  u.major_deg = std::fmod(core::rad2deg(std::atan2(major.y(), major.x())) + 360.0, 180.0);
+  return u;
 }
 
 MergedMaps merge_and_fuse(const std::vector<const mapping::OccupancyGrid*>& grids, const MergeOptions& options,
@@ -159,7 +199,8 @@ MergedMaps fuse_placed(const std::vector<const mapping::OccupancyGrid*>& grids, 
   std::vector<const mapping::OccupancyGrid*> in_first_cells;
   for (std::size_t i = 0; i < grids.size(); ++i) {
     const mapping::OccupancyGrid& g = *grids[i];
-    out.placements.push_back(out.merge.to_first[i] ? std::optional(placement(first.geometry(), g.geometry(), *out.merge.to_first[i]))
+    out.placements.push_back(out.merge.to_first[i] ? std::optional(placement(first.geometry(), g.geometry(), *out.merge.to_first[i],
+                                                                                  out.merge.covariance[i]))
                                                    : std::nullopt);
     if (g.resolution() == first.resolution() || !out.merge.to_first[i]) {
       in_first_cells.push_back(&g);

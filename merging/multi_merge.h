@@ -26,6 +26,10 @@ struct MultiMergeResult {
   // Per input: its cells into the first input's cells; nullopt when no chain of reliable pairs
   // links it to the first. The first's is the identity.
   std::vector<std::optional<core::Transform2>> to_first;
+  // Per input: the covariance of to_first's (tx, ty, theta) (first's cells, radians), the pairs'
+  // covariances (MergeResult::covariance) composed along the chain to the first, taken as
+  // independent; zero for the first, nullopt when not placed or a pair of the chain has none.
+  std::vector<std::optional<Eigen::Matrix3d>> covariance;
   std::vector<int> parent;          // the tree: input i was placed through input parent[i] (-1: root or not placed)
   std::vector<double> confidence;   // of the pair that placed input i (1 for the first, 0 if not placed)
   std::vector<std::string> method;  // method of that pair
@@ -55,12 +59,28 @@ struct Placement {
   // scale R(theta) (u, v) + t in the first input's pixel grid.
   core::Transform2 pixels;
   double scale = 1.0;  // the input's metres per cell / the first's
+  // The covariance of metres' (tx, ty, theta): metres, metres, radians; nullopt when not known.
+  std::optional<Eigen::Matrix3d> covariance;
 };
+
+// A covariance of a transform's (tx, ty, theta) (metres and radians) in the words a user reads:
+// the standard deviations, and at `at` (a point of the first map, metres: where the maps overlap)
+// the largest and smallest standard deviation of where a point of b lands and the direction of the
+// largest (degrees from the x axis, in [0, 180)).
+struct Uncertainty {
+  double std_tx = 0.0, std_ty = 0.0, std_theta_deg = 0.0;
+  Eigen::Vector2d at = Eigen::Vector2d::Zero();
+  double std_major = 0.0, std_minor = 0.0, major_deg = 0.0;
+};
+Uncertainty describe_uncertainty(const Eigen::Matrix3d& covariance, const core::Transform2& transform,
+                                 const Eigen::Vector2d& at);
 
 // The placement of an input whose cells seen through the first's cells (mapping::resample(input,
 // first.resolution()), the input's own cells at one resolution) `cells` takes into the first's
 // cells, as MultiMergeResult::to_first and its pairs' transforms do.
-Placement placement(const core::GridGeometry& first, const core::GridGeometry& input, const core::Transform2& cells);
+// With `covariance` (of cells' parameters, cells and radians), Placement::covariance too.
+Placement placement(const core::GridGeometry& first, const core::GridGeometry& input, const core::Transform2& cells,
+                    const std::optional<Eigen::Matrix3d>& covariance = std::nullopt);
 
 // The margin kept around the known cells of a merged map (metres): what `fleetmap merge --out
 // merged.yaml` writes and its picture shows.

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "merging/grid_level.h"
 
@@ -19,14 +20,19 @@ struct Sums {
   Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
   Eigen::Vector3d g = Eigen::Vector3d::Zero();
   Eigen::Vector2d position_sum = Eigen::Vector2d::Zero();
+  double weighted_squares = 0.0;  // sum w d^2
   int count = 0;
 };
 
 // The wall points of `from` moved by t into `to`, with the distance to `to`'s walls, added to
 // `sums`. `to_a` takes `to`'s frame into a's; `turn` the distance gradient into b's frame, negated
-// for a's points (they move by the inverse of the update).
+// for a's points (they move by the inverse of the update). With `normals` (one per wall point of
+// `from`, line_normals), the gradient is taken along the point's normal only where it has one: a
+// slanted wall's cells stand in steps, and the distance to them changes along the wall too, which
+// says where the steps are, not where the wall is.
 void collect(const GridLevel& from, const GridLevel& to, const core::Transform2& t, const core::Transform2& to_a,
-             const Eigen::Matrix2d& turn, double cutoff, Sums& sums, int& inliers, int& outliers) {
+             const Eigen::Matrix2d& turn, double cutoff, Sums& sums, int& inliers, int& outliers,
+             const std::vector<Eigen::Vector2f>* normals = nullptr) {
   const Eigen::Matrix2f r = t.rotation_matrix().cast<float>();
   const Eigen::Vector2f tr = t.translation().cast<float>();
   // to_a.apply, with its rotation computed once (not once per point).
@@ -49,12 +55,18 @@ void collect(const GridLevel& from, const GridLevel& to, const core::Transform2&
     if (d > cutoff || !seen_from_same_side(to, p, r * from.wall_normals[i])) continue;
     if (d <= 1.0f) ++in;
     const Eigen::Vector2d position = ra * p.cast<double>() + ta;
-    const Eigen::Vector2d g = turn * Eigen::Vector2d(gx, gy);
+    Eigen::Vector2d g(gx, gy);
+    if (normals && (*normals)[i] != Eigen::Vector2f::Zero()) {
+      const Eigen::Vector2d n = (r * (*normals)[i]).cast<double>();
+      g = g.dot(n) * n;
+    }
+    g = turn * g;
     const Eigen::Vector3d j(g.x(), g.y(), position.x() * g.y() - position.y() * g.x());
     const double w = d <= 1.0f ? 1.0 : 1.0 / d;  // Huber weights
     const Eigen::Vector3d wj = w * j;
     s.h += wj * j.transpose();
     s.g += d * wj;
+    s.weighted_squares += w * double(d) * double(d);
     s.position_sum += position;
     ++s.count;
   }
@@ -77,6 +89,43 @@ int interior_outliers(const GridLevel& from, const GridLevel& to, const core::Tr
     if (to.distance_at(p.x(), p.y(), kFar) >= 2.5f) ++outliers;
   }
   return outliers;
+}
+
+// Per wall point of `level`, the unit normal of the straight wall it lies on: the direction of
+// least spread of the wall cells within 3 cells, when they lie along a line (spread across at most
+// a tenth of the spread along: a 7-cell stretch of a one-cell-thick line of any slope is about
+// 0.02); zero at corners, ends and clutter, where the distance's gradient is the wall's own.
+std::vector<Eigen::Vector2f> line_normals(const GridLevel& level) {
+  constexpr int kR = 3;
+  constexpr double kMostSpread = 0.1;
+  std::vector<Eigen::Vector2f> out;
+  out.reserve(level.wall_points.size());
+  for (const Eigen::Vector2f& p : level.wall_points) {
+    const int cx = int(std::lround(p.x())), cy = int(std::lround(p.y()));
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    int n = 0;
+    for (int y = std::max(0, cy - kR); y <= std::min(level.walls.rows - 1, cy + kR); ++y) {
+      const auto* row = level.walls.ptr<std::uint8_t>(y);
+      for (int x = std::max(0, cx - kR); x <= std::min(level.walls.cols - 1, cx + kR); ++x) {
+        if (!row[x] || (x - cx) * (x - cx) + (y - cy) * (y - cy) > kR * kR) continue;
+        const Eigen::Vector2d q(x - cx, y - cy);
+        scatter += q * q.transpose();
+        sum += q;
+        ++n;
+      }
+    }
+    if (n < 4) {
+      out.emplace_back(Eigen::Vector2f::Zero());
+      continue;
+    }
+    const Eigen::Vector2d mean = sum / double(n);
+    scatter = scatter / double(n) - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
+    const bool line = eig.eigenvalues()(0) <= kMostSpread * eig.eigenvalues()(1);
+    out.emplace_back(line ? Eigen::Vector2f(eig.eigenvectors().col(0).cast<float>()) : Eigen::Vector2f::Zero());
+  }
+  return out;
 }
 
 }  // namespace
@@ -132,6 +181,76 @@ LevelFit refine_alignment(const PreparedGrid& a, const PreparedGrid& b, const co
   const int top = std::min({from_level, a.level_count() - 1, b.level_count() - 1});
   for (int k = top; k >= 0; --k) fit = refine_at_level(a, b, fit.b_to_a, k, options);
   return fit;
+}
+
+std::optional<Eigen::Matrix3d> fit_covariance(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a,
+                                              const RefineOptions& options) {
+  const GridLevel& la = a.level(0);
+  const GridLevel& lb = b.level(0);
+  const std::vector<Eigen::Vector2f> normals_a = line_normals(la), normals_b = line_normals(lb);
+  Sums sums;
+  int inliers = 0, outliers = 0;
+  collect(lb, la, b_to_a, core::Transform2::identity(), Eigen::Matrix2d::Identity(), options.inlier_distance, sums,
+          inliers, outliers, &normals_b);
+  collect(la, lb, b_to_a.inverse(), b_to_a, -b_to_a.rotation_matrix(), options.inlier_distance, sums, inliers, outliers,
+          &normals_a);
+  if (sums.count < 4) return std::nullopt;
+  // About the residuals' mean position c (well conditioned), then to the parameters of b_to_a: the
+  // update x -> R(dtheta) (x - c) + c + dt moves t by dt + dtheta perp(t - c).
+  const Eigen::Vector2d c = sums.position_sum / double(sums.count);
+  Eigen::Matrix3d about_c = Eigen::Matrix3d::Identity();
+  about_c(2, 0) = c.y(), about_c(2, 1) = -c.x();
+  const Eigen::Matrix3d h = about_c * sums.h * about_c.transpose();
+  constexpr double kCellVariance = 1.0 / 12.0;
+  const double noise = std::max(kCellVariance, sums.weighted_squares / double(sums.count - 3));
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(h);
+  constexpr double kUnconstrained = 1e12;
+  Eigen::Vector3d inverse_values;
+  for (int i = 0; i < 3; ++i) {
+    const double v = eig.eigenvalues()(i);
+    inverse_values(i) = v > 0.0 ? std::min(kUnconstrained, 2.0 * noise / v) : kUnconstrained;
+  }
+  const Eigen::Matrix3d about = eig.eigenvectors() * inverse_values.asDiagonal() * eig.eigenvectors().transpose();
+  const Eigen::Vector2d lever = b_to_a.translation() - c;
+  Eigen::Matrix3d to_params = Eigen::Matrix3d::Identity();
+  to_params(0, 2) = -lever.y(), to_params(1, 2) = lever.x();
+  return to_params * about * to_params.transpose();
+}
+
+namespace {
+
+Eigen::Vector3d params(const core::Transform2& t) { return {t.translation().x(), t.translation().y(), t.rotation()}; }
+
+// d params(f(T)) / d params(T) at `at`, by central differences (angles wrapped).
+Eigen::Matrix3d jacobian(const core::Transform2& at, const std::function<core::Transform2(const core::Transform2&)>& f) {
+  Eigen::Matrix3d j;
+  const Eigen::Vector3d p = params(at);
+  for (int k = 0; k < 3; ++k) {
+    const double step = k < 2 ? 1e-4 * std::max(1.0, std::abs(p(k))) : 1e-6;
+    Eigen::Vector3d lo = p, hi = p;
+    lo(k) -= step, hi(k) += step;
+    const Eigen::Vector3d fl = params(f(core::Transform2(lo.x(), lo.y(), lo.z())));
+    const Eigen::Vector3d fh = params(f(core::Transform2(hi.x(), hi.y(), hi.z())));
+    Eigen::Vector3d d = fh - fl;
+    d(2) = std::remainder(d(2), 2.0 * std::numbers::pi);
+    j.col(k) = d / (2.0 * step);
+  }
+  return j;
+}
+
+}  // namespace
+
+Eigen::Matrix3d propagate_covariance(const Eigen::Matrix3d& covariance, const core::Transform2& at,
+                                     const std::function<core::Transform2(const core::Transform2&)>& f) {
+  const Eigen::Matrix3d j = jacobian(at, f);
+  return j * covariance * j.transpose();
+}
+
+Eigen::Matrix3d propagate_covariance(const Eigen::Matrix3d& covariance_t, const core::Transform2& t,
+                                     const Eigen::Matrix3d& covariance_u, const core::Transform2& u,
+                                     const std::function<core::Transform2(const core::Transform2&, const core::Transform2&)>& f) {
+  return propagate_covariance(covariance_t, t, [&](const core::Transform2& x) { return f(x, u); }) +
+         propagate_covariance(covariance_u, u, [&](const core::Transform2& y) { return f(t, y); });
 }
 
 }  // namespace fleetmap::merging

@@ -2,6 +2,11 @@
 // Local refinement of an alignment to sub-cell and sub-degree accuracy: Gauss-Newton on the
 // truncated distance between the walls of the two maps (chamfer matching, both ways), coarse to
 // fine over the pyramid.
+#include <Eigen/Core>
+
+#include <functional>
+#include <optional>
+
 #include "core/transform2.h"
 #include "merging/prepared_grid.h"
 
@@ -35,5 +40,29 @@ LevelFit refine_at_level(const PreparedGrid& a, const PreparedGrid& b, const cor
 // Refines from `from_level` down to level 0.
 LevelFit refine_alignment(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a,
                           int from_level, const RefineOptions& options = {});
+
+// The covariance of the parameters (tx, ty, theta) of `b_to_a` (cells, cells, radians) that the
+// fit of the walls at full resolution determines: the Gauss-Newton model of refine_at_level at
+// b_to_a (level 0, the same residuals: distances of each map's walls to the other's, both ways,
+// within inlier_distance, Huber-weighted), Sigma = s^2 H^-1 with H = sum w J^T J and
+// s^2 = sum w d^2 / (n - 3) the residuals' own noise, at least 1/12 cell^2 (a grid places a wall
+// only to within a cell: uniform, variance 1/12). Every matched wall gives one residual from each
+// map, so H counts each wall twice: Sigma is doubled. Residuals are taken as independent, which
+// walls drawn several cells thick are not: the covariance is a lower bound, and its shape (which
+// direction the walls leave free) is what it tells best: a long straight wall alone constrains
+// nothing along itself, and the variance along it is then large. nullopt with fewer than 4
+// residuals. Directions the walls do not constrain at all get a variance of 1e12 (cells^2 or rad^2).
+std::optional<Eigen::Matrix3d> fit_covariance(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a,
+                                              const RefineOptions& options = {});
+
+// The covariance of f(T)'s parameters (tx, ty, theta) given that of T's, to first order: J C J^T
+// with J the Jacobian of f at `at` (central differences). For moving a transform between frames
+// (cuts, resolutions, metres): f composes it with fixed transforms.
+Eigen::Matrix3d propagate_covariance(const Eigen::Matrix3d& covariance, const core::Transform2& at,
+                                     const std::function<core::Transform2(const core::Transform2&)>& f);
+// Of (f(T, U)) for independent T and U: J_T C_T J_T^T + J_U C_U J_U^T (a placement through a chain of pairs).
+Eigen::Matrix3d propagate_covariance(const Eigen::Matrix3d& covariance_t, const core::Transform2& t,
+                                     const Eigen::Matrix3d& covariance_u, const core::Transform2& u,
+                                     const std::function<core::Transform2(const core::Transform2&, const core::Transform2&)>& f);
 
 }  // namespace fleetmap::merging

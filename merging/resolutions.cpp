@@ -73,6 +73,10 @@ MergeResult align_across_resolutions(const mapping::OccupancyGrid& a, const mapp
     const mapping::OccupancyGrid pooled_b = pooled_where_placed(b, r, first.transform, offset);
     MergeResult second = align_maps(a, pooled_b, options);
     const core::Transform2 into_pooled(-offset.cast<double>(), 0.0);
+    if (second.covariance)
+      second.covariance = propagate_covariance(*second.covariance, second.transform, [&](const core::Transform2& t) {
+        return t * into_pooled * first.transform;
+      });
     second.transform = second.transform * into_pooled * first.transform;
     if (second.alternative) second.alternative = *second.alternative * into_pooled * first.transform;
     return second;
@@ -82,6 +86,9 @@ MergeResult align_across_resolutions(const mapping::OccupancyGrid& a, const mapp
   const mapping::OccupancyGrid pooled_a = pooled_where_placed(a, r, first.transform.inverse(), offset);
   MergeResult second = align_maps(pooled_a, b, options);
   const core::Transform2 from_pooled = first.transform * core::Transform2(offset.cast<double>(), 0.0);
+  if (second.covariance)
+    second.covariance = propagate_covariance(*second.covariance, second.transform,
+                                             [&](const core::Transform2& t) { return from_pooled * t; });
   second.transform = from_pooled * second.transform;
   if (second.alternative) second.alternative = from_pooled * *second.alternative;
   second.quality.overlap_centre = from_pooled.apply(second.quality.overlap_centre);

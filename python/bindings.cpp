@@ -112,8 +112,13 @@ class PairMerge {
       merge_ = merging::merge_maps(grids, options);
     }
     const auto& pair = result();
-    placement_ = merging::placement(grids[0]->geometry(), grids[1]->geometry(), pair.transform);
+    placement_ = merging::placement(grids[0]->geometry(), grids[1]->geometry(), pair.transform, pair.covariance);
+    if (placement_.covariance) {
+      const Eigen::Vector2d at = grids[0]->geometry().grid_to_world(pair.quality.overlap_centre + Eigen::Vector2d(0.5, 0.5));
+      uncertainty_ = merging::describe_uncertainty(*placement_.covariance, placement_.metres, at);
+    }
   }
+  const std::optional<merging::Uncertainty>& uncertainty() const { return uncertainty_; }
   const merging::MergeResult& result() const { return merge_.pairs.front().result; }
   const merging::Placement& placement() const { return placement_; }
   std::optional<mapping::OccupancyGrid> map() {
@@ -133,6 +138,7 @@ class PairMerge {
   py::object a_, b_;  // held, so that the maps outlive the result that fuses them
   merging::MultiMergeResult merge_;
   merging::Placement placement_;
+  std::optional<merging::Uncertainty> uncertainty_;
   std::optional<mapping::OccupancyGrid> map_;
 };
 
@@ -580,6 +586,37 @@ PYBIND11_MODULE(_fleetmap, m) {
       .def_property_readonly(
           "scale", [](const PairMerge& r) { return r.placement().scale; },
           "b's metres per cell / a's: the scale of pixel_transform.")
+      .def_property_readonly(
+          "covariance",
+          [](const PairMerge& r) -> py::object {
+            if (!r.placement().covariance) return py::none();
+            py::array_t<double> out({3, 3});
+            auto m = out.mutable_unchecked<2>();
+            for (py::ssize_t i = 0; i < 3; ++i)
+              for (py::ssize_t j = 0; j < 3; ++j) m(i, j) = (*r.placement().covariance)(i, j);
+            return out;
+          },
+          "The 3 x 3 covariance of `transform`'s (tx, ty, theta) in metres, metres and radians, from the fit of the "
+          "walls around the answer (a lower bound: wall cells taken as independent); None without one.")
+      .def_property_readonly(
+          "std",
+          [](const PairMerge& r) -> py::object {
+            if (!r.uncertainty()) return py::none();
+            const auto& u = *r.uncertainty();
+            return py::make_tuple(u.std_tx, u.std_ty, u.std_theta_deg);
+          },
+          "(std_tx_m, std_ty_m, std_theta_deg): the standard deviations of `transform` (`fleetmap merge`'s std_tx_m, "
+          "std_ty_m, std_theta_deg); None without a covariance.")
+      .def_property_readonly(
+          "uncertain_direction",
+          [](const PairMerge& r) -> py::object {
+            if (!r.uncertainty()) return py::none();
+            const auto& u = *r.uncertainty();
+            return py::make_tuple(u.std_major, u.std_minor, u.major_deg);
+          },
+          "(std_major_m, std_minor_m, major_direction_deg): where the maps overlap, the largest and smallest standard "
+          "deviation (metres) of where a point of b lands in a, and the direction of the largest (degrees from a's x "
+          "axis, in [0, 180)); a corridor leaves its own axis the uncertain one. None without a covariance.")
       .def_property_readonly("map", &PairMerge::map,
                              "The fused map (a Map in a's frame and resolution, cut to the known cells and half a "
                              "metre around them: what `fleetmap merge a b --out merged.yaml` writes); None when not "

@@ -240,7 +240,10 @@ def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5
     (0, 0)) lies at R(theta) p + (tx, ty) in a's, R(theta) = [[cos, -sin], [sin, cos]] - the
     numbers `fleetmap merge` prints and writes as tx_m, ty_m, theta_deg. `pixel_transform` is the
     same in pixels (tx_px, ty_px, theta_px_deg, with `scale`). `confidence` is in [0, 1] and
-    `merged` says whether it reached `min_confidence`. `map` is the fused map (in a's frame and
+    `merged` says whether it reached `min_confidence`. `covariance` (3 x 3, metres, metres,
+    radians) says how sure `transform` is in which direction, `std` gives its standard deviations
+    (m, m, deg) and `uncertain_direction` the largest and smallest (m) where the maps overlap with
+    the largest's direction (deg). `map` is the fused map (in a's frame and
     resolution, what `fleetmap merge a b --out merged.yaml` writes), for plan_path; None when not
     merged."""
     for name, value in (("a", a), ("b", b)):

@@ -72,6 +72,17 @@ class MergeResult:
     def scale(self) -> float:
         """b's metres per cell / a's."""
     @property
+    def covariance(self) -> Optional[npt.NDArray[np.float64]]:
+        """3 x 3 covariance of `transform`'s (tx, ty, theta) in metres, metres and radians, from the
+        fit of the walls; None without one."""
+    @property
+    def std(self) -> Optional[Tuple[float, float, float]]:
+        """(std_tx_m, std_ty_m, std_theta_deg) of `transform`; None without a covariance."""
+    @property
+    def uncertain_direction(self) -> Optional[Tuple[float, float, float]]:
+        """(std_major_m, std_minor_m, major_direction_deg) where the maps overlap; None without a
+        covariance."""
+    @property
     def map(self) -> Optional[Map]:
         """The fused map in a's frame and resolution, cut to the known cells and half a metre around
         them (what `fleetmap merge a b --out merged.yaml` writes); None when not merged."""

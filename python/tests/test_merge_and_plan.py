@@ -41,6 +41,24 @@ class MergeTest(unittest.TestCase):
         self.assertAlmostEqual(ptheta, 0.0, delta=0.5)
         self.assertEqual(result.scale, 1.0)
 
+    def test_a_merge_reports_its_covariance_in_metres_and_radians(self):
+        a, b = office_windows()
+        result = fleetmap.merge_maps(a, b)
+        self.assertTrue(result.merged, result.reason)
+        cov = result.covariance
+        self.assertEqual(cov.shape, (3, 3))
+        np.testing.assert_allclose(cov, cov.T, atol=1e-15)
+        self.assertTrue(np.all(np.linalg.eigvalsh(cov) >= 0.0))
+        # Its standard deviations, metres and degrees: a fraction of a 0.05 m cell and of a degree.
+        std_tx, std_ty, std_theta = result.std
+        self.assertAlmostEqual(std_tx, math.sqrt(cov[0, 0]), places=12)
+        self.assertAlmostEqual(std_theta, math.degrees(math.sqrt(cov[2, 2])), places=9)
+        self.assertLess(max(std_tx, std_ty), 0.025)
+        self.assertLess(std_theta, 0.5)
+        major, minor, direction = result.uncertain_direction
+        self.assertGreaterEqual(major, minor)
+        self.assertTrue(0.0 <= direction < 180.0)
+
     def test_a_turned_and_shifted_map_file_is_recovered_in_metres(self):
         office = fleetmap.load_map("office").image
         a = fleetmap.Map.from_image(office[:, :130].copy())

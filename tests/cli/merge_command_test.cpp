@@ -97,6 +97,17 @@ TEST(MergeCommand, MergesTwoMapsAndGivesThePixelPlacement) {
   EXPECT_LE(t["confidence"].get<double>(), 1.0);
   EXPECT_EQ(t["method"], "overlap");
   EXPECT_EQ(t["via"], "a.png");
+  // The covariance of (tx_m, ty_m, theta): symmetric, its standard deviations as given, a fraction
+  // of a cell (a bare image's cells are 0.05 m) and of a degree; and the summary line says them.
+  ASSERT_EQ(t["covariance"].size(), 3u);
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(t["covariance"][i][k].get<double>(), t["covariance"][k][i].get<double>());
+  EXPECT_DOUBLE_EQ(t["std_tx_m"].get<double>(), std::sqrt(t["covariance"][0][0].get<double>()));
+  EXPECT_NEAR(t["std_theta_deg"].get<double>(), core::rad2deg(std::sqrt(t["covariance"][2][2].get<double>())), 1e-12);
+  EXPECT_LT(t["std_tx_m"].get<double>(), 0.025);
+  EXPECT_LT(t["std_theta_deg"].get<double>(), 0.5);
+  EXPECT_GE(t["std_major_m"].get<double>(), t["std_minor_m"].get<double>());
+  EXPECT_NE(r.out.find("uncertainty (1 sigma"), std::string::npos) << r.out;
   EXPECT_NE(j["convention"].get<std::string>().find("R(theta) p + (tx_m, ty_m)"), std::string::npos);
   EXPECT_NE(j["pixel_convention"].get<std::string>().find("R(theta_px) (u, v) + (tx_px, ty_px)"), std::string::npos);
 

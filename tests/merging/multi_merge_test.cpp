@@ -47,6 +47,15 @@ TEST(MultiMerge, FourCropsOfOneMapMergeIntoOneConsistentMap) {
     }
   }
   EXPECT_LT(r.max_loop_gap, 1.0);
+  // Every placement has a covariance; one placed through another map is no surer than that one.
+  ASSERT_TRUE(r.covariance[0].has_value());
+  EXPECT_EQ(*r.covariance[0], Eigen::Matrix3d::Zero());
+  for (int i = 1; i < 4; ++i) {
+    ASSERT_TRUE(r.covariance[std::size_t(i)].has_value()) << "view " << i;
+    const int parent = r.parent[std::size_t(i)];
+    EXPECT_GE((*r.covariance[std::size_t(i)])(2, 2), (*r.covariance[std::size_t(parent)])(2, 2)) << "view " << i;
+    EXPECT_GT((*r.covariance[std::size_t(i)])(2, 2), 0.0) << "view " << i;
+  }
   // The fused map, put back on the source map, agrees with it.
   const FusedMap fused = fuse_merged(grids, r);
   EXPECT_EQ(fused.inputs, (std::vector<int>{0, 1, 2, 3}));
@@ -75,6 +84,33 @@ TEST(MultiMerge, FourCropsOfOneMapMergeIntoOneConsistentMap) {
     }
   }
   EXPECT_EQ(off_edge, 0) << "of " << fused.conflict_cells << " conflicts";
+}
+
+// The same two maps said to have cells of 0.05 m and of 0.1 m: the placement's covariance is in
+// metres and radians, so its translation's variances grow four times and theta's stays.
+TEST(MultiMerge, ThePlacementsCovarianceIsInMetresWhateverTheCellSize) {
+  const auto source = testing::source_map("office");
+  core::Random random(21);
+  const CropPair pair = make_crop_pair(source, testing::half_overlap_crops(source), random);
+  const auto relabelled = [](const mapping::OccupancyGrid& g, double resolution) {
+    mapping::OccupancyGrid out(core::GridGeometry(resolution, g.width(), g.height()));
+    for (int y = 0; y < g.height(); ++y)
+      for (int x = 0; x < g.width(); ++x) out.set_state({x, y}, g.state({x, y}));
+    return out;
+  };
+  std::vector<Eigen::Matrix3d> covariances;
+  for (const double resolution : {0.05, 0.1}) {
+    const auto a = relabelled(pair.a, resolution), b = relabelled(pair.b, resolution);
+    const MergedMaps m = merge_and_fuse({&a, &b});
+    ASSERT_TRUE(m.placements[1].has_value()) << resolution << ": " << m.merge.reason[1];
+    ASSERT_TRUE(m.placements[1]->covariance.has_value()) << resolution;
+    covariances.push_back(*m.placements[1]->covariance);
+  }
+  EXPECT_NEAR(covariances[1](0, 0), 4.0 * covariances[0](0, 0), 0.02 * covariances[1](0, 0));
+  EXPECT_NEAR(covariances[1](1, 1), 4.0 * covariances[0](1, 1), 0.02 * covariances[1](1, 1));
+  EXPECT_NEAR(covariances[1](2, 2), covariances[0](2, 2), 0.02 * covariances[0](2, 2));
+  // A fraction of a cell, in metres, at 0.05 m.
+  EXPECT_LT(std::sqrt(covariances[0](0, 0)), 0.05);
 }
 
 TEST(MultiMerge, AMapThatOverlapsNothingIsLeftOutWithAReason) {

@@ -2,10 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <functional>
 
 #include "core/angle.h"
 #include "merging/evaluation.h"
+#include "merging/multi_merge.h"
 #include "tests/merging/merging_test_support.h"
 
 namespace fleetmap::merging {
@@ -56,6 +58,74 @@ TEST(Refine, CoarseLevelsStoppingEarlierEndAtTheSameAnswer) {
     EXPECT_LT(mean_displacement(early.b_to_a, full.b_to_a, pair.b), 0.05) << name;
     EXPECT_NEAR(early.inliers, full.inliers, 0.01 * full.inliers) << name;
   });
+}
+
+// --- the covariance of the fit ------------------------------------------------------------------
+
+// A window of 12 m of a corridor 1.2 m wide (0.05 m cells) whose axis runs at `axis_deg` to the x
+// axis, `shift` cells along it from the window's centre: two walls a cell thick, free between
+// them, unknown beyond. With `pillars`, two square pillars in it and a wall across one end:
+// something that pins the placement along the axis.
+mapping::OccupancyGrid corridor(double axis_deg, bool pillars, double shift = 0.0) {
+  constexpr int kSide = 300;
+  mapping::OccupancyGrid g(core::GridGeometry(0.05, kSide, kSide));
+  const double c = std::cos(core::deg2rad(axis_deg)), s = std::sin(core::deg2rad(axis_deg));
+  const Eigen::Vector2d centre(kSide / 2.0, kSide / 2.0);
+  for (int y = 0; y < kSide; ++y) {
+    for (int x = 0; x < kSide; ++x) {
+      const Eigen::Vector2d d = Eigen::Vector2d(x, y) - centre;
+      const double along = c * d.x() + s * d.y() + shift, across = -s * d.x() + c * d.y();
+      if (std::abs(along - shift) > 120.0) continue;
+      const bool end_wall = pillars && along < -118.5;
+      const bool pillar = pillars && std::abs(across) < 3.0 && (std::abs(along - 40.0) < 3.0 || std::abs(along + 60.0) < 3.0);
+      if (std::abs(across) < 12.5 && !end_wall && !pillar) g.set_state({x, y}, mapping::CellState::Free);
+      else if (std::abs(across) < 13.5 || (pillar && !end_wall) || (end_wall && std::abs(across) < 13.5))
+        g.set_state({x, y}, mapping::CellState::Occupied);
+    }
+  }
+  return g;
+}
+
+// A corridor's walls pin its placement across it and not along it: the largest standard deviation
+// of where b's points land lies along the corridor's axis (to a few degrees, at any axis angle) and
+// is many times the smallest. b is a window 40 cells farther along (its walls' ends lie on a's
+// walls, as two robots' windows' do). With pillars and an end wall both are small and within a
+// factor of a few of each other, and the translation is known to a fraction of a cell.
+TEST(FitCovariance, ACorridorLeavesItsAxisUncertainAndPillarsPinIt) {
+  for (const double axis : {0.0, 30.0, 115.0}) {
+    const auto bare = corridor(axis, false), farther = corridor(axis, false, 40.0);
+    const PreparedGrid a(bare), b(farther);
+    const core::Transform2 truth(40.0 * std::cos(core::deg2rad(axis)), 40.0 * std::sin(core::deg2rad(axis)), 0.0);
+    const auto cov = fit_covariance(a, b, truth);
+    ASSERT_TRUE(cov.has_value()) << axis;
+    const Uncertainty u = describe_uncertainty(*cov, truth, Eigen::Vector2d(150.0, 150.0));
+    EXPECT_NEAR(std::remainder(u.major_deg - axis, 180.0), 0.0, 3.0) << axis;
+    EXPECT_GT(u.std_major, 10.0 * u.std_minor) << axis;
+    EXPECT_LT(u.std_minor, 0.3) << axis;
+
+    const auto fixed = corridor(axis, true);
+    const PreparedGrid fa(fixed), fb(fixed);
+    const auto pinned = fit_covariance(fa, fb, core::Transform2::identity());
+    ASSERT_TRUE(pinned.has_value()) << axis;
+    const Uncertainty p = describe_uncertainty(*pinned, core::Transform2::identity(), Eigen::Vector2d(150.0, 150.0));
+    EXPECT_LT(p.std_major, 4.0 * p.std_minor) << axis;
+    EXPECT_LT(p.std_major, 0.3) << axis;
+  }
+}
+
+// The covariance follows the transform between frames: the same fit moved by fixed transforms
+// (as a cut map's result is moved to the full map's cells) gives the covariance of the moved
+// parameters, which for a pure shift before the transform turns theta's variance into translation.
+TEST(FitCovariance, PropagatesThroughAFixedShiftAsItsJacobianSays) {
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  cov(2, 2) = 1e-4;  // theta only
+  const core::Transform2 t(5.0, -2.0, 0.3);
+  const core::Transform2 shift(100.0, 0.0, 0.0);
+  // T' = T * shift: t' = t + R(theta) (100, 0), so d t' / d theta = 100 (-sin, cos).
+  const Eigen::Matrix3d moved = propagate_covariance(cov, t, [&](const core::Transform2& x) { return x * shift; });
+  EXPECT_NEAR(moved(0, 0), 1e-4 * std::pow(100.0 * std::sin(0.3), 2), 1e-6);
+  EXPECT_NEAR(moved(1, 1), 1e-4 * std::pow(100.0 * std::cos(0.3), 2), 1e-6);
+  EXPECT_NEAR(moved(2, 2), 1e-4, 1e-10);
 }
 
 }  // namespace
