@@ -149,6 +149,8 @@ class Localizer {
   virtual std::vector<Landmark> landmark_estimates() const { return {}; }
   // True when the localizer estimates landmarks (landmark_estimates() fills as it observes them).
   virtual bool estimates_landmarks() const { return false; }
+  // True when update_scan does something: the localizer reads range scans.
+  virtual bool uses_scans() const { return false; }
   // The grid the localizer builds itself, if any (`rbpf`: the best particle's map).
   virtual std::optional<mapping::OccupancyGrid> map_estimate() const { return std::nullopt; }
 };
