@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/format.h"
 #include "core/suggest.h"
+#include "localization/submap_grid.h"
 #include "mapping/range_scan.h"
 
 namespace fleetmap::experiments {
@@ -43,6 +44,48 @@ mapping::RangeScan cut(const mapping::RangeScan& scan, double range) {
   return out;
 }
 
+// The map of the whole log at the final poses, each scan inserted once into one probability grid
+// with the submaps' hit and miss odds (a grazing ray does not erase a wall), then given the states a
+// map_server map holds: occupied above 0.6 (three hits more than misses), free below 0.45 (five
+// scans more free than occupied).
+mapping::OccupancyGrid final_map(const std::function<std::unique_ptr<io::LaserLogReader>()>& open_log,
+                                 const std::vector<core::Pose2>& trajectory, double reach, double resolution) {
+  localization::SubmapGridOptions go;
+  go.resolution_m = resolution;
+  localization::SubmapGrid grid(go);
+  auto log = open_log();
+  std::size_t i = 0;
+  std::vector<Eigen::Vector2d> hits;
+  while (const auto s = log->next()) {
+    if (i >= trajectory.size()) break;
+    const core::Pose2& pose = trajectory[i++];
+    hits.clear();
+    for (std::size_t b = 0; b < s->scan.ranges.size(); ++b) {
+      const auto& r = s->scan.ranges[b];
+      if (!r || *r > reach) continue;
+      hits.push_back(pose.transform(*r * Eigen::Vector2d(std::cos(s->scan.angles[b]), std::sin(s->scan.angles[b]))));
+    }
+    grid.insert(pose.position(), hits);
+  }
+  mapping::OccupancyGridOptions mo;
+  mo.hit_probability = go.hit_probability;
+  mo.miss_probability = go.miss_probability;
+  mo.min_probability = go.min_probability;
+  mo.max_probability = go.max_probability;
+  mo.occupied_threshold = 0.6;
+  mo.free_threshold = 0.45;
+  const int w = std::max(grid.width(), 1), h = std::max(grid.height(), 1);
+  mapping::OccupancyGrid map(core::GridGeometry(resolution, w, h, core::Pose2(grid.min_x() * resolution, grid.min_y() * resolution, 0.0)), mo);
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      if (!grid.known(x + grid.min_x(), y + grid.min_y())) continue;
+      const double p = grid.probability(x + grid.min_x(), y + grid.min_y());
+      map.set_log_odds(core::Cell{x, y}, float(std::log(p / (1.0 - p))));
+    }
+  }
+  return map;
+}
+
 }  // namespace
 
 std::vector<std::string> log_slam_methods() {
@@ -58,7 +101,8 @@ std::vector<std::string> log_slam_methods() {
 }
 
 LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReader>()>& open_log,
-                           const LogSlamOptions& o, const std::function<void(std::size_t)>& progress) {
+                           const LogSlamOptions& o,
+                           const std::function<void(std::size_t, std::size_t)>& progress) {
   const auto methods = log_slam_methods();
   if (std::find(methods.begin(), methods.end(), o.method) == methods.end()) {
     throw InputError("method '" + o.method + "'" + core::did_you_mean(o.method, methods) +
@@ -71,10 +115,12 @@ LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReade
   // extent for the drift the method will correct.
   double lo_x = INFINITY, hi_x = -INFINITY, lo_y = INFINITY, hi_y = -INFINITY;
   double max_range = 0.0;
+  std::size_t scans = 0;
   {
     auto log = open_log();
     std::optional<core::Pose2> first;
     while (const auto s = log->next()) {
+      ++scans;
       if (!first) first = s->odometry;
       const core::Pose2 p = first->inverse().compose(s->odometry);
       lo_x = std::min(lo_x, p.x), hi_x = std::max(hi_x, p.x), lo_y = std::min(lo_y, p.y), hi_y = std::max(hi_y, p.y);
@@ -94,6 +140,7 @@ LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReade
 
   LogSlamResult out;
   auto localizer = localization::make_localizer(o.method, context_for(o));
+  const bool own_map = !localizer->ignores_own_map();
   auto log = open_log();
   std::optional<core::Pose2> first_odometry, previous_odometry;
   double previous_time = 0.0;
@@ -109,21 +156,24 @@ LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReade
     const mapping::RangeScan scan = cut(s->scan, reach);
     localizer->update_scan(scan, map);
     const core::Pose2 pose = localizer->pose();
-    mapping::insert_scan(map, pose, scan);
-    if (!out.trajectory.empty()) out.distance_m += (pose.position() - out.trajectory.back().position()).norm();
+    if (own_map) mapping::insert_scan(map, pose, scan);
     out.trajectory.push_back(pose);
     out.odometry.push_back(first_odometry->inverse().compose(s->odometry));
     out.timestamps.push_back(s->timestamp);
     out.times_s.push_back(s->time_s);
     previous_odometry = s->odometry;
     previous_time = s->time_s;
-    if (progress) progress(out.trajectory.size());
+    if (progress) progress(out.trajectory.size(), scans);
+  }
+  if (auto revised = localizer->finish_trajectory(); revised && revised->size() == out.trajectory.size()) {
+    out.trajectory = std::move(*revised);
+  }
+  for (std::size_t i = 1; i < out.trajectory.size(); ++i) {
+    out.distance_m += (out.trajectory[i].position() - out.trajectory[i - 1].position()).norm();
   }
   out.log_duration_s = out.times_s.empty() ? 0.0 : out.times_s.back() - out.times_s.front();
-  // The method's own map where it keeps one (a particle filter's best particle), else the scans at its poses.
-  if (auto own = localizer->map_estimate(); own && own->geometry() == map.geometry()) out.map = std::move(*own);
-  else out.map = std::move(map);
   out.counters = localizer->counters();
+  out.map = final_map(open_log, out.trajectory, reach, o.resolution_m);
   return out;
 }
 

@@ -53,8 +53,9 @@ struct LogSlamResult {
 // Reads the log (three streaming passes: the maximum range, the odometry's extent for the map, and
 // the scans) and runs the method scan by scan: the odometry between two scans drives its
 // prediction (as an arc; a sideways slip odometry reports is lost), the scan its update.
-// `progress(scans_done)` after each scan. Throws InputError for a bad log or method.
+// `progress(scans_done, scans_in_log)` after each scan. Throws InputError for a bad log or method.
 LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReader>()>& open_log,
-                           const LogSlamOptions& options, const std::function<void(std::size_t)>& progress = {});
+                           const LogSlamOptions& options,
+                           const std::function<void(std::size_t done, std::size_t total)>& progress = {});
 
 }  // namespace fleetmap::experiments
