@@ -199,6 +199,8 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
       wide.angular_window_rad = std::min(std::numbers::pi, std::abs(core::normalize_angle(odometry.theta - steady->theta)) +
                                                                o.local_search.angular_window_rad);
       wide.min_score = 0.0;
+      wide.translation_weight = o.relocalize_translation_weight;
+      wide.rotation_weight = o.relocalize_rotation_weight;
       const int depth = std::clamp(int(std::ceil(std::log2(wide.linear_window_m / m.grid.resolution()))), 1, o.branch_and_bound_depth);
       const PrecomputedGrids grids(m.grid, depth);
       const auto found = branch_and_bound_match(grids, match_points, center, wide);

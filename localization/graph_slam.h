@@ -24,7 +24,7 @@ struct GraphSlamOptions {
   double max_range_m = 30.0;
   // Points for matching kept one per square of this side (local matching; loop closure search).
   double match_voxel_m = 0.05;
-  double loop_voxel_m = 0.1;
+  double loop_voxel_m = 0.2;
   // A new submap starts every `scans_per_submap` inserted scans and each submap takes twice as
   // many, so that the robot is always matched against a submap already well filled.
   int scans_per_submap = 45;
@@ -37,19 +37,27 @@ struct GraphSlamOptions {
   // step's velocity by more (beyond the search window) is an outlier.
   double max_acceleration = 2.0;
   double max_angular_acceleration = 5.0;
+  // The search for such a scan prefers poses near the steady prediction (as CorrelativeOptions'
+  // weights): along a corridor whose walls do not fix the position, the steady motion does.
+  double relocalize_translation_weight = 1.0;
+  double relocalize_rotation_weight = 1.0;
   RefineOptions local_refine;
   // Loop closures: searched for a fraction of the (node, finished submap) pairs closer than
   // max_constraint_distance_m, over the branch-and-bound window, refined with loop_refine.
   BranchAndBoundOptions loop_search;
   int branch_and_bound_depth = 7;
-  double loop_sampling_ratio = 0.3;
+  double loop_sampling_ratio = 0.1;
   double max_constraint_distance_m = 15.0;
   RefineOptions loop_refine{20.0, 10.0, 1.0, 20};
-  // The pose graph (Cartographer's weights: residuals are weight x error, metres and radians).
-  double intra_translation_weight = 5e2, intra_rotation_weight = 1.6e3;
-  double loop_translation_weight = 1.1e4, loop_rotation_weight = 1e5;
-  double consecutive_translation_weight = 1e5, consecutive_rotation_weight = 1e5;
-  double huber_scale = 10.0;  // on the loop closures' residuals
+  // The pose graph. Residuals are the constraint's error divided by its standard deviation
+  // (weights in 1/m and 1/rad): local SLAM's motion between consecutive scans is sure to about
+  // 1 cm and 0.005 rad, a scan's match in a submap to 2 cm and 0.01 rad. A loop closure's residual
+  // goes through a Huber loss of scale huber_scale (in standard deviations): a false match pulls
+  // with a bounded force, while true ones close loops that drifted metres.
+  double intra_translation_weight = 50.0, intra_rotation_weight = 100.0;
+  double loop_translation_weight = 50.0, loop_rotation_weight = 100.0;
+  double consecutive_translation_weight = 100.0, consecutive_rotation_weight = 200.0;
+  double huber_scale = 3.0;
   int optimize_every_n_nodes = 90;
   int iterations = 10;        // per optimization while running
   int final_iterations = 100;

@@ -182,10 +182,20 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
     double score = 0.0;
   };
   const double n = double(points.size()) * 255.0;
+  // The prior's factor at the pose of the candidate's region nearest the centre, so that the
+  // region's score still bounds every pose in it.
+  auto prior = [&](const Candidate& c, int level) {
+    if (o.translation_weight == 0.0 && o.rotation_weight == 0.0) return 1.0;
+    const int size = (1 << level) - 1;
+    const int nx = c.dx > 0 ? c.dx : (c.dx + size < 0 ? c.dx + size : 0);
+    const int ny = c.dy > 0 ? c.dy : (c.dy + size < 0 ? c.dy + size : 0);
+    const double penalty = std::hypot(nx * r, ny * r) * o.translation_weight + std::abs(angles[std::size_t(c.scan)]) * o.rotation_weight;
+    return std::exp(-penalty * penalty);
+  };
   auto score = [&](Candidate& c, int level) {
     int sum = 0;
     for (const auto& p : scans[std::size_t(c.scan)]) sum += grids.value(level, p.x() + c.dx, p.y() + c.dy);
-    c.score = double(sum) / n;
+    c.score = double(sum) / n * prior(c, level);
   };
   auto by_score = [](const Candidate& a, const Candidate& b) { return a.score > b.score; };
 

@@ -67,6 +67,10 @@ struct BranchAndBoundOptions {
   double linear_window_m = 7.0;
   double angular_window_rad = 0.52;  // 30 degrees
   double min_score = 0.55;
+  // As CorrelativeOptions: a pose's score is multiplied by exp(-(d * translation_weight + |a| *
+  // rotation_weight)^2) for its distance d (m) and turn a (rad) from the centre; 0: no prior.
+  double translation_weight = 0.0;
+  double rotation_weight = 0.0;
 };
 
 // The best pose within the window around `center` whose score exceeds min_score, found by branch

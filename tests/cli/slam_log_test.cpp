@@ -57,7 +57,7 @@ TEST(SlamLogCommand, WritesTheMapTrajectoryAndMetrics) {
 TEST(SlamLogCommand, SameLogAndSeedGiveTheSameBytes) {
   TempDir dir;
   LogFiles files(dir);
-  for (const std::string method : {"graph-slam", "rbpf"}) {
+  for (const std::string method : {"graph-slam", "scan-matching"}) {
     const auto a = run_fleetmap("slam --log sim.log --method " + method + " --seed 3 --out a_" + method + " -q", dir);
     const auto b = run_fleetmap("slam --log sim.log --method " + method + " --seed 3 --out b_" + method + " -q", dir);
     ASSERT_EQ(a.exit_code, 0) << a.err;
