@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <climits>
+#include <cstdint>
 #include <unordered_set>
 
 #include "core/angle.h"
@@ -89,10 +91,16 @@ struct PriorCost {
 }  // namespace
 
 double angular_search_step(const PointCloud& points, double resolution_m) {
-  double d = 0.0;
-  for (const auto& p : points) d = std::max(d, p.norm());
-  if (d < resolution_m) return 0.1;
-  return std::acos(1.0 - resolution_m * resolution_m / (2.0 * d * d));
+  if (points.empty()) return 0.1;
+  std::vector<double> d;
+  d.reserve(points.size());
+  for (const auto& p : points) d.push_back(p.norm());
+  // The 95th percentile: a few far returns (a long corridor's end) would make the step tiny; they
+  // land within a cell or two of their place at the best angle, which the refinement recovers.
+  const auto k = d.begin() + std::ptrdiff_t(0.95 * double(d.size() - 1));
+  std::nth_element(d.begin(), k, d.end());
+  if (*k < resolution_m) return 0.1;
+  return std::acos(1.0 - resolution_m * resolution_m / (2.0 * *k * *k));
 }
 
 PointCloud voxel_filter(const PointCloud& points, double cell_m) {
@@ -192,9 +200,27 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
     const double penalty = std::hypot(nx * r, ny * r) * o.translation_weight + std::abs(angles[std::size_t(c.scan)]) * o.rotation_weight;
     return std::exp(-penalty * penalty);
   };
+  // Each rotated scan's cell bounds, so that a candidate wholly inside the grids reads cells
+  // without bounds checks (the searches' inner loop).
+  std::vector<Eigen::Vector4i> bounds;
+  for (const auto& cells : scans) {
+    Eigen::Vector4i b(INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN);
+    for (const auto& p : cells) b = Eigen::Vector4i(std::min(b[0], p.x()), std::min(b[1], p.y()), std::max(b[2], p.x()), std::max(b[3], p.y()));
+    bounds.push_back(b);
+  }
   auto score = [&](Candidate& c, int level) {
     int sum = 0;
-    for (const auto& p : scans[std::size_t(c.scan)]) sum += grids.value(level, p.x() + c.dx, p.y() + c.dy);
+    const auto& cells = scans[std::size_t(c.scan)];
+    const auto& b = bounds[std::size_t(c.scan)];
+    if (b[0] + c.dx >= grids.min_x() && b[1] + c.dy >= grids.min_y() && b[2] + c.dx < grids.min_x() + grids.width() &&
+        b[3] + c.dy < grids.min_y() + grids.height()) {
+      const std::uint8_t* data = grids.level_data(level);
+      const std::ptrdiff_t w = grids.width();
+      const std::ptrdiff_t offset = std::ptrdiff_t(c.dy - grids.min_y()) * w + (c.dx - grids.min_x());
+      for (const auto& p : cells) sum += data[offset + std::ptrdiff_t(p.y()) * w + p.x()];
+    } else {
+      for (const auto& p : cells) sum += grids.value(level, p.x() + c.dx, p.y() + c.dy);
+    }
     c.score = double(sum) / n * prior(c, level);
   };
   auto by_score = [](const Candidate& a, const Candidate& b) { return a.score > b.score; };

@@ -21,7 +21,8 @@ struct MatchResult {
 };
 
 // The angular step at which no point moves by more than a cell: acos(1 - r^2 / (2 d^2)) for the
-// farthest point at d (Olson 2009, sec. IV-C; Hess et al. 2016, eq. (7)).
+// farthest point at d (Olson 2009, sec. IV-C; Hess et al. 2016, eq. (7)), with d the 95th
+// percentile of the points' distances.
 double angular_search_step(const PointCloud& points, double resolution_m);
 
 // The points kept one per `cell_m` square (the first in scan order): thins dense close-up returns
@@ -30,7 +31,7 @@ PointCloud voxel_filter(const PointCloud& points, double cell_m);
 
 struct CorrelativeOptions {
   double linear_window_m = 0.1;
-  double angular_window_rad = 0.35;
+  double angular_window_rad = 0.2;
   // A candidate's score is multiplied by exp(-(d * translation_weight + |a| * rotation_weight)^2)
   // for its distance d (m) and turn a (rad) from the prior, so that ties go to the prior.
   double translation_weight = 0.1;
@@ -50,6 +51,12 @@ class PrecomputedGrids {
   int depth() const { return int(levels_.size()) - 1; }
   double resolution() const { return resolution_; }
   // Probability x 255 at a cell of level h; outside the grid the unknown value.
+  // Level h's cells, row by row, and the bounds every level shares.
+  const std::uint8_t* level_data(int level) const { return levels_[std::size_t(level)].data(); }
+  int min_x() const { return min_x_; }
+  int min_y() const { return min_y_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
   std::uint8_t value(int level, int x, int y) const {
     const int ix = x - min_x_, iy = y - min_y_;
     if (ix < 0 || iy < 0 || ix >= width_ || iy >= height_) return unknown_;
