@@ -188,9 +188,23 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
     // Matching happens in the grid frame, the submap's (its local origin is a translation).
     const core::Pose2 in_grid = m.local.inverse().compose(prior);
     core::Pose2 refined;
-    if (!steady) {
-      const MatchResult coarse = correlative_match(m.grid, match_points, in_grid, o.local_search);
-      refined = refine_match(m.grid, match_points, coarse.pose, in_grid, o.local_refine);
+    auto match_near = [&](const core::Pose2& guess) {
+      const MatchResult coarse = correlative_match(m.grid, match_points, guess, o.local_search);
+      return refine_match(m.grid, match_points, coarse.pose, guess, o.local_refine);
+    };
+    // Odometry that did not change at all while the robot was moving is as likely a stale reading
+    // (the odometry messages stopped; real logs then catch up with a jump) as a stop: both are
+    // matched and the scan decides, the steady motion first.
+    const bool still = odometry.x == 0.0 && odometry.y == 0.0 && odometry.theta == 0.0;
+    const bool was_moving = s.last_step && (s.last_step->x != 0.0 || s.last_step->y != 0.0 || s.last_step->theta != 0.0);
+    if (!steady && still && was_moving && dt_s > 0.0 && s.last_dt > 0.0) {
+      const double k = dt_s / s.last_dt;
+      const core::Pose2 step(k * s.last_step->x, k * s.last_step->y, k * s.last_step->theta);
+      const core::Pose2 moving = match_near(m.local.inverse().compose(s.nodes.back().local.compose(step)));
+      const core::Pose2 stopped = match_near(in_grid);
+      refined = match_score(m.grid, match_points, stopped) > match_score(m.grid, match_points, moving) ? stopped : moving;
+    } else if (!steady) {
+      refined = match_near(in_grid);
     } else {
       // Branch and bound over the window around the steady prediction that reaches the odometry's.
       const core::Pose2 center = m.local.inverse().compose(s.nodes.back().local.compose(*steady));

@@ -27,10 +27,11 @@ struct GraphSlamOptions {
   double loop_voxel_m = 0.2;
   // A new submap starts every `scans_per_submap` inserted scans and each submap takes twice as
   // many, so that the robot is always matched against a submap already well filled.
-  int scans_per_submap = 45;
+  int scans_per_submap = 30;
   // A scan is inserted into the submaps when the robot moved this much since the last inserted
+  // (Cartographer's motion filter)
   // (matched, it becomes a node either way): a robot standing still does not swamp the grid.
-  double insert_min_distance_m = 0.1;
+  double insert_min_distance_m = 0.2;
   double insert_min_angle_rad = 0.0175;
   CorrelativeOptions local_search;
   // What the robot can do between two scans (m/s^2, rad/s^2): odometry that departs from the last
@@ -52,12 +53,12 @@ struct GraphSlamOptions {
   // The pose graph. Residuals are the constraint's error divided by its standard deviation
   // (weights in 1/m and 1/rad): local SLAM's motion between consecutive scans is sure to about
   // 1 cm and 0.005 rad, a scan's match in a submap to 2 cm and 0.01 rad. A loop closure's residual
-  // goes through a Huber loss of scale huber_scale (in standard deviations): a false match pulls
-  // with a bounded force, while true ones close loops that drifted metres.
+  // goes through a Huber loss of scale huber_scale (in standard deviations; Cartographer's 10): a
+  // false match pulls with a bounded force, while true ones close loops that drifted metres.
   double intra_translation_weight = 50.0, intra_rotation_weight = 100.0;
   double loop_translation_weight = 50.0, loop_rotation_weight = 100.0;
   double consecutive_translation_weight = 100.0, consecutive_rotation_weight = 200.0;
-  double huber_scale = 3.0;
+  double huber_scale = 10.0;
   int optimize_every_n_nodes = 90;
   int iterations = 10;        // per optimization while running
   int final_iterations = 100;
