@@ -46,8 +46,8 @@ mapping::RangeScan cut(const mapping::RangeScan& scan, double range) {
 
 // The map of the whole log at the final poses, each scan inserted once into one probability grid
 // with the submaps' hit and miss odds (a grazing ray does not erase a wall), then given the states a
-// map_server map holds: occupied above 0.6 (three hits more than misses), free below 0.45 (five
-// scans more free than occupied).
+// map_server map holds: occupied when its hits outweigh its misses (above 0.5), free below 0.45
+// (five scans more free than occupied), unknown between.
 mapping::OccupancyGrid final_map(const std::function<std::unique_ptr<io::LaserLogReader>()>& open_log,
                                  const std::vector<core::Pose2>& trajectory, double reach, double resolution) {
   localization::SubmapGridOptions go;
@@ -72,7 +72,7 @@ mapping::OccupancyGrid final_map(const std::function<std::unique_ptr<io::LaserLo
   mo.miss_probability = go.miss_probability;
   mo.min_probability = go.min_probability;
   mo.max_probability = go.max_probability;
-  mo.occupied_threshold = 0.6;
+  mo.occupied_threshold = 0.5;
   mo.free_threshold = 0.45;
   const int w = std::max(grid.width(), 1), h = std::max(grid.height(), 1);
   mapping::OccupancyGrid map(core::GridGeometry(resolution, w, h, core::Pose2(grid.min_x() * resolution, grid.min_y() * resolution, 0.0)), mo);
