@@ -164,6 +164,7 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
     points.emplace_back(*r * std::cos(scan.angles[b]), *r * std::sin(scan.angles[b]));
   }
   const PointCloud match_points = voxel_filter(points, o.match_voxel_m);
+  PointCloud loop_points = voxel_filter(points, o.loop_voxel_m);
 
   const core::Pose2 prior = s.nodes.empty() ? s.initial : s.nodes.back().local.compose(odometry);
   core::Pose2 local = prior;
@@ -189,7 +190,8 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
     const core::Pose2 in_grid = m.local.inverse().compose(prior);
     core::Pose2 refined;
     auto match_near = [&](const core::Pose2& guess) {
-      const MatchResult coarse = correlative_match(m.grid, match_points, guess, o.local_search);
+      // The exhaustive search only needs to land in the refinement's basin: the sparser points do.
+      const MatchResult coarse = correlative_match(m.grid, loop_points, guess, o.local_search);
       return refine_match(m.grid, match_points, coarse.pose, guess, o.local_refine);
     };
     // Odometry that did not change at all while the robot was moving is as likely a stale reading
@@ -233,7 +235,7 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
   Node node;
   node.local = local;
   node.global = s.local_to_global.compose(local);
-  node.loop_points = voxel_filter(points, o.loop_voxel_m);
+  node.loop_points = std::move(loop_points);
   s.nodes.push_back(std::move(node));
 
   std::vector<std::size_t> linked;

@@ -22,7 +22,8 @@ struct GraphSlamOptions {
   // Beams are used between these ranges (a farther return counts as no return).
   double min_range_m = 0.1;
   double max_range_m = 30.0;
-  // Points for matching kept one per square of this side (local matching; loop closure search).
+  // Points for matching kept one per square of this side: the least-squares refinement; the
+  // correlative searches (local and loop closure).
   double match_voxel_m = 0.05;
   double loop_voxel_m = 0.2;
   // A new submap starts every `scans_per_submap` inserted scans and each submap takes twice as
