@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <numbers>
@@ -32,6 +33,8 @@ std::string row(const std::string& log, const std::string& relations_path, const
   const double cpu = double(std::clock()) / CLOCKS_PER_SEC - cpu0;
   std::vector<fm::localization::TimedPose> trajectory;
   for (std::size_t i = 0; i < r.trajectory.size(); ++i) trajectory.push_back({r.times_s[i], r.trajectory[i]});
+  // Logs' times need not rise (the Intel lab's go back four times): relation_errors wants them sorted.
+  std::stable_sort(trajectory.begin(), trajectory.end(), [](const auto& a, const auto& b) { return a.time_s < b.time_s; });
   std::vector<fm::localization::ReferenceRelation> reference;
   for (const auto& rel : relations) reference.push_back({rel.t1, rel.t2, rel.t1_tolerance, rel.t2_tolerance, rel.motion});
   const auto e = fm::localization::relation_errors(trajectory, reference);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -135,6 +136,8 @@ int run_slam_log(const SlamLogFlags& f) {
   if (!f.relations.empty()) {
     std::vector<localization::TimedPose> trajectory;
     for (std::size_t i = 0; i < r.trajectory.size(); ++i) trajectory.push_back({r.times_s[i], r.trajectory[i]});
+    // Logs' times need not rise (the Intel lab's go back four times): relation_errors wants them sorted.
+    std::stable_sort(trajectory.begin(), trajectory.end(), [](const auto& a, const auto& b) { return a.time_s < b.time_s; });
     std::vector<localization::ReferenceRelation> reference;
     for (const auto& rel : relations) reference.push_back({rel.t1, rel.t2, rel.t1_tolerance, rel.t2_tolerance, rel.motion});
     const auto e = localization::relation_errors(trajectory, reference);

@@ -143,14 +143,17 @@ LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReade
   const bool own_map = !localizer->ignores_own_map();
   auto log = open_log();
   std::optional<core::Pose2> first_odometry, previous_odometry;
-  double previous_time = 0.0;
+  double previous_time = 0.0, period = 0.0;
   while (const auto s = log->next()) {
     if (!first_odometry) {
       first_odometry = s->odometry;
       out.format = log->format();
       out.max_range_m = log->max_range_m();
     } else {
-      const double dt = s->time_s > previous_time ? s->time_s - previous_time : 1.0;
+      // A log whose time stands still or goes back (the Intel lab's, four times) took the scan
+      // one scan period after the last all the same.
+      const double dt = s->time_s > previous_time ? s->time_s - previous_time : (period > 0.0 ? period : 1.0);
+      period = dt;
       localizer->predict(arc_between(*previous_odometry, s->odometry, dt));
     }
     const mapping::RangeScan scan = cut(s->scan, reach);

@@ -173,7 +173,10 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
   // than the robot can accelerate in the time (real odometry jumps: slipping wheels, glitching
   // encoders); then the step is taken as unknown between the two predictions.
   std::optional<core::Pose2> steady;
-  if (s.last_step && dt_s > 0.0 && s.last_dt > 0.0) {
+  // The last step's velocity predicts the next scan of a regular stream only: not across a gap
+  // in the log (the Intel lab's has gaps of seconds between scans 0.2 s apart).
+  const bool regular = dt_s > 0.0 && s.last_dt > 0.0 && dt_s <= 2.0 * s.last_dt;
+  if (s.last_step && regular) {
     const double k = dt_s / s.last_dt;
     const core::Pose2 step(k * s.last_step->x, k * s.last_step->y, k * s.last_step->theta);
     const double e = std::hypot(odometry.x - step.x, odometry.y - step.y);
@@ -199,7 +202,7 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
     // matched and the scan decides, the steady motion first.
     const bool still = odometry.x == 0.0 && odometry.y == 0.0 && odometry.theta == 0.0;
     const bool was_moving = s.last_step && (s.last_step->x != 0.0 || s.last_step->y != 0.0 || s.last_step->theta != 0.0);
-    if (!steady && still && was_moving && dt_s > 0.0 && s.last_dt > 0.0) {
+    if (!steady && still && was_moving && regular) {
       const double k = dt_s / s.last_dt;
       const core::Pose2 step(k * s.last_step->x, k * s.last_step->y, k * s.last_step->theta);
       const core::Pose2 moving = match_near(m.local.inverse().compose(s.nodes.back().local.compose(step)));
