@@ -14,11 +14,13 @@
 #include "cli/corridor_command.h"
 #include "cli/landmark_command.h"
 #include "cli/progress.h"
+#include "cli/slam_log_command.h"
 #include "cli/validators.h"
 #include "core/format.h"
 #include "core/parallel.h"
 #include "io/file_io.h"
 #include "core/error.h"
+#include "experiments/log_slam.h"
 #include "experiments/slam_experiment.h"
 #include "experiments/slam_output.h"
 #include "experiments/slam_scenario.h"
@@ -39,6 +41,7 @@ struct SlamFlags {
   bool quiet = false;
   bool sampled_start = false;
   bool exact_start = false;
+  SlamLogFlags log;  // --log mode
 };
 
 std::string method_names() { return core::join(experiments::slam_method_names()); }
@@ -49,12 +52,21 @@ void refuse_unused_flags(const SlamFlags& f, const std::string& experiment, cons
       {"--runs", f.runs.has_value()}, {"--jobs", f.jobs.has_value()}, {"--sampled-start", f.sampled_start}, {"--exact-start", f.exact_start}};
   for (const auto& [flag, set] : given) {
     if (set && std::find(unused.begin(), unused.end(), flag) != unused.end()) {
-      throw InputError(std::string(flag) + " does not apply to the " + experiment + " experiment of " + f.scenario);
+      throw InputError(std::string(flag) + " does not apply to " +
+                       (experiment == "--log" ? std::string("--log") : "the " + experiment + " experiment of " + f.scenario));
     }
   }
 }
 
-int run_slam(const SlamFlags& f) {
+int run_slam(SlamFlags f) {
+  if (!f.log.log.empty()) {
+    refuse_unused_flags(f, "--log", {"--runs", "--jobs", "--sampled-start", "--exact-start"});
+    f.log.seed = f.seed;
+    f.log.out = f.out;
+    f.log.quiet = f.quiet;
+    return run_slam_log(f.log);
+  }
+  if (f.scenario.empty()) throw InputError("slam: give --scenario FILE (a paper's experiment) or --log FILE (a laser log)");
   const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
   // The corridor loop of León et al. (experiment: leon_corridor) has its own runner.
   if (is_corridor_scenario_file(f.scenario)) {
@@ -130,20 +142,29 @@ Command add_slam_command(CLI::App& root) {
       "Scenarios with `experiment: landmark_alignment` (scenarios/landmark_alignment.yaml) run the map-alignment paper's\n"
       "experiments: FastSLAM 2.0 landmark maps aligned by data association or inter-robot observations, Tables I-III,\n"
       "Fig. 2 and the leader/follower merges (--sampled-start and --exact-start do not apply); README.md,\n"
-      "\"Landmark map alignment (map-alignment paper)\".");
+      "\"Landmark map alignment (map-alignment paper)\".\n\n" + slam_log_help());
   auto f = std::make_shared<SlamFlags>();
-  app->add_option("--scenario", f->scenario, "SLAM scenario YAML (see scenarios/dalfonso_3robots.yaml)")
-      ->required()
+  auto* scenario = app->add_option("--scenario", f->scenario, "SLAM scenario YAML (see scenarios/dalfonso_3robots.yaml)")
+                       ->check(CLI::ExistingFile);
+  auto* log = app->add_option("--log", f->log.log, "A laser log (CARMEN or DP-SLAM, plain or .gz) to run one SLAM method over")
+                  ->check(CLI::ExistingFile)
+                  ->excludes(scenario);
+  app->add_option("--method", f->log.method, "With --log: the SLAM method [default: graph-slam]")
+      ->needs(log)
+      ->check(one_of(experiments::log_slam_methods()));
+  app->add_option("--relations", f->log.relations,
+                  "With --log: reference relations (`t1 t2 x y z roll pitch yaw`) to score the trajectory against")
+      ->needs(log)
       ->check(CLI::ExistingFile);
   app->add_option("--runs", f->runs, "Number of runs [default: the scenario's runs, 100 if it has none]")
       ->check(in_range(experiments::kSlamRunsRange));
-  app->add_option("--seed", f->seed, "Random seed; run k uses its own streams derived from it [default: the scenario's, 1]")
+  app->add_option("--seed", f->seed, "Random seed; run k uses its own streams derived from it [default: the scenario's, 1; with --log 1]")
       ->check(seed_number());
   app->add_option("--jobs", f->jobs, "Runs computed in parallel, one thread each; results do not depend on it [default: 1]")
       ->check(in_range(sweep::kJobsRange));
   app->add_option("--out,-o", f->out,
                   "Output folder: new, empty, or of an earlier slam run (its files are replaced) "
-                  "[default: out/slam_<scenario name>]");
+                  "[default: out/slam_<scenario or log name>]");
   auto* sampled = app->add_flag("--sampled-start", f->sampled_start,
                                 "Start each robot's estimate off its true start by a draw from P0, so that the NEES "
                                 "measures consistency [default: the scenario's initial_sigma.sampled]");
@@ -151,7 +172,7 @@ Command add_slam_command(CLI::App& root) {
                 "Start each robot's estimate exactly at its true start, as D'Alfonso et al. do "
                 "[default: the scenario's initial_sigma.sampled]")
       ->excludes(sampled);
-  app->add_flag("--quiet,-q", f->quiet, "Print only the path of table1.md; no progress bar");
+  app->add_flag("--quiet,-q", f->quiet, "Print only the path of table1.md (with --log: of metrics.json); no progress bar");
   return {app, [f]() { return run_slam(*f); }};
 }
 

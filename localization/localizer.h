@@ -149,6 +149,15 @@ class Localizer {
   virtual std::vector<Landmark> landmark_estimates() const { return {}; }
   // True when the localizer estimates landmarks (landmark_estimates() fills as it observes them).
   virtual bool estimates_landmarks() const { return false; }
+  // True when update_scan does something: the localizer reads range scans.
+  virtual bool uses_scans() const { return false; }
+  // True when the localizer maps the scans itself and never reads update_scan's own_map, so that
+  // the caller need not build one for it.
+  virtual bool ignores_own_map() const { return false; }
+  // Ends a run: a localizer that revises past poses (graph SLAM) optimizes a last time and returns
+  // the pose of every scan given to update_scan, in order; the others return nullopt (the pose()
+  // after each scan is their answer).
+  virtual std::optional<std::vector<core::Pose2>> finish_trajectory() { return std::nullopt; }
   // The grid the localizer builds itself, if any (`rbpf`: the best particle's map).
   virtual std::optional<mapping::OccupancyGrid> map_estimate() const { return std::nullopt; }
 };

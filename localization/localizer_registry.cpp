@@ -35,6 +35,10 @@ core::Registry<LocalizerFactory>& localizer_registry() {
           "grid-based FastSLAM: particles drawn from the raw motion model, each weighted by its scan on its own grid, "
           "no scan-matching proposal (León et al., sec. II.B)",
           make_grid_fastslam_localizer);
+    r.add("graph-slam",
+          "graph SLAM: scans matched to submaps (correlative search + least squares), loop closures by branch and "
+          "bound, pose graph with a robust loss on Ceres (Hess et al. 2016)",
+          make_graph_slam_localizer);
     r.add("fastslam2",
           "FastSLAM 2.0: particles over the path, an EKF per landmark in each, proposal including the readings "
           "(Montemerlo et al. 2003)",

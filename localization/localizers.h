@@ -19,6 +19,7 @@ std::unique_ptr<Localizer> make_scan_matching_localizer(const LocalizerContext& 
 std::unique_ptr<Localizer> make_mcl_localizer(const LocalizerContext& context);            // mcl_localizer.cpp
 std::unique_ptr<Localizer> make_rbpf_localizer(const LocalizerContext& context);           // rbpf_localizer.cpp
 std::unique_ptr<Localizer> make_grid_fastslam_localizer(const LocalizerContext& context);  // rbpf_localizer.cpp
+std::unique_ptr<Localizer> make_graph_slam_localizer(const LocalizerContext& context);      // graph_slam_localizer.cpp
 std::unique_ptr<Localizer> make_fastslam2_localizer(const LocalizerContext& context);      // fastslam2.cpp
 
 }  // namespace fleetmap::localization

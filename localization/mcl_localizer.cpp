@@ -64,6 +64,7 @@ class MclLocalizer final : public Localizer {
   }
 
   std::string name() const override { return "mcl"; }
+  bool uses_scans() const override { return true; }
 
   void predict(const Odometry& u) override {
     const double dist = std::abs(u.v * u.dt), turn = std::abs(u.omega * u.dt);

@@ -29,6 +29,7 @@ class PolynomialLocalizer final : public Localizer {
                       std::size_t max_beams = 0);
 
   std::string name() const override { return "polynomial"; }
+  bool uses_scans() const override { return true; }
   void predict(const Odometry& u) override { slam_.predict(u); }
   void update_scan(const RangeScan& scan, const mapping::OccupancyGrid& own_map) override;
   void change_frame(const core::Transform2& new_from_old) override { slam_.change_frame(new_from_old); }

@@ -52,6 +52,7 @@ class RbpfLocalizer final : public Localizer {
   explicit RbpfLocalizer(const LocalizerContext& context, Proposal proposal = Proposal::ScanMatching);
 
   std::string name() const override { return proposal_ == Proposal::Motion ? "fastslam-grid" : "rbpf"; }
+  bool uses_scans() const override { return true; }
   void predict(const Odometry& u) override;
   void update_scan(const RangeScan& scan, const mapping::OccupancyGrid& own_map) override;
   core::Pose2 pose() const override { return particles_[std::size_t(best_)].pose; }

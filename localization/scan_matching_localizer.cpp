@@ -28,6 +28,7 @@ class ScanMatchingLocalizer final : public Localizer {
   explicit ScanMatchingLocalizer(const LocalizerContext& c)
       : pose_(c.initial_pose), options_(c.options), covariance_(initial_covariance(c.options)) {}
   std::string name() const override { return "scan-matching"; }
+  bool uses_scans() const override { return true; }
 
   void predict(const Odometry& u) override {
     const Eigen::Matrix3d f = motion_jacobian(pose_, u);

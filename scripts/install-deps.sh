@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libopencv-dev libompl-dev liboctomap-dev libpng-dev
   libboost-serialization-dev libboost-filesystem-dev libboost-system-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libexpat1-dev
+  libceres-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libfmt-dev libexpat1-dev
   pybind11-dev python3-dev python3-numpy
   slurm-wlm
   chromium  # the tests that open fleetmap's HTML pages in a real, headless browser

@@ -15,7 +15,7 @@ namespace {
 
 TEST(LocalizerRegistry, ListsTheLocalizersInHelpOrder) {
   const std::vector<std::string> names = localizer_names();
-  EXPECT_EQ(names, (std::vector<std::string>{"ideal", "odometry", "ekf", "ekf-slam", "polynomial", "scan-matching", "mcl", "rbpf", "fastslam-grid", "fastslam2"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"ideal", "odometry", "ekf", "ekf-slam", "polynomial", "scan-matching", "mcl", "rbpf", "fastslam-grid", "graph-slam", "fastslam2"}));
   const std::string help = localizer_help();
   for (const auto& n : names) EXPECT_NE(help.find("  " + n + ": "), std::string::npos) << n;
 }

@@ -1,0 +1,61 @@
+#pragma once
+// SLAM on a real robot's laser log: one of fleetmap's localizers that map (scan matching, the
+// Rao-Blackwellized particle filter, grid FastSLAM) run over every scan of the log in order, as
+// León et al. compare them on real data, and the trajectory and map they make.
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/transform2.h"
+#include "io/laser_log.h"
+#include "localization/localizer.h"
+#include "mapping/occupancy_grid.h"
+
+namespace fleetmap::experiments {
+
+struct LogSlamOptions {
+  std::string method = "scan-matching";  // a registered localizer that maps (log_slam_methods())
+  double resolution_m = 0.05;            // of the map
+  // Beams are used up to this range (a longer return counts as no return beyond it): far returns
+  // cost time and add little to an indoor map. Cartographer's 2D default.
+  double mapping_range_m = 30.0;
+  std::uint64_t seed = 1;
+  io::LaserLogOptions log;
+  // Particles and noise. A real robot's odometry over the motion between two scans is far less
+  // sure than the simulator's default: 5 cm and 0.05 rad (3 degrees) per step, the scale of
+  // GMapping's defaults for scans a few tens of centimetres apart.
+  localization::LocalizerOptions localizer = [] {
+    localization::LocalizerOptions o;
+    o.process_noise_xy = 0.05;
+    o.process_noise_theta = 0.05;
+    return o;
+  }();
+};
+
+// The localizers a log can be run with: the registered ones that build a map of their own.
+std::vector<std::string> log_slam_methods();
+
+struct LogSlamResult {
+  std::string format;                    // the log's ("CARMEN", "DP-SLAM")
+  std::vector<std::string> timestamps;   // per scan, as the log writes it
+  std::vector<double> times_s;
+  std::vector<core::Pose2> trajectory;   // per scan, the laser's estimated pose; the first at the origin
+  std::vector<core::Pose2> odometry;     // per scan, the raw odometry in the same frame (for comparison)
+  mapping::OccupancyGrid map;            // the method's map, in the trajectory's frame
+  double distance_m = 0.0;               // along the estimated trajectory
+  double log_duration_s = 0.0;           // last scan's time - first's (0 for logs without times)
+  double max_range_m = 0.0;              // what the reader took as "no return"
+  std::vector<std::pair<std::string, double>> counters;  // the localizer's
+};
+
+// Reads the log (three streaming passes: the maximum range, the odometry's extent for the map, and
+// the scans) and runs the method scan by scan: the odometry between two scans drives its
+// prediction (as an arc; a sideways slip odometry reports is lost), the scan its update.
+// `progress(scans_done, scans_in_log)` after each scan. Throws InputError for a bad log or method.
+LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReader>()>& open_log,
+                           const LogSlamOptions& options,
+                           const std::function<void(std::size_t done, std::size_t total)>& progress = {});
+
+}  // namespace fleetmap::experiments

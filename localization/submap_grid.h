@@ -1,0 +1,63 @@
+#pragma once
+// A probability grid for one submap of graph SLAM (Hess et al. 2016, sec. IV): each scan moves a
+// cell's occupancy odds by a fixed hit or miss factor, once per scan, hits before misses, and
+// clamps it. A miss factor near 1 (0.49 against a hit's 0.55) means that the many rays grazing a
+// wall at a shallow angle cannot erase it, as a log-odds grid with strong misses does. The grid
+// grows to hold whatever is inserted; cells are addressed by integer coordinates floor(x / res).
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+#include "core/transform2.h"
+
+namespace fleetmap::localization {
+
+struct SubmapGridOptions {
+  double resolution_m = 0.05;
+  double hit_probability = 0.55;
+  double miss_probability = 0.49;
+  double min_probability = 0.1;  // also what an unknown cell reads as
+  double max_probability = 0.9;
+};
+
+class SubmapGrid {
+ public:
+  explicit SubmapGrid(const SubmapGridOptions& options = {});
+
+  double resolution() const { return options_.resolution_m; }
+  // The cell holding a point (metres) of the grid's frame.
+  Eigen::Vector2i cell_of(const Eigen::Vector2d& p) const;
+  // Probability of occupancy; unknown cells and cells outside read min_probability.
+  float probability(int x, int y) const {
+    const int ix = x - min_x_, iy = y - min_y_;
+    if (ix < 0 || iy < 0 || ix >= width_ || iy >= height_) return float(options_.min_probability);
+    const float p = cells_[std::size_t(iy) * std::size_t(width_) + std::size_t(ix)];
+    return p == 0.0f ? float(options_.min_probability) : p;
+  }
+  bool known(int x, int y) const;
+
+  // One scan taken at `sensor` (grid frame): `hits` are returns (grid frame); each cell between
+  // the sensor and a hit gets a miss, each hit cell a hit, every cell at most one update.
+  void insert(const Eigen::Vector2d& sensor, const std::vector<Eigen::Vector2d>& hits);
+
+  // The bounds of the cells held (inclusive min, exclusive max).
+  int min_x() const { return min_x_; }
+  int min_y() const { return min_y_; }
+  int width() const { return width_; }
+  int height() const { return height_; }
+  std::size_t known_cells() const { return known_; }
+
+ private:
+  void grow_to(int lo_x, int lo_y, int hi_x, int hi_y);
+  void update(int x, int y, double odds_factor);
+
+  SubmapGridOptions options_;
+  int min_x_ = 0, min_y_ = 0, width_ = 0, height_ = 0;
+  std::vector<float> cells_;          // probability, 0 = unknown
+  std::vector<std::uint32_t> stamp_;  // the scan that last updated the cell
+  std::uint32_t scan_ = 0;
+  std::size_t known_ = 0;
+};
+
+}  // namespace fleetmap::localization

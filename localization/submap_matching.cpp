@@ -1,0 +1,299 @@
+#include "localization/submap_matching.h"
+
+#include <ceres/ceres.h>
+#include <ceres/cubic_interpolation.h>
+
+#include <algorithm>
+#include <cmath>
+#include <climits>
+#include <cstdint>
+#include <unordered_set>
+
+#include "core/angle.h"
+
+namespace fleetmap::localization {
+
+namespace {
+
+// The points turned by `angle` about the scan's origin, then moved by `t`, as grid cells.
+std::vector<Eigen::Vector2i> cells_at(const PointCloud& points, double angle, const Eigen::Vector2d& t, double resolution) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  std::vector<Eigen::Vector2i> out;
+  out.reserve(points.size());
+  for (const auto& p : points) {
+    const double x = c * p.x() - s * p.y() + t.x(), y = s * p.x() + c * p.y() + t.y();
+    out.emplace_back(int(std::floor(x / resolution)), int(std::floor(y / resolution)));
+  }
+  return out;
+}
+
+// The angles of a window: 0, then +-k steps out to the window's edge.
+std::vector<double> window_angles(double window, double step) {
+  const int n = step > 0.0 ? int(std::ceil(window / step)) : 0;
+  std::vector<double> out;
+  for (int k = -n; k <= n; ++k) out.push_back(k * step);
+  return out;
+}
+
+// The grid seen by Ceres's bicubic interpolator: row y, column x, unknown cells at min probability.
+class GridAdapter {
+ public:
+  enum { DATA_DIMENSION = 1 };
+  explicit GridAdapter(const SubmapGrid& grid) : grid_(grid) {}
+  void GetValue(int row, int column, double* value) const {
+    *value = grid_.probability(column + grid_.min_x(), row + grid_.min_y());
+  }
+
+ private:
+  const SubmapGrid& grid_;
+};
+
+struct OccupiedSpaceCost {
+  OccupiedSpaceCost(const SubmapGrid& grid, const PointCloud& points, double weight)
+      : grid_(grid), adapter_(grid), interpolator_(adapter_), points_(points), weight_(weight) {}
+
+  template <typename T>
+  bool operator()(const T* pose, T* residual) const {
+    const T c = ceres::cos(pose[2]), s = ceres::sin(pose[2]);
+    const double r = grid_.resolution();
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      const T x = c * points_[i].x() - s * points_[i].y() + pose[0];
+      const T y = s * points_[i].x() + c * points_[i].y() + pose[1];
+      T value;
+      // Sample (row, column) is the centre of cell (min_x + column, min_y + row).
+      interpolator_.Evaluate(y / r - 0.5 - double(grid_.min_y()), x / r - 0.5 - double(grid_.min_x()), &value);
+      residual[i] = weight_ * (1.0 - value);
+    }
+    return true;
+  }
+
+  const SubmapGrid& grid_;
+  GridAdapter adapter_;
+  ceres::BiCubicInterpolator<GridAdapter> interpolator_;
+  const PointCloud& points_;
+  double weight_;
+};
+
+struct PriorCost {
+  PriorCost(const core::Pose2& target, double translation_weight, double rotation_weight)
+      : target_(target), tw_(translation_weight), rw_(rotation_weight) {}
+  template <typename T>
+  bool operator()(const T* pose, T* residual) const {
+    residual[0] = tw_ * (pose[0] - target_.x);
+    residual[1] = tw_ * (pose[1] - target_.y);
+    residual[2] = rw_ * (pose[2] - target_.theta);
+    return true;
+  }
+  core::Pose2 target_;
+  double tw_, rw_;
+};
+
+}  // namespace
+
+double angular_search_step(const PointCloud& points, double resolution_m) {
+  if (points.empty()) return 0.1;
+  std::vector<double> d;
+  d.reserve(points.size());
+  for (const auto& p : points) d.push_back(p.norm());
+  // The 95th percentile: a few far returns (a long corridor's end) would make the step tiny; they
+  // land within a cell or two of their place at the best angle, which the refinement recovers.
+  const auto k = d.begin() + std::ptrdiff_t(0.95 * double(d.size() - 1));
+  std::nth_element(d.begin(), k, d.end());
+  if (*k < resolution_m) return 0.1;
+  return std::acos(1.0 - resolution_m * resolution_m / (2.0 * *k * *k));
+}
+
+PointCloud voxel_filter(const PointCloud& points, double cell_m) {
+  std::unordered_set<std::uint64_t> seen;
+  PointCloud out;
+  for (const auto& p : points) {
+    const auto x = std::uint64_t(std::uint32_t(std::int32_t(std::floor(p.x() / cell_m))));
+    const auto y = std::uint64_t(std::uint32_t(std::int32_t(std::floor(p.y() / cell_m))));
+    if (seen.insert((x << 32) | y).second) out.push_back(p);
+  }
+  return out;
+}
+
+double match_score(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose) {
+  if (points.empty()) return 0.0;
+  double sum = 0.0;
+  for (const auto& c : cells_at(points, pose.theta, pose.position(), grid.resolution())) sum += grid.probability(c.x(), c.y());
+  return sum / double(points.size());
+}
+
+MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
+                              const CorrelativeOptions& o) {
+  MatchResult best{prior, -1.0};
+  if (points.empty()) return {prior, 0.0};
+  const double r = grid.resolution();
+  const int w = int(std::ceil(o.linear_window_m / r));
+  const double step = angular_search_step(points, r);
+  const double n = double(points.size());
+  for (const double da : window_angles(o.angular_window_rad, step)) {
+    const auto cells = cells_at(points, prior.theta + da, prior.position(), r);
+    for (int dy = -w; dy <= w; ++dy) {
+      for (int dx = -w; dx <= w; ++dx) {
+        double sum = 0.0;
+        for (const auto& c : cells) sum += grid.probability(c.x() + dx, c.y() + dy);
+        const double d = std::hypot(dx * r, dy * r);
+        const double penalty = d * o.translation_weight + std::abs(da) * o.rotation_weight;
+        const double score = sum / n * std::exp(-penalty * penalty);
+        if (score > best.score) best = {core::Pose2(prior.x + dx * r, prior.y + dy * r, prior.theta + da), score};
+      }
+    }
+  }
+  best.pose.theta = core::normalize_angle(best.pose.theta);
+  return best;
+}
+
+PrecomputedGrids::PrecomputedGrids(const SubmapGrid& grid, int depth) : resolution_(grid.resolution()) {
+  const int pad = (1 << depth) - 1;
+  min_x_ = grid.min_x() - pad, min_y_ = grid.min_y() - pad;
+  width_ = grid.width() + pad, height_ = grid.height() + pad;
+  unknown_ = std::uint8_t(std::lround(255.0 * grid.probability(grid.min_x() - 1, grid.min_y() - 1)));
+  std::vector<std::uint8_t> level(std::size_t(width_) * std::size_t(height_));
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      level[std::size_t(y) * std::size_t(width_) + std::size_t(x)] =
+          std::uint8_t(std::lround(255.0 * grid.probability(x + min_x_, y + min_y_)));
+    }
+  }
+  levels_.push_back(std::move(level));
+  // Level h from level h-1: the largest of four cells half the width apart.
+  for (int h = 1; h <= depth; ++h) {
+    const int s = 1 << (h - 1);
+    std::vector<std::uint8_t> next(levels_.back().size());
+    for (int y = 0; y < height_; ++y) {
+      for (int x = 0; x < width_; ++x) {
+        const int gx = x + min_x_, gy = y + min_y_;
+        next[std::size_t(y) * std::size_t(width_) + std::size_t(x)] =
+            std::max(std::max(value(h - 1, gx, gy), value(h - 1, gx + s, gy)),
+                     std::max(value(h - 1, gx, gy + s), value(h - 1, gx + s, gy + s)));
+      }
+    }
+    levels_.push_back(std::move(next));
+  }
+}
+
+std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids, const PointCloud& points,
+                                                  const core::Pose2& center, const BranchAndBoundOptions& o) {
+  if (points.empty()) return std::nullopt;
+  const double r = grids.resolution();
+  const int w = int(std::ceil(o.linear_window_m / r));
+  const auto angles = window_angles(o.angular_window_rad, angular_search_step(points, r));
+  std::vector<std::vector<Eigen::Vector2i>> scans;
+  scans.reserve(angles.size());
+  for (const double da : angles) scans.push_back(cells_at(points, center.theta + da, center.position(), r));
+
+  struct Candidate {
+    int scan = 0, dx = 0, dy = 0;
+    double score = 0.0;
+  };
+  const double n = double(points.size()) * 255.0;
+  // The prior's factor at the pose of the candidate's region nearest the centre, so that the
+  // region's score still bounds every pose in it.
+  auto prior = [&](const Candidate& c, int level) {
+    if (o.translation_weight == 0.0 && o.rotation_weight == 0.0) return 1.0;
+    const int size = (1 << level) - 1;
+    const int nx = c.dx > 0 ? c.dx : (c.dx + size < 0 ? c.dx + size : 0);
+    const int ny = c.dy > 0 ? c.dy : (c.dy + size < 0 ? c.dy + size : 0);
+    const double penalty = std::hypot(nx * r, ny * r) * o.translation_weight + std::abs(angles[std::size_t(c.scan)]) * o.rotation_weight;
+    return std::exp(-penalty * penalty);
+  };
+  // Each rotated scan's cell bounds, so that a candidate wholly inside the grids reads cells
+  // without bounds checks (the searches' inner loop).
+  std::vector<Eigen::Vector4i> bounds;
+  for (const auto& cells : scans) {
+    Eigen::Vector4i b(INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN);
+    for (const auto& p : cells) b = Eigen::Vector4i(std::min(b[0], p.x()), std::min(b[1], p.y()), std::max(b[2], p.x()), std::max(b[3], p.y()));
+    bounds.push_back(b);
+  }
+  auto score = [&](Candidate& c, int level) {
+    int sum = 0;
+    const auto& cells = scans[std::size_t(c.scan)];
+    const auto& b = bounds[std::size_t(c.scan)];
+    if (b[0] + c.dx >= grids.min_x() && b[1] + c.dy >= grids.min_y() && b[2] + c.dx < grids.min_x() + grids.width() &&
+        b[3] + c.dy < grids.min_y() + grids.height()) {
+      const std::uint8_t* data = grids.level_data(level);
+      const std::ptrdiff_t w = grids.width();
+      const std::ptrdiff_t offset = std::ptrdiff_t(c.dy - grids.min_y()) * w + (c.dx - grids.min_x());
+      for (const auto& p : cells) sum += data[offset + std::ptrdiff_t(p.y()) * w + p.x()];
+    } else {
+      for (const auto& p : cells) sum += grids.value(level, p.x() + c.dx, p.y() + c.dy);
+    }
+    c.score = double(sum) / n * prior(c, level);
+  };
+  auto by_score = [](const Candidate& a, const Candidate& b) { return a.score > b.score; };
+
+  const int top = grids.depth();
+  std::vector<Candidate> start;
+  const int top_step = 1 << top;
+  for (int k = 0; k < int(scans.size()); ++k) {
+    for (int dy = -w; dy <= w; dy += top_step) {
+      for (int dx = -w; dx <= w; dx += top_step) {
+        Candidate c{k, dx, dy, 0.0};
+        score(c, top);
+        start.push_back(c);
+      }
+    }
+  }
+  std::sort(start.begin(), start.end(), by_score);
+
+  std::optional<Candidate> best;
+  double best_score = o.min_score;
+  // Depth-first: a candidate at level h covers offsets [dx, dx + 2^h) x [dy, dy + 2^h), and its
+  // level-h score bounds every pose it covers.
+  auto search = [&](auto&& self, const std::vector<Candidate>& candidates, int level) -> void {
+    for (const auto& c : candidates) {
+      if (c.score <= best_score) break;
+      if (level == 0) {
+        best = c, best_score = c.score;
+        continue;
+      }
+      const int half = 1 << (level - 1);
+      std::vector<Candidate> children;
+      for (int oy : {0, half}) {
+        for (int ox : {0, half}) {
+          Candidate child{c.scan, c.dx + ox, c.dy + oy, 0.0};
+          if (child.dx > w || child.dy > w) continue;
+          score(child, level - 1);
+          children.push_back(child);
+        }
+      }
+      std::sort(children.begin(), children.end(), by_score);
+      self(self, children, level - 1);
+    }
+  };
+  search(search, start, top);
+  if (!best) return std::nullopt;
+  return MatchResult{core::Pose2(center.x + best->dx * r, center.y + best->dy * r,
+                                 core::normalize_angle(center.theta + angles[std::size_t(best->scan)])),
+                     best->score};
+}
+
+core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& initial,
+                         const core::Pose2& target, const RefineOptions& o) {
+  if (points.empty()) return initial;
+  double pose[3] = {initial.x, initial.y, initial.theta};
+  ceres::Problem::Options problem_options;
+  problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<OccupiedSpaceCost, ceres::DYNAMIC, 3>(
+                               new OccupiedSpaceCost(grid, points, o.occupied_weight / std::sqrt(double(points.size()))),
+                               int(points.size())),
+                           nullptr, pose);
+  problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(
+                               new PriorCost(core::Pose2(target.x, target.y, initial.theta), o.translation_weight, o.rotation_weight)),
+                           nullptr, pose);
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_QR;
+  options.max_num_iterations = o.max_iterations;
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  return core::Pose2(pose[0], pose[1], core::normalize_angle(pose[2]));
+}
+
+}  // namespace fleetmap::localization
