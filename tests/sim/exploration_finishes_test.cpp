@@ -108,6 +108,38 @@ TEST(ExplorationFinishes, WhenTheTargetARobotStandsOnStaysUnseen) {
   expect_finished(Simulation(s, grid).run(), "unstructured, coordinated, 2 robots, seed 2");
 }
 
+// A robot put in a room with no door (the user's start) looks round it, says it has nothing left
+// in its reach and stays where it is, while its teammate explores the rest; the run ends by itself.
+TEST(ExplorationFinishes, ARobotInAClosedRoomStopsAndSaysSo) {
+  auto grid = three_rooms(0.05);
+  // A closed 1.6 x 1.2 m room in the left room, walls one cell thick.
+  for (int y = 48; y <= 72; ++y)
+    for (int x = 8; x <= 40; ++x)
+      if (y == 48 || y == 72 || x == 8 || x == 40) grid.set_state({x, y}, CellState::Occupied);
+  Scenario s = one_robot(360, 4.0);
+  s.robot_count = 2;
+  s.exploration.strategy = "coordinated";
+  s.starts = {core::Pose2(1.2, 3.0, 0.0), core::Pose2(3.0, 1.0, 0.0)};
+  const RunResult r = Simulation(s, grid).run();
+  expect_finished(r, "a robot in a closed room");
+  const Event* said = nullptr;
+  for (const Event& e : r.events)
+    if (e.kind == "finished" && e.robot == 0 && !said) said = &e;
+  ASSERT_NE(said, nullptr) << "the robot in the closed room never said it had nothing left";
+  EXPECT_NE(said->detail.find("no reachable frontier"), std::string::npos) << said->detail;
+  EXPECT_LT(said->step, r.steps / 2) << "it said so only at the end";
+  // From then on it drives nowhere (it has no reason to): what its wheels did after it said so.
+  // (Its true pose still drifts by the motion noise a standing robot is given.)
+  const auto& driven = r.robots[0].odometry;  // driven[k - 1]: the motion of step k
+  double metres = 0.0, radians = 0.0;
+  for (std::size_t k = std::size_t(said->step); k < driven.size(); ++k) {
+    metres += std::abs(driven[k].v) * driven[k].dt;
+    radians += std::abs(driven[k].omega) * driven[k].dt;
+  }
+  EXPECT_LT(metres, 0.05) << "driven after it had nothing left";
+  EXPECT_LT(radians, 0.5) << "turned after it had nothing left";
+}
+
 TEST(ExplorationFinishes, ASensorThatSeesNothingIsRefused) {
   const auto grid = three_rooms(0.05);
   fleetmap::testing::expect_input_error([&] { Simulation(one_robot(360, 0.04), grid); },
