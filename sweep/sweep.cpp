@@ -437,7 +437,9 @@ void validate_sweep(const Sweep& sweep) {
   for (const auto& axis : sweep.axes) {
     if (const auto key = strategy_parameter(axis.scenario_key); !key.empty()) parameters.emplace_back(key, "vary " + axis.name);
   }
-  for (const auto& [key, where] : parameters) {
+  for (const auto& parameter : parameters) {
+    const std::string& key = parameter.first;  // not a structured binding: clang 14 cannot capture one
+    const std::string& where = parameter.second;
     if (std::none_of(sweep.strategies.begin(), sweep.strategies.end(),
                      [&](const std::string& s) { return exploration::strategy_options(s).declares(key); })) {
       throw InputError(where + ": no strategy of this sweep (" + join(sweep.strategies) + ") has a parameter '" + key + "'");
