@@ -74,7 +74,7 @@ void BM_RbpfStep(benchmark::State& state) {
   c.initial_pose = {3.0, 7.0, 0.0};
   c.options.process_noise_xy = 0.02;
   c.options.process_noise_theta = 0.01;
-  c.options.rbpf_particles = int(state.range(0));
+  c.params = localizer_options("rbpf", {{"particles", std::to_string(state.range(0))}});
   c.seed = 1;
   RbpfLocalizer pf(c);
   core::Pose2 truth_pose = c.initial_pose;
@@ -103,7 +103,7 @@ void BM_MclUpdate(benchmark::State& state) {
   LocalizerContext c;
   c.known_map = truth;
   c.global_localization = true;
-  c.options.mcl_particles = int(state.range(0));
+  c.params = localizer_options("mcl", {{"particles", std::to_string(state.range(0))}});
   c.seed = 1;
   auto mcl = make_localizer("mcl", c);
   const RangeScan scan = scan_at(*truth, {9.0, 7.2, 0.1});

@@ -518,7 +518,7 @@ PlanMap build_plan_map(const fs::path& plan_yaml, int index, int robot, const fs
     s.range.max_range_m = p.recipe.max_range;
     s.range.noise_m = p.recipe.range_noise;
     s.localization = p.recipe.localization;
-    s.localization_options.rbpf_particles = 15;
+    s.localization_settings = localization::localizer_registry().declared(s.localization, {{"particles", "15"}});
     s.steps = 1500;
     sim::Simulation simulation(s, truth);
     const sim::RunResult r = simulation.run();

@@ -33,7 +33,9 @@ std::vector<Family> families() {
       {"strategy", "explore/bench --strategy NAME; scenario exploration.strategy: {name: NAME, KEY: VALUE}; "
                    "--set strategy.KEY=VALUE; bench --vary strategy.KEY=V1,V2",
        exploration::strategy_registry().help()},
-      {"localization", "explore --localization NAME; scenario localization.method", localization::localizer_registry().help()},
+      {"localization", "explore/bench --localization NAME; scenario localization: {name: NAME, KEY: VALUE}; "
+                       "--set localization.KEY=VALUE; bench --vary localization.KEY=V1,V2",
+       localization::localizer_registry().help()},
       {"merging", "explore/bench --merging NAME; scenario merging.mode", merging::map_aligner_registry().help()},
       {"merge-method", "merge --method NAME; scenario merging.method", merging::merge_method_registry().help()},
       {"planner", "plan --planner NAME; explore --path-planner NAME", planning::planner_registry().help()},

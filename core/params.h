@@ -5,6 +5,7 @@
 // `--help` and `fleetmap plugins` list them from it (as OMPL's ParamSet or Nav2's declared
 // parameters).
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/range.h"
@@ -68,6 +69,10 @@ class Params {
   std::vector<ParamSpec> specs_;
   std::vector<std::string> values_;  // canonical text, one per spec
 };
+
+// Settings for a member as given by the user, key and value text, in the order given (a scenario
+// file's `{name: coordinated, beta: 0.5}`, `--set strategy.beta=0.5`); checked when applied.
+using Settings = std::vector<std::pair<std::string, std::string>>;
 
 // Splits "family.key=value" (as given to --set) into its three parts; throws InputError naming
 // `what` when one is missing.

@@ -6,6 +6,7 @@
 // adds its own through the family's public register_* call, and the command line, scenario files
 // and test harnesses then reach it by name like the built-in ones (as Nav2's plugins or OMPL's
 // planner allocators).
+#include <algorithm>
 #include <deque>
 #include <mutex>
 #include <string>
@@ -61,6 +62,37 @@ class Registry {
   Params params(std::string_view name) const {
     const auto& e = get(name);
     return Params(family_ + " '" + e.name + "'", e.params);
+  }
+
+  // The member's parameters with `settings` applied in order. Throws InputError as get() for an
+  // unknown name, and as Params::set for a setting it does not declare or a value it refuses.
+  Params configure(std::string_view name, const Settings& settings) const {
+    auto p = params(name);
+    for (const auto& [key, value] : settings) p.set(key, value);
+    return p;
+  }
+
+  // The settings among `settings` that member `name` declares: a sweep over several members gives
+  // each its own parameters and runs the others unchanged.
+  Settings declared(std::string_view name, const Settings& settings) const {
+    const auto p = params(name);
+    Settings out;
+    for (const auto& s : settings) {
+      if (p.declares(s.first)) out.push_back(s);
+    }
+    return out;
+  }
+
+  // Every parameter name some member declares, each once, in registration order.
+  std::vector<std::string> parameter_names() const {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<std::string> out;
+    for (const auto& e : entries_) {
+      for (const auto& p : e.params) {
+        if (std::find(out.begin(), out.end(), p.name) == out.end()) out.push_back(p.name);
+      }
+    }
+    return out;
   }
 
   bool contains(std::string_view name) const {

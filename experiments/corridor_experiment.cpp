@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include "core/angle.h"
 #include "core/error.h"
+#include "core/format.h"
 #include "core/random.h"
 #include "io/file_io.h"
 #include "io/yaml_reader.h"
@@ -112,7 +113,31 @@ CorridorOptions parse_corridor_options(const std::string& text, const std::strin
         o.methods.push_back(n.Scalar());
       }
     }
-    o.rbpf_particles = int(m.integer("rbpf_particles", o.rbpf_particles, 1, 10000));
+    // Every other key is a parameter of the localizers in the list that declare it (`particles: 30`
+    // sets rbpf's and fastslam-grid's); `rbpf_particles` is its older name.
+    if (m.has("rbpf_particles") && m.has("particles")) throw InputError(m.where("rbpf_particles") + ": give 'particles' only (rbpf_particles is its older name)");
+    o.localizer_settings.clear();
+    for (const auto& key : m.keys()) {
+      if (key == "list") continue;
+      const auto node = *m.node(key);
+      if (!node.IsScalar()) throw InputError(m.where(key) + ": expected a value, got " + io::describe_node(node));
+      const std::string name = key == "rbpf_particles" ? "particles" : key;
+      bool declared = false;
+      for (const auto& method : o.methods) {
+        core::Params p = localization::localizer_options(method);  // unknown names: the list's own error
+        if (!p.declares(name)) continue;
+        declared = true;
+        try {
+          p.set(name, node.Scalar());
+        } catch (const InputError& e) {
+          throw InputError(m.where(key) + ": " + e.what());
+        }
+      }
+      if (!declared) {
+        throw InputError(m.where(key) + ": no localizer of the list (" + core::join(o.methods) + ") has a parameter '" + name + "'");
+      }
+      o.localizer_settings.emplace_back(name, node.Scalar());
+    }
     m.finish();
   }
   {
@@ -187,8 +212,10 @@ std::vector<Eigen::Vector2d> centre_line(const CorridorOptions& o) {
   return {{c, c}, {o.length_m - c, c}, {o.length_m - c, o.height_m - c}, {c, o.height_m - c}};
 }
 
-localization::LocalizerContext context_for(const CorridorOptions& o, const core::Pose2& start, std::uint64_t seed) {
+localization::LocalizerContext context_for(const CorridorOptions& o, const std::string& method, const core::Pose2& start,
+                                           std::uint64_t seed) {
   localization::LocalizerContext c;
+  c.params = localization::localizer_options(method, localization::localizer_registry().declared(method, o.localizer_settings));
   c.initial_pose = start;
   c.seed = seed;
   // The filters' noise model: one step's odometry error (speed and turn noise over a period).
@@ -198,7 +225,6 @@ localization::LocalizerContext context_for(const CorridorOptions& o, const core:
   c.options.range_noise = o.laser.noise_m;
   c.options.initial_xy = 0.0;
   c.options.initial_theta = 0.0;
-  c.options.rbpf_particles = o.rbpf_particles;
   return c;
 }
 
@@ -249,7 +275,7 @@ Drive drive(const CorridorOptions& o, const mapping::OccupancyGrid& truth, const
   robot.odometry_error = sim::OdometryError{o.odometry.scale_error, core::deg2rad(o.odometry.turn_bias_deg_per_m),
                                             o.odometry.speed_noise, core::deg2rad(o.odometry.turn_noise_deg)};
   robot.localizer = [&](const localization::LocalizerContext& c) {
-    return localization::make_localizer(spec.method, context_for(o, c.initial_pose, spec.seed));
+    return localization::make_localizer(spec.method, context_for(o, spec.method, c.initial_pose, spec.seed));
   };
   robot.map_geometry = spec.own_frame;
 

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "core/params.h"
 #include "core/transform2.h"
 #include "mapping/occupancy_grid.h"
 #include "sim/sensors.h"
@@ -49,7 +50,9 @@ struct CorridorOptions {
   double period_s = 0.5;
   sim::RangeSensorOptions laser;          // set by default_laser()
   OdometryErrorOptions odometry;
-  int rbpf_particles = 30;                // particles of rbpf and fastslam-grid
+  // Parameters of the localizers above, each given to those that declare it (e.g. `particles` of
+  // rbpf and fastslam-grid, 30 by default as León et al.).
+  core::Settings localizer_settings;
   std::uint64_t seed = 1;
   // Table I over the seeds seed .. seed + seeds - 1 (mean and standard deviation); the pictures and
   // the merge study use `seed`.

@@ -230,7 +230,7 @@ LandmarkCaseRun run_landmark_case(const LandmarkExperimentOptions& o, const Land
   scenario.range.angles_rad = {0.0};
   scenario.range.max_range_m = 1.0;
   scenario.localization = "fastslam2";
-  scenario.localization_options.fastslam_particles = o.particles;
+  scenario.localization_settings = {{"particles", std::to_string(o.particles)}};
   scenario.merging = "rendezvous";       // each robot maps in its own frame, its start
   scenario.communication.range_m = 0.0;  // robots talk when they see each other
   sim::SimulationSetup how;

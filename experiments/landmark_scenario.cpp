@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "experiments/slam_experiment.h"
 #include "io/yaml_reader.h"
+#include "localization/localizer.h"
 #include "sim/scenario.h"
 #include "sim/scenario_yaml.h"
 
@@ -114,7 +115,16 @@ LandmarkExperimentOptions parse_landmark_options(const std::string& text, const 
   o.runs = int(top.integer("runs", o.runs, 1, 100000));
   o.period_s = top.number("period", o.period_s, 1e-3, 60.0);
   o.speed_mps = top.number("speed", o.speed_mps, 1e-3, 100.0);
-  o.particles = int(top.integer("particles", o.particles, 1, 100000));
+  // The particles of every robot's fastslam2, checked against that localizer's declaration.
+  if (const auto n = top.node("particles")) {
+    core::Params fastslam2 = localization::localizer_options("fastslam2");
+    try {
+      fastslam2.set("particles", n->IsScalar() ? n->Scalar() : io::describe_node(*n));
+    } catch (const InputError& e) {
+      throw InputError(top.where("particles") + ": " + e.what());
+    }
+    o.particles = int(fastslam2.number("particles"));
+  }
   o.noise = sim::read_motion_noise(top.map("noise"), o.noise);
   {
     auto sensors = top.map("sensors");

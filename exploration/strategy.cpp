@@ -50,18 +50,11 @@ std::vector<std::string> strategy_names() { return strategy_registry().names(); 
 std::string strategy_help() { return strategy_registry().help(); }
 
 StrategyOptions strategy_options(const std::string& name, const StrategySettings& settings) {
-  auto options = strategy_registry().params(name);
-  for (const auto& [key, value] : settings) options.set(key, value);
-  return options;
+  return strategy_registry().configure(name, settings);
 }
 
 StrategySettings declared_settings(const std::string& name, const StrategySettings& settings) {
-  const auto options = strategy_registry().params(name);
-  StrategySettings out;
-  for (const auto& s : settings) {
-    if (options.declares(s.first)) out.push_back(s);
-  }
-  return out;
+  return strategy_registry().declared(name, settings);
 }
 
 std::unique_ptr<CoordinationStrategy> make_strategy(const std::string& name, const StrategySettings& settings) {

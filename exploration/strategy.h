@@ -19,7 +19,7 @@ namespace fleetmap::exploration {
 using StrategyOptions = core::Params;
 // Settings by name, as written in a scenario file ({beta: "0.5"}), applied over the defaults of
 // whichever strategy is made: a sweep gives each run's strategy those it declares.
-using StrategySettings = std::vector<std::pair<std::string, std::string>>;
+using StrategySettings = core::Settings;
 
 // What a strategy weighed when it chose targets, for a replay to show why (a robot's candidates and
 // their score terms). Strategies fill it only when AssignmentInput::scores asks: no cost otherwise.

@@ -57,6 +57,13 @@ std::string YamlMap::where(const std::string& key) const {
 
 bool YamlMap::has(const std::string& key) const { return node_ && node_.IsMap() && node_[key]; }
 
+std::vector<std::string> YamlMap::keys() const {
+  std::vector<std::string> out;
+  if (!node_ || !node_.IsMap()) return out;
+  for (const auto& kv : node_) out.push_back(kv.first.Scalar());
+  return out;
+}
+
 std::optional<YAML::Node> YamlMap::node(const std::string& key) {
   if (std::find(asked_.begin(), asked_.end(), key) == asked_.end()) asked_.push_back(key);
   if (!has(key)) return std::nullopt;

@@ -25,6 +25,8 @@ class YamlMap {
   YamlMap(const YAML::Node& node, std::string source, std::string prefix = "");
 
   bool has(const std::string& key) const;
+  // The keys written, in file order.
+  std::vector<std::string> keys() const;
   // The raw node (marks the key as known); nullopt when absent.
   std::optional<YAML::Node> node(const std::string& key);
   // A nested mapping; absent keys give an empty mapping.

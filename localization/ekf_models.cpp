@@ -77,14 +77,15 @@ void validate_options(const LocalizerOptions& o) {
     throw InputError("localization option 'association_gate': expected a positive chi-square value, got " +
                      std::to_string(o.association_gate));
   }
-  if (!(o.slam_new_landmark_gate >= o.association_gate)) {
-    throw InputError("localization option 'slam_new_landmark_gate': expected a value >= association_gate (" +
-                     std::to_string(o.association_gate) + "), got " + std::to_string(o.slam_new_landmark_gate));
+}
+
+double new_landmark_gate(const LocalizerOptions& o, const core::Params& params) {
+  const double gate = params.number("new_landmark_gate");
+  if (!(gate >= o.association_gate)) {
+    throw InputError(params.owner() + ": new_landmark_gate must be >= association_gate (" + std::to_string(o.association_gate) +
+                     "), got " + std::to_string(gate));
   }
-  if (o.slam_forget_after_steps < 0) {
-    throw InputError("localization option 'slam_forget_after_steps': expected an integer >= 0, got " +
-                     std::to_string(o.slam_forget_after_steps));
-  }
+  return gate;
 }
 
 Eigen::Vector2d range_bearing(const core::Pose2& pose, const Eigen::Vector2d& point) {

@@ -38,6 +38,9 @@ Eigen::Matrix3d initial_covariance(const LocalizerOptions& options);
 // Throws InputError naming the option for a negative noise, a non-positive gate or a new-landmark
 // gate below the association gate.
 void validate_options(const LocalizerOptions& options);
+// The `new_landmark_gate` parameter of ekf-slam and fastslam2; throws InputError naming the
+// localizer when it is below options.association_gate.
+double new_landmark_gate(const LocalizerOptions& options, const core::Params& params);
 
 // h(x, m) = (|m - p|, atan2(m - p) - theta) with the bearing wrapped to (-pi, pi].
 Eigen::Vector2d range_bearing(const core::Pose2& pose, const Eigen::Vector2d& point);

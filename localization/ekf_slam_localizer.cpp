@@ -8,11 +8,11 @@
 //       without an id is rejected);
 //     - otherwise: global nearest neighbour in Mahalanobis distance gated at
 //       options.association_gate; an unmatched reading whose smallest distance to every landmark
-//       exceeds options.slam_new_landmark_gate is new, any other unmatched reading is rejected;
+//       exceeds the new_landmark_gate parameter is new, any other unmatched reading is rejected;
 //  2. adds each new landmark with g(x, y) and the covariance augmentation of D'Alfonso et al. eq. (4),
 //     with G_x and G_y evaluated at x_{k|k-1} and y_k as eq. (5) prescribes;
 //  3. updates the state with each associated reading in turn.
-// The state shrinks when options.slam_forget_after_steps > 0: a landmark not observed for more
+// The state shrinks when the forget_after_steps parameter > 0: a landmark not observed for more
 // than that many predict steps is removed (its rows and columns leave the covariance) at the
 // next predict. Ids: the sensor's with known associations, otherwise 0, 1, 2, ... in order of
 // creation (an id is never reused).
@@ -37,6 +37,8 @@ class EkfSlamLocalizer final : public Localizer {
  public:
   explicit EkfSlamLocalizer(const LocalizerContext& c)
       : options_((validate_options(c.options), c.options)),
+        new_landmark_gate_(new_landmark_gate(c.options, c.params)),
+        forget_after_steps_(int(c.params.number("forget_after_steps"))),
         q_(process_noise(c.options)),
         r_(measurement_noise(c.options)),
         filter_(c.initial_pose, initial_covariance(c.options)) {}
@@ -150,7 +152,7 @@ class EkfSlamLocalizer final : public Localizer {
     for (std::size_t i = 0; i < observations.size(); ++i) {
       if (a.match[i] >= 0) {
         target[i] = a.match[i];
-      } else if (a.smallest_d2[i] > options_.slam_new_landmark_gate) {
+      } else if (a.smallest_d2[i] > new_landmark_gate_) {
         target[i] = kNew;
       }
     }
@@ -158,11 +160,11 @@ class EkfSlamLocalizer final : public Localizer {
   }
 
   void forget_unseen() {
-    if (options_.slam_forget_after_steps <= 0) return;
+    if (forget_after_steps_ <= 0) return;
     std::vector<int> drop;
     std::vector<Tracked> kept;
     for (std::size_t s = 0; s < tracked_.size(); ++s) {
-      if (step_ - tracked_[s].last_seen > options_.slam_forget_after_steps) {
+      if (step_ - tracked_[s].last_seen > forget_after_steps_) {
         drop.push_back(static_cast<int>(s));
       } else {
         kept.push_back(tracked_[s]);
@@ -175,6 +177,8 @@ class EkfSlamLocalizer final : public Localizer {
   }
 
   LocalizerOptions options_;
+  double new_landmark_gate_;
+  int forget_after_steps_;
   Eigen::Matrix3d q_;
   Eigen::Matrix2d r_;
   EkfCore filter_;

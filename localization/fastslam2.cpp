@@ -303,17 +303,17 @@ namespace {
 class FastSlam2Localizer final : public Localizer {
  public:
   explicit FastSlam2Localizer(const LocalizerContext& c)
-      : filter_(c.initial_pose, initial_covariance((validate_options(c.options), c.options)), options_from(c.options),
-                c.seed) {}
+      : filter_(c.initial_pose, initial_covariance((validate_options(c.options), c.options)), options_from(c), c.seed) {}
 
-  static FastSlam2Options options_from(const LocalizerOptions& o) {
+  static FastSlam2Options options_from(const LocalizerContext& c) {
+    const LocalizerOptions& o = c.options;
     FastSlam2Options f;
-    f.particles = o.fastslam_particles;
+    f.particles = int(c.params.number("particles"));
     f.process_noise = process_noise(o);
     f.measurement_noise = measurement_noise(o);
     f.known_associations = o.known_associations;
     f.association_gate = o.association_gate;
-    f.new_landmark_gate = o.slam_new_landmark_gate;
+    f.new_landmark_gate = new_landmark_gate(o, c.params);
     return f;
   }
 

@@ -87,24 +87,8 @@ struct LocalizerOptions {
   // Mahalanobis gate (chi-square, 2 dof) when identities are unknown.
   bool known_associations = true;
   double association_gate = 9.21;  // chi2(2) at 99%
-  // `ekf-slam`, unknown identities: a reading whose smallest squared Mahalanobis distance to every
-  // landmark in the state exceeds this starts a new landmark; one between association_gate and
-  // this is rejected as ambiguous (and counted). A true reading exceeds it once in a million, so
-  // a long run does not duplicate its landmarks.
-  double slam_new_landmark_gate = 27.63;  // chi2(2) at 1 - 1e-6
-  // `ekf-slam`: a landmark not observed for more than this many predict steps leaves the state
-  // (its rows and columns are removed, D'Alfonso et al. §3.1); 0 keeps every landmark.
-  int slam_forget_after_steps = 0;
   // Robot-robot detections update the estimate (off by default).
   bool use_robot_detections = false;
-  // `mcl` and `rbpf`: particles per robot.
-  int mcl_particles = 2000;
-  int rbpf_particles = 30;
-  // `fastslam2`: particles per robot (Bailey's FastSLAM 2.0 implementation uses 100).
-  int fastslam_particles = 100;
-  // `rbpf`: each particle's search starts from its odometry step drawn with the process noise
-  // (false: from the odometry step itself, so one particle is the scan matcher).
-  bool rbpf_sample_motion = true;
 };
 
 // What a localizer may be given at the start.
@@ -112,6 +96,9 @@ struct LocalizerContext {
   core::Pose2 initial_pose;             // where the robot starts, in its map frame
   std::vector<Landmark> known_landmarks;  // for `ekf` (wave-algorithm paper, §V: fixed artificial landmarks)
   LocalizerOptions options;
+  // The localizer's own declared parameters (localizer_registry(); `particles` of mcl, rbpf,
+  // fastslam-grid and fastslam2, ...). Left empty, make_localizer gives the member's defaults.
+  core::Params params;
   std::uint64_t seed = 0;
   // `mcl`: the known map, in the robot's map frame; `global_localization`: the robot does not know
   // initial_pose and starts from a uniform belief over the map's free cells (León et al., §IV).
@@ -168,13 +155,20 @@ using LocalizerFactory = std::function<std::unique_ptr<Localizer>(const Localize
 core::Registry<LocalizerFactory>& localizer_registry();
 // Adds a localizer: `--localization NAME`, scenario files and the test harnesses reach it.
 // Throws Error when the name is taken or unusable.
-void register_localizer(std::string name, std::string help, LocalizerFactory make);
+// `params` are the settings it accepts (core/params.h); its factory finds their values in the
+// context's `params`.
+void register_localizer(std::string name, std::string help, LocalizerFactory make,
+                        std::vector<core::ParamSpec> params = {});
 
 // The registered names, in the order --help lists them.
 std::vector<std::string> localizer_names();
 // One line per localizer, for --help and README.
 std::string localizer_help();
-// Throws InputError naming the valid names for an unknown one.
+// The localizer's declared parameters with `settings` applied. Throws InputError for an unknown
+// localizer (listing the valid names), a setting it does not declare or a value out of its range.
+core::Params localizer_options(const std::string& name, const core::Settings& settings = {});
+// Throws InputError naming the valid names for an unknown one, and for context.params declared by
+// another member.
 std::unique_ptr<Localizer> make_localizer(const std::string& name, const LocalizerContext& context);
 
 }  // namespace fleetmap::localization

@@ -41,10 +41,7 @@ class MclLocalizer final : public Localizer {
  public:
   explicit MclLocalizer(const LocalizerContext& c) : options_(c.options), rng_(c.seed), map_(c.known_map) {
     if (!map_) throw InputError("localization 'mcl' needs the known map (merging: known)");
-    if (c.options.mcl_particles < 1) {
-      throw InputError("localization.mcl_particles: expected at least 1, got " + std::to_string(c.options.mcl_particles));
-    }
-    const std::size_t n = std::size_t(c.options.mcl_particles);
+    const std::size_t n = std::size_t(c.params.number("particles"));  // declared >= 1
     const auto& g = map_->geometry();
     for (int i = 0; i < g.width() * g.height(); ++i) {
       if (map_->state_at(i) == mapping::CellState::Free) free_cells_.push_back(i);

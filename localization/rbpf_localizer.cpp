@@ -14,13 +14,22 @@
 
 namespace fleetmap::localization {
 
+namespace {
+
+// The context's parameters, or the member's defaults when it has none.
+core::Params params_of(const LocalizerContext& c, RbpfLocalizer::Proposal proposal) {
+  if (!c.params.specs().empty()) return c.params;
+  return localizer_registry().params(proposal == RbpfLocalizer::Proposal::ScanMatching ? "rbpf" : "fastslam-grid");
+}
+
+}  // namespace
+
 RbpfLocalizer::RbpfLocalizer(const LocalizerContext& c, Proposal proposal)
     : options_(c.options), proposal_(proposal), rng_(c.seed) {
-  if (c.options.rbpf_particles < 1) {
-    throw InputError("localization.rbpf_particles: expected at least 1, got " + std::to_string(c.options.rbpf_particles));
-  }
+  const core::Params params = params_of(c, proposal);
+  sample_motion_ = params.declares("sample_motion") ? params.flag("sample_motion") : true;
   // The robot knows where it starts: every particle starts there, with equal weights.
-  particles_.resize(std::size_t(c.options.rbpf_particles));
+  particles_.resize(std::size_t(params.number("particles")));  // declared >= 1
   for (auto& p : particles_) p.pose = p.odometry_pose = c.initial_pose;
   n_eff_ = double(particles_.size());
 }
@@ -30,7 +39,7 @@ void RbpfLocalizer::predict(const Odometry& u) {
   for (auto& p : particles_) {
     p.odometry_pose = integrate_motion(p.pose, u);
     p.pose = p.odometry_pose;
-    if (!options_.rbpf_sample_motion && proposal_ == Proposal::ScanMatching) continue;
+    if (!sample_motion_ && proposal_ == Proposal::ScanMatching) continue;
     p.pose = {p.pose.x + rng_.normal(0.0, options_.process_noise_xy), p.pose.y + rng_.normal(0.0, options_.process_noise_xy),
               core::normalize_angle(p.pose.theta + rng_.normal(0.0, options_.process_noise_theta))};
   }

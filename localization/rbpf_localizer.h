@@ -2,7 +2,7 @@
 // `rbpf`: a Rao-Blackwellized particle filter for grid SLAM (León et al., §II.B-C; Grisetti, Stachniss
 // & Burgard 2005). Every particle carries a pose and its own grid (grid FastSLAM). Each step:
 //  1. sampling: the particle's odometry step is drawn with the process noise
-//     (LocalizerOptions::rbpf_sample_motion);
+//     (its sample_motion parameter);
 //  2. improved proposal: the scan is matched to the particle's own map, the search starting from
 //     that draw, with the motion model centred on the odometry step as prior (match_scan:
 //     correlative search, then refinement); the particle takes the proposal's mode, as GMapping
@@ -71,6 +71,7 @@ class RbpfLocalizer final : public Localizer {
 
   LocalizerOptions options_;
   Proposal proposal_;
+  bool sample_motion_ = true;  // `rbpf`'s sample_motion parameter (fastslam-grid always samples)
   core::Random rng_;
   std::vector<Particle> particles_;
   int best_ = 0;

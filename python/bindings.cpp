@@ -412,6 +412,32 @@ void register_python_strategy(const std::string& name, const py::object& cls, co
 
 }  // namespace
 
+// A family's members as Python lists them: {name, help, params}, each parameter {name, kind,
+// default, unit, accepts, doc}.
+template <typename Factory>
+py::list registry_members(const core::Registry<Factory>& registry) {
+  py::list out;
+  for (const auto& name : registry.names()) {
+    py::list params;
+    for (const auto& spec : registry.get(name).params) {
+      py::dict p;
+      p["name"] = spec.name;
+      p["kind"] = spec.type == core::ParamSpec::Type::Number ? "number" : spec.type == core::ParamSpec::Type::Flag ? "flag" : "text";
+      p["default"] = spec.default_value;
+      p["unit"] = spec.unit;
+      p["accepts"] = spec.expected();
+      p["doc"] = spec.doc;
+      params.append(p);
+    }
+    py::dict member;
+    member["name"] = name;
+    member["help"] = registry.get(name).help;
+    member["params"] = params;
+    out.append(member);
+  }
+  return out;
+}
+
 PYBIND11_MODULE(_fleetmap, m) {
   m.doc() = "fleetmap's C++ core; use the package `fleetmap`, which wraps it.";
   // Importing the module changes no process-wide setting: a script that merges in a loop asks for
@@ -499,35 +525,14 @@ PYBIND11_MODULE(_fleetmap, m) {
   m.def("strategy_names", &exploration::strategy_names,
         "Every coordination strategy's name, the built-in ones and those registered (scenario exploration.strategy).");
   m.def(
-      "strategies",
-      [] {
-        py::list out;
-        const auto& registry = exploration::strategy_registry();
-        for (const auto& name : registry.names()) {
-          py::list params;
-          for (const auto& spec : registry.get(name).params) {
-            py::dict p;
-            p["name"] = spec.name;
-            p["kind"] = spec.type == core::ParamSpec::Type::Number ? "number"
-                        : spec.type == core::ParamSpec::Type::Flag ? "flag"
-                                                                    : "text";
-            p["default"] = spec.default_value;
-            p["unit"] = spec.unit;
-            p["accepts"] = spec.expected();
-            p["doc"] = spec.doc;
-            params.append(p);
-          }
-          py::dict member;
-          member["name"] = name;
-          member["help"] = registry.get(name).help;
-          member["params"] = params;
-          out.append(member);
-        }
-        return out;
-      },
+      "strategies", [] { return registry_members(exploration::strategy_registry()); },
       "Every coordination strategy, built-in and registered: a list of {name, help, params}, each parameter a "
       "{name, kind, default, unit, accepts, doc} (scenario exploration.strategy: {name: ..., KEY: VALUE}, "
       "--set strategy.KEY=VALUE).");
+  m.def(
+      "localizers", [] { return registry_members(localization::localizer_registry()); },
+      "Every localizer, built-in and registered: a list of {name, help, params} as strategies() gives them "
+      "(scenario localization: {name: ..., KEY: VALUE}, --set localization.KEY=VALUE).");
   m.def("planner_names", &planning::planner_names, "Every path planner's name (plan_path's `planner`).");
   m.def("merge_method_names", &merging::merge_method_names, "Every merge method's name (merge_maps's `method`).");
 

@@ -161,29 +161,74 @@ void read_landmarks(io::YamlMap& top, Scenario& s) {
   lm.finish();
 }
 
+// The member-specific keys of `localization` before each localizer declared its own parameters, and
+// the localizers whose `particles` each set. Old files still read: the key sets `particles` of the
+// localizers it named and is ignored by the others, as it always was.
+const std::vector<std::pair<std::string, std::vector<std::string>>>& old_particle_keys() {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> kKeys = {
+      {"mcl_particles", {"mcl"}}, {"rbpf_particles", {"rbpf", "fastslam-grid"}}, {"fastslam_particles", {"fastslam2"}}};
+  return kKeys;
+}
+
+// `localization`: a localizer's name, or a mapping of the settings every localizer shares (the
+// data association, the start's uncertainty, lost robots), its name (`name`, or `method` as older
+// files write it) and the parameters that localizer declares.
 void read_localization(io::YamlMap& top, Scenario& s) {
   if (const auto l = top.node("localization"); l && l->IsScalar()) {
-    s.localization = top.text("localization", s.localization);
-  } else {
-    auto loc = top.map("localization");
-    s.localization = loc.text("method", s.localization);
-    auto& o = s.localization_options;
-    o.known_associations = loc.boolean("known_associations", o.known_associations);
-    o.association_gate = loc.number("association_gate", o.association_gate, limits::kGate);
-    o.use_robot_detections = loc.boolean("robot_detections", o.use_robot_detections);
-    o.initial_xy = loc.number("initial_sigma_xy", o.initial_xy, limits::kInitialSigma);
-    o.initial_theta = deg2rad(loc.number("initial_sigma_heading_deg", rad2deg(o.initial_theta), limits::kAngleDeg));
-    o.mcl_particles = int(loc.number("mcl_particles", o.mcl_particles, limits::kMclParticles));
-    o.rbpf_particles = int(loc.number("rbpf_particles", o.rbpf_particles, limits::kRbpfParticles));
-    o.fastslam_particles = int(loc.number("fastslam_particles", o.fastslam_particles, limits::kRbpfParticles));
-    for (double r : loc.numbers("lost_robots")) {
-      if (r != std::floor(r) || r < 1) {
-        throw InputError(loc.where("lost_robots") + ": expected robot numbers from 1, got " + fmt(r));
-      }
-      s.lost_robots.push_back(int(r));
-    }
-    loc.finish();
+    s.localization = top.choice("localization", s.localization, localization::localizer_names());
+    s.localization_settings.clear();
+    return;
   }
+  auto loc = top.map("localization");
+  if (loc.has("name") && loc.has("method")) throw InputError(loc.where("method") + ": give the localizer's 'name' only once");
+  const std::string name = loc.choice(loc.has("method") ? "method" : "name", s.localization, localization::localizer_names());
+  if (name != s.localization) s.localization_settings.clear();
+  s.localization = name;
+  auto& o = s.localization_options;
+  o.known_associations = loc.boolean("known_associations", o.known_associations);
+  o.association_gate = loc.number("association_gate", o.association_gate, limits::kGate);
+  o.use_robot_detections = loc.boolean("robot_detections", o.use_robot_detections);
+  o.initial_xy = loc.number("initial_sigma_xy", o.initial_xy, limits::kInitialSigma);
+  o.initial_theta = deg2rad(loc.number("initial_sigma_heading_deg", rad2deg(o.initial_theta), limits::kAngleDeg));
+  for (double r : loc.numbers("lost_robots")) {
+    if (r != std::floor(r) || r < 1) {
+      throw InputError(loc.where("lost_robots") + ": expected robot numbers from 1, got " + fmt(r));
+    }
+    s.lost_robots.push_back(int(r));
+  }
+  core::Params params = localization::localizer_options(name, s.localization_settings);
+  const auto set = [&](const std::string& key, const std::string& value, const std::string& where) {
+    try {
+      params.set(key, value);
+    } catch (const InputError& e) {
+      throw InputError(where + ": " + e.what());
+    }
+    std::erase_if(s.localization_settings, [&](const auto& kv) { return kv.first == key; });
+    s.localization_settings.emplace_back(key, params.value_text(key));
+  };
+  for (const auto& [old, members] : old_particle_keys()) {
+    if (!loc.has(old)) continue;
+    const std::string value = loc.text(old, "");
+    if (std::find(members.begin(), members.end(), name) == members.end()) continue;
+    if (loc.has("particles")) throw InputError(loc.where(old) + ": give 'particles' only (" + old + " is its older name)");
+    set("particles", value, loc.where(old));
+  }
+  // The localizer's own parameters; a key another localizer declares is named as such, any other
+  // unknown key gets the reader's "did you mean" over every key `localization` accepts.
+  for (const auto& spec : params.specs()) {
+    const auto node = loc.node(spec.name);
+    if (!node) continue;
+    if (!node->IsScalar()) throw InputError(loc.where(spec.name) + ": expected a value, got " + io::describe_node(*node));
+    set(spec.name, node->Scalar(), loc.where(spec.name));
+  }
+  const auto others = localization::localizer_registry().parameter_names();
+  for (const auto& key : loc.keys()) {
+    if (std::find(others.begin(), others.end(), key) != others.end() && !params.declares(key)) {
+      throw InputError(loc.where(key) + ": localization '" + name + "' has no parameter '" + key + "'" +
+                       (params.specs().empty() ? std::string(" (it has none)") : ""));
+    }
+  }
+  loc.finish();
 }
 
 void read_communication(io::YamlMap& top, Scenario& s) {
@@ -235,6 +280,13 @@ void read_merging(io::YamlMap& top, Scenario& s) {
   }
 }
 
+// A setting's value as a YAML scalar: plain when it reads back as itself, quoted otherwise.
+std::string yaml_scalar(const std::string& value) {
+  const bool plain = !value.empty() &&
+                     value.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.+-") == std::string::npos;
+  return plain ? value : io::yaml_quoted(value);
+}
+
 }  // namespace
 
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
@@ -277,18 +329,37 @@ Scenario load_scenario(const std::filesystem::path& path) {
   return parse_scenario(io::read_file(path, 16 << 20), path.string(), path.parent_path());
 }
 
+const std::vector<ParameterFamily>& parameter_families() {
+  static const std::vector<ParameterFamily> kFamilies = {
+      {"strategy", "exploration.strategy", [](const Scenario& s) { return s.exploration.strategy; },
+       [](Scenario& s) -> core::Settings& { return s.exploration.strategy_settings; },
+       [](const std::string& m) { return exploration::strategy_registry().params(m); },
+       [] { return exploration::strategy_registry().parameter_names(); }},
+      {"localization", "localization", [](const Scenario& s) { return s.localization; },
+       [](Scenario& s) -> core::Settings& { return s.localization_settings; },
+       [](const std::string& m) { return localization::localizer_registry().params(m); },
+       [] { return localization::localizer_registry().parameter_names(); }},
+  };
+  return kFamilies;
+}
+
+const ParameterFamily* parameter_family(const std::string& name) {
+  for (const auto& f : parameter_families()) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
 void set_parameter(Scenario& s, const std::string& assignment, const std::string& what) {
   const auto a = core::parse_param_assignment(assignment, what);
-  if (a.family != "strategy") {
-    const std::vector<std::string> families = {"strategy", "localization", "merging", "planner"};
-    if (std::find(families.begin(), families.end(), a.family) == families.end()) {
-      throw InputError(what + ": unknown family '" + a.family + "'" + core::did_you_mean(a.family, families) +
-                       " (--set takes strategy.KEY=VALUE)");
-    }
-    throw InputError(what + ": " + a.family + " settings are scenario keys for now (see --help's scenario keys); "
-                     "--set takes strategy.KEY=VALUE");
+  const ParameterFamily* family = parameter_family(a.family);
+  if (!family) {
+    std::vector<std::string> names;
+    for (const auto& f : parameter_families()) names.push_back(f.name);
+    throw InputError(what + ": unknown family '" + a.family + "'" + core::did_you_mean(a.family, names) + " (--set takes " +
+                     core::join(names, ".KEY=VALUE, ") + ".KEY=VALUE)");
   }
-  auto& settings = s.exploration.strategy_settings;
+  auto& settings = family->settings(s);
   std::erase_if(settings, [&](const auto& kv) { return kv.first == a.key; });
   settings.emplace_back(a.key, a.value);
 }
@@ -324,9 +395,6 @@ void validate_scenario(const Scenario& s) {
   check("localization.association_gate", o.association_gate, limits::kGate);
   check("localization.initial_sigma_xy", o.initial_xy, limits::kInitialSigma);
   check("localization.initial_sigma_heading_deg", rad2deg(o.initial_theta), limits::kAngleDeg);
-  check("localization.mcl_particles", o.mcl_particles, limits::kMclParticles);
-  check("localization.rbpf_particles", o.rbpf_particles, limits::kRbpfParticles);
-  check("localization.fastslam_particles", o.fastslam_particles, limits::kRbpfParticles);
   check("communication.range", s.communication.range_m, limits::kCommRange);
   const auto& e = s.exploration;
   check("exploration.occupancy_weight", e.wave.occupancy_weight, limits::kWeight);
@@ -353,6 +421,11 @@ void validate_scenario(const Scenario& s) {
     throw InputError(std::string("exploration.strategy: ") + err.what());
   }
   check_name("localization", s.localization, localization::localizer_names());
+  try {
+    localization::localizer_options(s.localization, s.localization_settings);
+  } catch (const InputError& err) {
+    throw InputError(std::string("localization: ") + err.what());
+  }
   for (int r : s.lost_robots) {
     if (s.localization != "mcl") throw InputError("localization.lost_robots: only 'mcl' can start without its pose, not '" + s.localization + "'");
     if (r < 1 || r > count) throw InputError("localization.lost_robots: robot " + std::to_string(r) + " does not exist (robots 1.." + std::to_string(count) + ")");
@@ -449,8 +522,7 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
   y << "localization:\n  method: " << s.localization << "\n  known_associations: " << (o.known_associations ? "true" : "false")
     << "\n  association_gate: " << fmt(o.association_gate) << "\n  robot_detections: " << (o.use_robot_detections ? "true" : "false")
     << "\n  initial_sigma_xy: " << fmt(o.initial_xy) << "\n  initial_sigma_heading_deg: " << fmt(rad2deg(o.initial_theta)) << "\n";
-  y << "  mcl_particles: " << o.mcl_particles << "\n  rbpf_particles: " << o.rbpf_particles
-    << "\n  fastslam_particles: " << o.fastslam_particles << "\n";
+  for (const auto& [key, value] : s.localization_settings) y << "  " << key << ": " << yaml_scalar(value) << "\n";
   if (!s.lost_robots.empty()) {
     y << "  lost_robots: [";
     for (std::size_t i = 0; i < s.lost_robots.size(); ++i) y << (i ? ", " : "") << s.lost_robots[i];
@@ -459,10 +531,7 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
   y << "communication:\n  range: " << fmt(s.communication.range_m) << "\n  line_of_sight: " << (s.communication.line_of_sight ? "true" : "false") << "\n";
   const auto& e = s.exploration;
   y << "exploration:\n  strategy: {name: " << e.strategy;
-  for (const auto& [key, value] : e.strategy_settings) {
-    const bool plain = value.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.+-") == std::string::npos;
-    y << ", " << key << ": " << (plain ? value : io::yaml_quoted(value));
-  }
+  for (const auto& [key, value] : e.strategy_settings) y << ", " << key << ": " << yaml_scalar(value);
   y << "}\n  eight_connected: " << (e.wave.eight_connected ? "true" : "false") << "\n  occupancy_weight: " << fmt(e.wave.occupancy_weight)
     << "\n  stall_steps: " << e.stall_steps << "\n  piece_radius: " << fmt(e.targets.piece_radius_m)
     << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m)

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -80,6 +81,9 @@ struct Scenario {
 
   std::string localization = "ideal";
   localization::LocalizerOptions localization_options;
+  // The localizer's own parameters, as given (`localization: {name: rbpf, particles: 50}`, `--set
+  // localization.particles=50`); checked against its declaration by validate_scenario.
+  core::Settings localization_settings;
   // Robots (numbered from 1) that do not know where they start: `mcl` starts them from a uniform
   // belief over the map (global localization, León et al. §IV).
   std::vector<int> lost_robots;
@@ -128,10 +132,26 @@ std::string scenario_to_yaml(const Scenario& scenario, const std::filesystem::pa
 // localizer meets). Throws InputError naming the key.
 void validate_scenario(const Scenario& scenario);
 
+// A family whose members declare parameters that a scenario sets: its name in `--set` and
+// `--vary` (strategy, localization), the member the scenario chose and the settings given to it.
+struct ParameterFamily {
+  std::string name;
+  std::string group;  // the scenario key whose mapping holds the member's name and parameters, dotted
+  std::function<std::string(const Scenario&)> member;
+  std::function<core::Settings&(Scenario&)> settings;
+  // The member's parameters at their defaults; throws InputError for an unknown name.
+  std::function<core::Params(const std::string& member)> params;
+  // Every parameter some member declares, for "did you mean" and to accept a sweep axis.
+  std::function<std::vector<std::string>()> parameter_names;
+};
+const std::vector<ParameterFamily>& parameter_families();
+// The family named `name`, or null.
+const ParameterFamily* parameter_family(const std::string& name);
+
 // `--set FAMILY.KEY=VALUE`: one declared parameter of the scenario's member of that family, kept
-// until the member is made (so that a sweep checks it against each of its strategies). Families
-// whose members declare parameters: strategy. Throws InputError naming `what` for another family
-// or a malformed assignment; the key and value are checked by validate_scenario (or validate_sweep).
+// until the member is made (so that a sweep checks it against each of its members). Throws
+// InputError naming `what` for an unknown family or a malformed assignment; the key and value are
+// checked by validate_scenario (or validate_sweep).
 void set_parameter(Scenario& scenario, const std::string& assignment, const std::string& what);
 
 // The message for a merging that aligns estimated landmarks (MapAligner::needs_landmark_estimates)

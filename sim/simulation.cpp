@@ -143,6 +143,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, S
   context.options.known_associations = scenario_.landmark_sensor.report_ids && scenario_.localization_options.known_associations;
   // `mcl` localizes on the known map, which is only meaningful in the world frame.
   if (aligner_->shared_frame()) context.known_map = std::make_shared<const mapping::OccupancyGrid>(world_.truth());
+  const core::Params localizer_params = localization::localizer_options(scenario_.localization, scenario_.localization_settings);
   for (int i = 0; i < n; ++i) {
     Robot& robot = robots_[std::size_t(i)];
     context.global_localization = std::find(scenario_.lost_robots.begin(), scenario_.lost_robots.end(), i + 1) !=
@@ -156,6 +157,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, S
     }
     context.seed = rng_.fork(300 + std::uint64_t(i)).seed();
     const auto& make = setup_.robots[std::size_t(i)].localizer;
+    context.params = localizer_params;  // the scenario's localizer's, for a robot's own maker too
     robot.localizer = make ? make(context) : localization::make_localizer(scenario_.localization, context);
     robot.map = mapping::OccupancyGrid(frame_geometry_[std::size_t(robot.frame)]);
   }

@@ -124,8 +124,8 @@ struct RobotSetup {
   // Drives the robot instead of the exploration.
   std::shared_ptr<Driver> driver;
   // Makes its localizer from the context the simulator built (start, seed, noise from the
-  // scenario), e.g. a registered localizer with the experiment's own noise model. Empty: the
-  // scenario's `localization` from the registry.
+  // scenario, the parameters of the scenario's localizer), e.g. a registered localizer with the
+  // experiment's own noise model. Empty: the scenario's `localization` from the registry.
   localization::LocalizerFactory localizer;
   // Its random streams (motion noise, range and landmark sensors, robot detector). Empty: its own,
   // forked from the scenario's seed, the detector reading from the sensors' stream. One stream may

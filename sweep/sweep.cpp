@@ -144,22 +144,69 @@ sim::Scenario for_strategy(const sim::Scenario& base, const std::string& strateg
   return s;
 }
 
-// The parameter an axis sets of the strategy ("exploration.strategy.beta": "beta"), or "".
-std::string strategy_parameter(const std::string& scenario_key) {
-  static const std::string prefix = "exploration.strategy.";
-  return scenario_key.rfind(prefix, 0) == 0 ? scenario_key.substr(prefix.size()) : std::string();
+// `s` with each family's settings cut to those its member declares (the others are for members an
+// axis chooses).
+sim::Scenario declared_only(sim::Scenario s) {
+  for (const auto& f : sim::parameter_families()) {
+    const core::Params declared = f.params(f.member(s));
+    std::erase_if(f.settings(s), [&](const auto& kv) { return !declared.declares(kv.first); });
+  }
+  return s;
 }
 
-// The base with one value per axis. An axis over a parameter the base's strategy does not declare
-// leaves its runs alone: a sweep of several strategies varies each one's own parameters.
+// The family parameter an axis sets ("strategy.beta", "exploration.strategy.beta",
+// "localization.particles"): its family and key, or no family for a plain scenario key.
+struct FamilyParameter {
+  const sim::ParameterFamily* family = nullptr;
+  std::string key;
+};
+FamilyParameter family_parameter(const std::string& scenario_key, const std::vector<std::string>& plain_keys) {
+  if (std::find(plain_keys.begin(), plain_keys.end(), scenario_key) != plain_keys.end()) return {};
+  for (const auto& f : sim::parameter_families()) {
+    for (const std::string& prefix : {f.name + ".", f.group + "."}) {
+      if (scenario_key.rfind(prefix, 0) == 0 && scenario_key.size() > prefix.size() &&
+          scenario_key.find('.', prefix.size()) == std::string::npos) {
+        return {&f, scenario_key.substr(prefix.size())};
+      }
+    }
+  }
+  return {};
+}
+
+// The settings of `family` in `s`: those of `given` that the member declares, then the axes' values
+// of parameters it declares.
+core::Settings member_settings(const sim::ParameterFamily& family, const sim::Scenario& s, const core::Settings& given,
+                               const std::vector<SweepAxis>& axes, const std::vector<std::string>& values,
+                               const std::vector<std::string>& plain_keys) {
+  const core::Params declared = family.params(family.member(s));
+  core::Settings out;
+  for (const auto& kv : given) {
+    if (declared.declares(kv.first)) out.push_back(kv);
+  }
+  for (std::size_t i = 0; i < axes.size(); ++i) {
+    const auto p = family_parameter(axes[i].scenario_key, plain_keys);
+    if (p.family != &family || !declared.declares(p.key)) continue;
+    std::erase_if(out, [&](const auto& kv) { return kv.first == p.key; });
+    out.emplace_back(p.key, values[i]);
+  }
+  return out;
+}
+
+// The base with one value per axis. An axis over a parameter the run's member of its family (its
+// strategy, its localizer) does not declare leaves the run alone: a sweep of several strategies
+// varies each one's own parameters.
 sim::Scenario with_values(const sim::Scenario& base, const std::vector<SweepAxis>& axes,
                           const std::vector<std::string>& values) {
   if (axes.empty()) return base;
   const std::string what = variant_label(axes, values);
-  YAML::Node root = YAML::Load(sim::scenario_to_yaml(base));
-  const auto declared = exploration::strategy_options(base.exploration.strategy);
+  // The members' settings are applied after the file is read back, since an axis may change the
+  // member they belong to.
+  sim::Scenario given = base, plain = base;
+  for (const auto& f : sim::parameter_families()) f.settings(plain).clear();
+  YAML::Node root = YAML::Load(sim::scenario_to_yaml(plain));
+  const auto& plain_keys = axis_settings();
   for (std::size_t i = 0; i < axes.size(); ++i) {
-    if (const auto key = strategy_parameter(axes[i].scenario_key); !key.empty() && !declared.declares(key)) continue;
+    if (family_parameter(axes[i].scenario_key, plain_keys).family) continue;
     std::vector<std::string> parts;
     std::size_t start = 0;
     for (std::size_t dot; (dot = axes[i].scenario_key.find('.', start)) != std::string::npos; start = dot + 1) {
@@ -174,6 +221,9 @@ sim::Scenario with_values(const sim::Scenario& base, const std::vector<SweepAxis
   try {
     sim::Scenario s = sim::parse_scenario(out.c_str(), source, base.base_dir);
     s.map = base.map;
+    for (const auto& f : sim::parameter_families()) {
+      f.settings(s) = member_settings(f, s, f.settings(given), axes, values, plain_keys);
+    }
     sim::validate_scenario(s);
     return s;
   } catch (const InputError& e) {
@@ -190,8 +240,6 @@ SweepAxis make_axis(const std::string& key, const std::vector<std::string>& valu
   for (const auto& [alias, full] : axis_aliases()) {
     if (alias == axis.name) axis.scenario_key = full;
   }
-  // strategy.KEY: a parameter the strategies declare (those that do not declare it ignore it).
-  if (axis.scenario_key.rfind("strategy.", 0) == 0) axis.scenario_key = "exploration." + axis.scenario_key;
   const std::string& k = axis.scenario_key;
   if (k.empty() || k.find_first_of(" =,\"'") != std::string::npos || k.front() == '.' || k.back() == '.' ||
       k.find("..") != std::string::npos) {
@@ -203,16 +251,14 @@ SweepAxis make_axis(const std::string& key, const std::vector<std::string>& valu
       k == "exploration.strategy" || k == "strategy" || k == "exploration.strategy.name") {
     throw InputError(what + ": '" + key + "' is an axis of every sweep already; use maps, robots, strategies or seeds");
   }
-  if (const auto parameter = strategy_parameter(k); !parameter.empty()) {
-    std::vector<std::string> declared;
-    for (const auto& name : exploration::strategy_names()) {
-      for (const auto& spec : exploration::strategy_registry().get(name).params) {
-        if (std::find(declared.begin(), declared.end(), spec.name) == declared.end()) declared.push_back(spec.name);
-      }
-    }
-    if (std::find(declared.begin(), declared.end(), parameter) == declared.end()) {
-      throw InputError(what + ": no strategy has a parameter '" + parameter + "'" + core::did_you_mean(parameter, declared) +
-                       " (the strategies' parameters: " + join(declared) + ")");
+  // FAMILY.KEY: a parameter some member of the family declares (the runs of members that do not
+  // declare it are left alone).
+  if (const auto p = family_parameter(k, axis_settings()); p.family) {
+    const auto declared = p.family->parameter_names();
+    if (std::find(declared.begin(), declared.end(), p.key) == declared.end()) {
+      throw InputError(what + ": no " + p.family->name + " has a parameter '" + p.key + "'" +
+                       core::did_you_mean(p.key, declared) + " (the " + p.family->name +
+                       " parameters: " + (declared.empty() ? std::string("none") : join(declared)) + ")");
     }
   } else if (const auto& settings = axis_settings(); std::find(settings.begin(), settings.end(), k) == settings.end()) {
     throw InputError(what + ": unknown setting '" + axis.name + "'" + core::did_you_mean(axis.name, settings) + " " +
@@ -431,18 +477,44 @@ void validate_sweep(const Sweep& sweep) {
   std::vector<std::string> keys;
   for (const auto& axis : sweep.axes) keys.push_back(axis.scenario_key);
   check_unique(keys, "vary");
-  // A strategy parameter, set or varied, belongs to at least one strategy of the sweep.
-  std::vector<std::pair<std::string, std::string>> parameters;  // (key, where it was given)
-  for (const auto& [key, value] : sweep.base.exploration.strategy_settings) parameters.emplace_back(key, "strategy." + key);
-  for (const auto& axis : sweep.axes) {
-    if (const auto key = strategy_parameter(axis.scenario_key); !key.empty()) parameters.emplace_back(key, "vary " + axis.name);
-  }
-  for (const auto& parameter : parameters) {
-    const std::string& key = parameter.first;  // not a structured binding: clang 14 cannot capture one
-    const std::string& where = parameter.second;
-    if (std::none_of(sweep.strategies.begin(), sweep.strategies.end(),
-                     [&](const std::string& s) { return exploration::strategy_options(s).declares(key); })) {
-      throw InputError(where + ": no strategy of this sweep (" + join(sweep.strategies) + ") has a parameter '" + key + "'");
+  // A member's parameter, set or varied, belongs to at least one member of the sweep in its family:
+  // one of its strategies, its localizer or one its axes choose.
+  for (const auto& family : sim::parameter_families()) {
+    std::vector<std::string> members;
+    if (family.name == "strategy") {
+      members = sweep.strategies;
+    } else {
+      members.push_back(family.member(sweep.base));
+      for (const auto& axis : sweep.axes) {
+        if (axis.scenario_key == family.group + ".method" || axis.scenario_key == family.group + ".name" ||
+            axis.scenario_key == family.group + ".mode") {
+          members.insert(members.end(), axis.values.begin(), axis.values.end());
+        }
+      }
+    }
+    std::vector<std::pair<std::string, std::string>> parameters;  // (key, where it was given)
+    sim::Scenario base = sweep.base;
+    for (const auto& kv : family.settings(base)) {
+      parameters.emplace_back(kv.first, family.name + "." + kv.first);
+    }
+    for (const auto& axis : sweep.axes) {
+      if (const auto p = family_parameter(axis.scenario_key, axis_settings()); p.family == &family) {
+        parameters.emplace_back(p.key, "vary " + axis.name);
+      }
+    }
+    for (const auto& parameter : parameters) {
+      const std::string& key = parameter.first;  // not a structured binding: clang 14 cannot capture one
+      const std::string& where = parameter.second;
+      const auto declares = [&](const std::string& m) {
+        try {
+          return family.params(m).declares(key);
+        } catch (const InputError&) {
+          return false;  // an unknown member: its axis says so below
+        }
+      };
+      if (std::none_of(members.begin(), members.end(), declares)) {
+        throw InputError(where + ": no " + family.name + " of this sweep (" + join(members) + ") has a parameter '" + key + "'");
+      }
     }
   }
   // Every value of every axis makes a valid scenario for every strategy (checked one axis at a
@@ -452,7 +524,7 @@ void validate_sweep(const Sweep& sweep) {
   for (const auto& strategy : sweep.strategies) {
     sim::Scenario probe = for_strategy(sweep.base, strategy);
     probe.robot_count = sweep.robots.front();
-    sim::validate_scenario(probe);
+    sim::validate_scenario(declared_only(probe));
     for (std::size_t i = 0; i < sweep.axes.size(); ++i) {
       std::vector<std::string> v = values;
       for (const auto& value : sweep.axes[i].values) {

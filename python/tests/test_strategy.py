@@ -115,6 +115,16 @@ class PythonStrategyTest(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "py-bad-param.*'beta' needs a default"):
             fleetmap.register_strategy("py-bad-param", CheapestFree, params={"beta": {"min": 0}})
 
+    def test_a_localizers_parameters_are_listed_and_set_like_a_strategys(self):
+        listed = {s["name"]: s for s in fleetmap.localizers()}
+        self.assertEqual([(p["name"], p["default"]) for p in listed["rbpf"]["params"]],
+                         [("particles", "30"), ("sample_motion", "true")])
+        self.assertEqual(listed["ekf"]["params"], [])
+        run = fleetmap.explore(map="empty", robots=1, steps=5, localization={"name": "rbpf", "particles": 2})
+        self.assertEqual(run.steps, 5)
+        with self.assertRaisesRegex(ValueError, "localization.particles.*a whole number from 1"):
+            fleetmap.explore(map="empty", robots=1, steps=5, localization={"name": "rbpf", "particles": 0})
+
     def test_assign_must_take_the_four_arrays(self):
         class TooFew:
             def assign(self, poses, targets):

@@ -1,6 +1,6 @@
-// End-to-end: the declared parameters of strategies as a user meets them: `fleetmap plugins`,
-// `--set strategy.KEY=VALUE` on explore and bench, `bench --vary strategy.KEY=...`, and the
-// messages for a mistyped key, a value out of range, and a strategy without that parameter.
+// End-to-end: the declared parameters of strategies and localizers as a user meets them:
+// `fleetmap plugins`, `--set FAMILY.KEY=VALUE` on explore and bench, `bench --vary FAMILY.KEY=...`,
+// and the messages for a mistyped key, a value out of range, and a member without that parameter.
 #include <gtest/gtest.h>
 
 #include "tests/cli/bench_test_support.h"
@@ -75,6 +75,60 @@ TEST(PluginsCommand, BenchVariesAParameterOfTheStrategiesThatDeclareIt) {
   ASSERT_EQ(coverage.size(), 4u);
   // market declares no beta: its two runs are the same run.
   EXPECT_EQ(coverage.at("market strategy.beta=0"), coverage.at("market strategy.beta=5"));
+}
+
+TEST(PluginsCommand, ExploreSetsALocalizersParameter) {
+  TempDir dir;
+  write_bench_maps(dir);
+  const auto r = run_fleetmap("explore --map hall.yaml --robots 1 --steps 10 --localization rbpf "
+                              "--set localization.particles=3 --out run", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string scenario = slurp(dir / "run" / "scenario.yaml");
+  EXPECT_NE(scenario.find("  method: rbpf\n"), std::string::npos) << scenario;
+  EXPECT_NE(scenario.find("  particles: 3\n"), std::string::npos) << scenario;
+  const auto again = run_fleetmap("explore --scenario run/scenario.yaml --out again", dir);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(slurp(dir / "again" / "scenario.yaml"), scenario);
+  EXPECT_NE(run_fleetmap("plugins --family localization", dir).out.find("      particles = 30  (a whole number"),
+            std::string::npos);
+}
+
+TEST(PluginsCommand, BadLocalizerSettingsAreOneLineNamingTheSetting) {
+  TempDir dir;
+  write_bench_maps(dir);
+  const std::string run = "explore --map hall.yaml --robots 1 --steps 5 --out out ";
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--localization scan-matching --set localization.particles=3", dir),
+                        "localization 'scan-matching' has no parameter 'particles' (it has none)");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--localization rbpf --set localization.particels=3", dir),
+                        "did you mean 'particles'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--localization mcl --set localization.particles=0.5", dir), "a whole number");
+  EXPECT_FALSE(std::filesystem::exists(dir / "out")) << "nothing written for bad input";
+  const std::string bench = "bench --maps hall.yaml --strategies coordinated --robots 1 --seeds 1 --steps 5 --out b ";
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(bench + "--localization scan-matching --set localization.particles=3", dir),
+                        "no localization of this sweep (scan-matching) has a parameter 'particles'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(bench + "--vary localization.particls=1,2", dir),
+                        "no localization has a parameter 'particls' (did you mean 'particles'?)");
+  EXPECT_FALSE(std::filesystem::exists(dir / "b"));
+}
+
+// A localizer parameter swept beside a localizer axis: the localizers that declare it run once per
+// value, the others once per value unchanged.
+TEST(PluginsCommand, BenchVariesAParameterOfTheLocalizersThatDeclareIt) {
+  TempDir dir;
+  write_bench_maps(dir);
+  const auto r = run_fleetmap("bench --maps hall.yaml --strategies coordinated --robots 1 --seeds 1 --steps 30 "
+                              "--vary localization=odometry,fastslam-grid --vary localization.particles=1,8 --vary noise_position=0.02 "
+                              "--out b", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const CsvTable results = read_csv(dir / "b" / "results.csv");
+  ASSERT_EQ(results.rows.size(), 4u);
+  std::map<std::string, std::string> error;
+  const std::string noise = " noise_position=0.02";
+  for (const auto& row : results.rows) error[row.at("variant").substr(0, row.at("variant").size() - noise.size())] = row.at("position_rmse_m");
+  ASSERT_EQ(error.size(), 4u) << r.out;
+  EXPECT_EQ(error.at("localization=odometry localization.particles=1"), error.at("localization=odometry localization.particles=8"));
+  EXPECT_NE(error.at("localization=fastslam-grid localization.particles=1"),
+            error.at("localization=fastslam-grid localization.particles=8"));
 }
 
 }  // namespace

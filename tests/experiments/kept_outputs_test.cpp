@@ -180,7 +180,7 @@ TEST(KeptOutputs, CorridorOfLeonEtAl) {
   o.height_m = 7.0;
   o.corridor_width_m = 1.6;
   o.laps = {1, 2};
-  o.rbpf_particles = 4;
+  o.localizer_settings = {{"particles", "4"}};
   o.detection_errors_deg = {0.0, 5.0};
   o.seed = 3;
   o.methods = {"ideal", "odometry", "scan-matching", "rbpf"};

@@ -129,7 +129,7 @@ TEST(Ekf, NearestNeighbourAssociationFindsTheIdentitiesTheSensorWouldGive) {
   LocalizerOptions with_ids = noisy_options();
   // A gate wide enough to keep every right pairing (d^2 of a true reading is chi2(2): 25 is
   // exceeded once in 270,000), far below the d^2 of any wrong one on this ring.
-  with_ids.association_gate = with_ids.slam_new_landmark_gate = 25.0;
+  with_ids.association_gate = 25.0;
   LocalizerOptions without_ids = with_ids;
   without_ids.known_associations = false;
   auto a = make("ekf", with_ids, world);

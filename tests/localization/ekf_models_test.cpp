@@ -149,12 +149,17 @@ TEST(ValidateOptions, RejectsBadValuesNamingTheOption) {
   o = {};
   o.association_gate = 0.0;
   EXPECT_NE(message(o).find("association_gate"), std::string::npos);
-  o = {};
-  o.slam_new_landmark_gate = 1.0;
-  EXPECT_NE(message(o).find("slam_new_landmark_gate"), std::string::npos);
-  o = {};
-  o.slam_forget_after_steps = -3;
-  EXPECT_NE(message(o).find("slam_forget_after_steps"), std::string::npos);
+  // The new-landmark gate of ekf-slam and fastslam2 below the association gate names the parameter.
+  for (const char* name : {"ekf-slam", "fastslam2"}) {
+    try {
+      new_landmark_gate({}, localizer_options(name, {{"new_landmark_gate", "1"}}));
+      ADD_FAILURE() << name << ": a new_landmark_gate below association_gate was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("localization '") + name + "': new_landmark_gate"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_THROW(localizer_options("ekf-slam", {{"forget_after_steps", "-3"}}), InputError);
   o = {};
   o.process_noise_theta = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(message(o).find("process_noise_theta"), std::string::npos);

@@ -32,10 +32,11 @@ LocalizerOptions slam_options() {
   return o;
 }
 
-std::unique_ptr<Localizer> make_slam(const LocalizerOptions& o) {
+std::unique_ptr<Localizer> make_slam(const LocalizerOptions& o, const core::Settings& settings = {}) {
   LocalizerContext c;
   c.initial_pose = testing::loop_start();
   c.options = o;
+  c.params = localizer_options("ekf-slam", settings);
   return make_localizer("ekf-slam", c);
 }
 
@@ -162,12 +163,11 @@ TEST(EkfSlam, UnknownAssociationsGiveOneLandmarkPerTrueLandmark) {
   EXPECT_LT(counter(*slam, "rejected_associations"), 0.03 * readings);
 }
 
-// With slam_forget_after_steps, landmarks left behind leave the state; seen again, they return.
+// With forget_after_steps, landmarks left behind leave the state; seen again, they return.
 TEST(EkfSlam, TheStateShrinksWhenLandmarksAreNotSeenForLong) {
   const auto world = ring_world();
   LocalizerOptions o = slam_options();
-  o.slam_forget_after_steps = 5;
-  auto slam = make_slam(o);
+  auto slam = make_slam(o, {{"forget_after_steps", "5"}});
   core::Random rng(4);
   core::Pose2 truth = testing::loop_start();
   std::map<int, int> last_seen;

@@ -33,13 +33,12 @@ LocalizerOptions fastslam_options() {
   o.bearing_noise = 0.02;
   o.initial_xy = 0.0;  // the robot knows its start: the map frame is the world frame
   o.initial_theta = 0.0;
-  o.fastslam_particles = 50;
   return o;
 }
 
 FastSlam2 make_filter(const LocalizerOptions& o, std::uint64_t seed) {
   FastSlam2Options f;
-  f.particles = o.fastslam_particles;
+  f.particles = 50;
   f.process_noise = process_noise(o);
   f.measurement_noise = measurement_noise(o);
   f.known_associations = o.known_associations;
@@ -128,7 +127,6 @@ TEST(FastSlam2, BeatsOdometryAndItsParticleMapsConverge) {
 // Nieto & Nebot 2006); README gives the measured value.
 TEST(FastSlam2, PoseErrorStaysCloseToEkfSlamsOnTheSameReadings) {
   LocalizerOptions o = fastslam_options();
-  o.fastslam_particles = 50;
   const auto world = dense_world();
   double mean_fastslam = 0.0, mean_ekf = 0.0, worst = 0.0;
   const int runs = 3, steps = 100;
@@ -137,7 +135,9 @@ TEST(FastSlam2, PoseErrorStaysCloseToEkfSlamsOnTheSameReadings) {
     c.initial_pose = testing::loop_start();
     c.options = o;
     c.seed = 100 + std::uint64_t(seed);
+    c.params = localizer_options("fastslam2", {{"particles", "50"}});
     auto fastslam = make_localizer("fastslam2", c);
+    c.params = {};
     auto ekf = make_localizer("ekf-slam", c);
     core::Random rng = core::Random(77).fork(std::uint64_t(seed));
     core::Pose2 truth = testing::loop_start();
@@ -168,6 +168,7 @@ TEST(FastSlam2, UnknownAssociationsGiveOneLandmarkPerTrueLandmark) {
   c.initial_pose = testing::loop_start();
   c.options = o;
   c.seed = 4;
+  c.params = localizer_options("fastslam2", {{"particles", "50"}});
   auto slam = make_localizer("fastslam2", c);
   core::Random rng(8);
   testing::simulate(*slam, dense_world(), o, testing::loop_start(), 150, rng);

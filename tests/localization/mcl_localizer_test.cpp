@@ -44,7 +44,7 @@ LocalizerContext context(const std::shared_ptr<const mapping::OccupancyGrid>& ma
   c.options.process_noise_theta = kMotionNoiseTheta;
   c.options.range_noise = kMclRangeNoise;
   c.options.initial_xy = 0.05;
-  c.options.mcl_particles = particles;
+  c.params = localizer_options("mcl", {{"particles", std::to_string(particles)}});
   return c;
 }
 

@@ -65,9 +65,8 @@ TEST(RbpfLocalizer, WithOneParticleAndNoNoiseEqualsTheScanMatcher) {
   c.options.process_noise_xy = 0.01;  // the model's odometry noise: the matcher's prior
   c.options.process_noise_theta = 0.005;
   c.options.range_noise = 0.01;
-  c.options.rbpf_particles = 1;
-  c.options.rbpf_sample_motion = false;
   auto sm = make_localizer("scan-matching", c);
+  c.params = localizer_options("rbpf", {{"particles", "1"}, {"sample_motion", "false"}});
   auto pf = make_localizer("rbpf", c);
   mapping::OccupancyGrid own(room.geometry());
   core::Pose2 truth = c.initial_pose;
@@ -111,7 +110,7 @@ TEST(RbpfLocalizer, ParticleMapsShareMemoryCopyOnWrite) {
   c.initial_pose = {2.0, 2.0, 0.0};
   c.options.process_noise_xy = 0.01;
   c.options.process_noise_theta = 0.005;
-  c.options.rbpf_particles = 30;
+  c.params = localizer_options("rbpf", {{"particles", "30"}});
   c.seed = 9;
   RbpfLocalizer pf(c);
   core::Pose2 truth = c.initial_pose;
@@ -156,7 +155,7 @@ TEST(RbpfLocalizer, CorrectsBiasedOdometry) {
   c.options.process_noise_xy = 0.01;
   c.options.process_noise_theta = 0.005;
   c.options.range_noise = 0.01;
-  c.options.rbpf_particles = 10;
+  c.params = localizer_options("rbpf", {{"particles", "10"}});
   c.seed = 3;
   auto pf = make_localizer("rbpf", c);
   mapping::OccupancyGrid own(room.geometry());
@@ -187,9 +186,9 @@ TEST(GridFastSlam, WithOneParticleAndNoNoiseIsDeadReckoning) {
   c.options.process_noise_xy = 0.0;
   c.options.process_noise_theta = 0.0;
   c.options.range_noise = 0.01;
-  c.options.rbpf_particles = 1;
-  auto fs = make_localizer("fastslam-grid", c);
   auto odo = make_localizer("odometry", c);
+  c.params = localizer_options("fastslam-grid", {{"particles", "1"}});
+  auto fs = make_localizer("fastslam-grid", c);
   EXPECT_EQ(fs->name(), "fastslam-grid");
   mapping::OccupancyGrid own(room.geometry());
   core::Pose2 truth = c.initial_pose;
@@ -220,7 +219,7 @@ TEST(GridFastSlam, WeighsParticlesByTheirScansAndBeatsDeadReckoning) {
   c.options.process_noise_xy = 0.01;
   c.options.process_noise_theta = 0.005;
   c.options.range_noise = 0.01;
-  c.options.rbpf_particles = 40;
+  c.params = localizer_options("fastslam-grid", {{"particles", "40"}});
   c.seed = 3;
   auto fs = make_localizer("fastslam-grid", c);
   mapping::OccupancyGrid own(room.geometry());

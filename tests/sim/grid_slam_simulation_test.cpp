@@ -22,7 +22,7 @@ Scenario noisy(const std::string& localization, int robots, int steps) {
   // Visible motion noise: 2 cm and 1 degree per step, which dead reckoning cannot undo.
   s.noise = {0.02, core::deg2rad(1.0)};
   s.localization = localization;
-  s.localization_options.rbpf_particles = 12;
+  if (localization == "rbpf") s.localization_settings = {{"particles", "12"}};
   return s;
 }
 
@@ -56,7 +56,7 @@ TEST(GridSlamSimulation, MclLostRobotIsLocalizedInExplore) {
   const auto grid = maps::load_map_source("office");
   Scenario s = noisy("mcl", 2, 60);
   s.noise = {0.005, core::deg2rad(0.3)};
-  s.localization_options.mcl_particles = 1500;
+  s.localization_settings = {{"particles", "1500"}};
   s.lost_robots = {2};
   const RunResult alone = Simulation(s, grid).run();
   EXPECT_GT((alone.robots[1].estimate.front().position() - alone.robots[1].truth.front().position()).norm(), 0.5);
@@ -76,16 +76,33 @@ TEST(GridSlamSimulation, MclNeedsTheKnownMapFrame) {
   expect_input_error([&] { Simulation(s, grid); }, {"mcl", "merging: known"});
 }
 
-TEST(GridSlamScenario, ReadsAndWritesTheNewLocalizationKeys) {
-  const Scenario s = parse_scenario(
-      "localization:\n  method: mcl\n  mcl_particles: 500\n  rbpf_particles: 12\n  lost_robots: [2]\nrobots:\n  count: 3\n",
-      "t.yaml", ".");
-  EXPECT_EQ(s.localization_options.mcl_particles, 500);
-  EXPECT_EQ(s.localization_options.rbpf_particles, 12);
+// The localizer's own parameters sit beside its name; the scenario written reads back the same.
+TEST(GridSlamScenario, ReadsAndWritesTheLocalizersParameters) {
+  const Scenario s = parse_scenario("localization:\n  name: mcl\n  particles: 500\n  lost_robots: [2]\nrobots:\n  count: 3\n",
+                                    "t.yaml", ".");
+  EXPECT_EQ(s.localization, "mcl");
+  EXPECT_EQ(s.localization_settings, (core::Settings{{"particles", "500"}}));
   EXPECT_EQ(s.lost_robots, std::vector<int>{2});
   const Scenario back = parse_scenario(scenario_to_yaml(s), "back.yaml", ".");
   EXPECT_EQ(back.lost_robots, s.lost_robots);
-  EXPECT_EQ(back.localization_options.mcl_particles, 500);
+  EXPECT_EQ(localization::localizer_options(back.localization, back.localization_settings).number("particles"), 500);
+}
+
+// Files written before the localizers declared their parameters still read: `method`, and each
+// old particles key sets `particles` of the localizers it named and nothing else.
+TEST(GridSlamScenario, OlderLocalizationKeysStillRead) {
+  const std::string old_keys = "  mcl_particles: 500\n  rbpf_particles: 12\n  fastslam_particles: 70\n";
+  const auto particles = [&](const std::string& method) {
+    const Scenario s = parse_scenario("landmarks: {along_walls: 0.5}\nlocalization:\n  method: " + method + "\n" + old_keys,
+                                      "t.yaml", ".");
+    return localization::localizer_options(s.localization, s.localization_settings).number("particles");
+  };
+  EXPECT_EQ(particles("mcl"), 500);
+  EXPECT_EQ(particles("rbpf"), 12);
+  EXPECT_EQ(particles("fastslam-grid"), 12);
+  EXPECT_EQ(particles("fastslam2"), 70);
+  const Scenario ekf = parse_scenario("landmarks: {along_walls: 0.5}\nlocalization:\n  method: ekf\n" + old_keys, "t.yaml", ".");
+  EXPECT_TRUE(ekf.localization_settings.empty());
 }
 
 TEST(GridSlamScenario, BadLocalizationKeysAreOneLineErrors) {
@@ -94,8 +111,13 @@ TEST(GridSlamScenario, BadLocalizationKeysAreOneLineErrors) {
   expect_input_error([&] { parse("localization:\n  method: mcl\n  lost_robots: [5]\nrobots:\n  count: 2\n"); },
                      {"lost_robots", "robot 5"});
   expect_input_error([&] { parse("localization:\n  method: mcl\n  lost_robots: [1.5]\n"); }, {"lost_robots", "1.5"});
-  expect_input_error([&] { parse("localization:\n  method: rbpf\n  rbpf_particles: 0\n"); }, {"rbpf_particles"});
-  expect_input_error([&] { parse("localization:\n  method: mcl\n  mcl_particles: -3\n"); }, {"mcl_particles"});
+  expect_input_error([&] { parse("localization:\n  method: rbpf\n  rbpf_particles: 0\n"); }, {"rbpf_particles", "particles", "1"});
+  expect_input_error([&] { parse("localization:\n  name: mcl\n  particles: -3\n"); }, {"localization.particles", "-3"});
+  // A parameter of another localizer, a misspelt one, and the name given twice.
+  expect_input_error([&] { parse("localization:\n  name: ekf\n  particles: 30\n"); }, {"localization 'ekf' has no parameter 'particles'"});
+  expect_input_error([&] { parse("localization:\n  name: rbpf\n  particels: 30\n"); }, {"particels", "did you mean 'particles'"});
+  expect_input_error([&] { parse("localization:\n  name: rbpf\n  method: rbpf\n"); }, {"'name' only once"});
+  expect_input_error([&] { parse("localization:\n  name: rbpf\n  sample_motion: maybe\n"); }, {"sample_motion", "true or false"});
 }
 
 }  // namespace

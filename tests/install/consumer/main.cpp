@@ -1,7 +1,8 @@
-// Registers a coordination strategy of its own, explores a built-in map with it and writes the
-// run's files into the folder given as its argument, through the installed headers and libraries
-// only. Exit status 0 when the strategy ran and mapped the room, and the files are there: the
-// merged map read back has the run's cells.
+// Registers a coordination strategy of its own, with a parameter of its own, explores a built-in map
+// with it and writes the run's files into the folder given as its argument, through the installed
+// headers and libraries only. Exit status 0 when the strategy ran and mapped the room, the files
+// are there (the merged map read back has the run's cells), and its parameter reached it from a
+// scenario file, from `--set`'s call and from each value of a sweep axis.
 #include <fleetmap/core/transform2.h>
 #include <fleetmap/exploration/strategy.h>
 #include <fleetmap/io/map_io.h>
@@ -9,6 +10,7 @@
 #include <fleetmap/sim/run_files.h>
 #include <fleetmap/sim/scenario.h>
 #include <fleetmap/sim/simulation.h>
+#include <fleetmap/sweep/sweep.h>
 
 #include <algorithm>
 #include <cmath>
@@ -23,6 +25,7 @@ namespace {
 using namespace fleetmap;
 
 int g_calls = 0;
+std::vector<double> g_built_with;  // the `patience` of every strategy made, in order
 
 // Every robot takes the reachable target with the lowest wave cost that no teammate took.
 class CheapestFreeTarget final : public exploration::CoordinationStrategy {
@@ -75,6 +78,40 @@ bool check_run_files(const sim::RunResult& result, const std::filesystem::path& 
   return true;
 }
 
+// The strategy's parameter reaches it from a scenario file, from set_parameter (what `--set
+// strategy.patience=2` calls) and from every value of a `--vary strategy.patience=...` axis.
+bool check_parameter() {
+  const auto made_with = [](const sim::Scenario& s) {
+    g_built_with.clear();
+    exploration::make_strategy(s.exploration.strategy, s.exploration.strategy_settings);
+    return g_built_with.size() == 1 ? g_built_with.front() : -1.0;
+  };
+  sim::Scenario from_file = sim::parse_scenario("exploration:\n  strategy: {name: cheapest-free, patience: 3}\n", "own.yaml", ".");
+  if (made_with(from_file) != 3.0) return std::cerr << "consumer: patience from a scenario file not used\n", false;
+  sim::Scenario set;
+  set.exploration.strategy = "cheapest-free";
+  sim::set_parameter(set, "strategy.patience=2", "--set strategy.patience=2");
+  sim::validate_scenario(set);
+  if (made_with(set) != 2.0) return std::cerr << "consumer: patience from --set not used\n", false;
+  try {
+    sim::set_parameter(set, "strategy.patience=-1", "--set strategy.patience=-1");
+    sim::validate_scenario(set);
+    return std::cerr << "consumer: patience -1 accepted\n", false;
+  } catch (const InputError&) {
+  }
+  sweep::Sweep sweep;
+  sweep.maps = {"empty"};
+  sweep.strategies = {"cheapest-free"};
+  sweep.robots = {1};
+  sweep.seeds = 1;
+  sweep.axes = {sweep::parse_axis("strategy.patience=4,5", "--vary")};
+  std::vector<double> swept;
+  for (const auto& run : sweep::sweep_runs(sweep)) swept.push_back(made_with(sweep::run_scenario(sweep, run)));
+  if (swept != std::vector<double>{4.0, 5.0}) return std::cerr << "consumer: patience not swept\n", false;
+  std::cout << "strategy cheapest-free: patience from a file, --set and a sweep axis\n";
+  return true;
+}
+
 int main(int argc, char** argv) {
   if (argc != 2) {
     std::cerr << "usage: consumer OUTPUT_FOLDER\n";
@@ -84,8 +121,14 @@ int main(int argc, char** argv) {
   const core::Transform2 t = core::Pose2{1.0, 2.0, 0.5}.as_transform();
   if ((t.inverse() * t).translation().norm() > 1e-12) return 1;
 
-  exploration::register_strategy("cheapest-free", "each robot takes the cheapest target left (the consumer's own)",
-                                 [](const exploration::StrategyOptions&) { return std::make_unique<CheapestFreeTarget>(); });
+  exploration::register_strategy(
+      "cheapest-free", "each robot takes the cheapest target left (the consumer's own)",
+      [](const exploration::StrategyOptions& options) {
+        g_built_with.push_back(options.number("patience"));
+        return std::make_unique<CheapestFreeTarget>();
+      },
+      {core::ParamSpec::number("patience", 1, {0, 10}, "rounds", "how long a robot waits for a better target")});
+  if (!check_parameter()) return 1;
   sim::Scenario scenario;
   scenario.map = "empty";
   scenario.robot_count = 2;
