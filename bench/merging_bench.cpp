@@ -91,7 +91,7 @@ void merge_pairs(benchmark::State& state, const Variant& v, int size, double ove
 
 int main(int argc, char** argv) {
   const std::vector<Variant> variants = {
-      {"overlap", "overlap", true},
+      {"grid", "grid", true},
       {"features", "features", true},
       // The feature method's own answer, without the common sub-cell refinement (as the ROS merger).
       {"features_unrefined", "features", false},

@@ -349,9 +349,8 @@ Command add_merge_command(CLI::App& root) {
   auto o = std::make_shared<MergeCommandOptions>();
   merge->add_option("maps", o->maps, "Two or more maps: PNG/PGM images or map_server YAML files (the first is the reference)")
       ->required();
-  merge->add_option("--method", o->method, "Alignment method: auto, overlap or features (see below)")
-      ->capture_default_str()
-      ->check(one_of(merging::merge_method_names()));
+  // Checked by check_merge_method, which also says the new name of a renamed method.
+  merge->add_option("--method", o->method, "Alignment method: auto, grid or features (see below)")->capture_default_str();
   merge->add_option("--out,-o", o->out,
                     "Merged map: a picture (.png; - for the standard output) or a map file in the first map's metres "
                     "(.yaml for map_server with a .pgm beside it, or a bare .pgm) that plan and explore read")

@@ -36,8 +36,11 @@ std::vector<Family> families() {
       {"localization", "explore/bench --localization NAME; scenario localization: {name: NAME, KEY: VALUE}; "
                        "--set localization.KEY=VALUE; bench --vary localization.KEY=V1,V2",
        localization::localizer_registry().help()},
-      {"merging", "explore/bench --merging NAME; scenario merging.mode", merging::map_aligner_registry().help()},
-      {"merge-method", "merge --method NAME; scenario merging.method", merging::merge_method_registry().help()},
+      {"merging", "explore/bench --merging NAME; scenario merging: {mode: NAME, KEY: VALUE}; --set merging.KEY=VALUE; "
+                  "bench --vary merging.KEY=V1,V2",
+       merging::map_aligner_registry().help()},
+      {"merge-method", "merge --method NAME; the overlap aligner's method (--set merging.method=NAME)",
+       merging::merge_method_registry().help()},
       {"planner", "plan --planner NAME; explore --path-planner NAME", planning::planner_registry().help()},
       {"slam-method", "slam scenario files' methods", experiments::slam_method_registry().help()},
       {"map", "any --map NAME", maps::map_registry().help()},

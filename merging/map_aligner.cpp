@@ -43,26 +43,33 @@ class RendezvousAligner final : public MapAligner {
   }
 };
 
-// The best overlap of the two grids (merge.h), merged from the scenario's confidence on.
+// The best overlap of the two grids (merge.h), merged from its min_confidence on.
 class OverlapAligner final : public MapAligner {
  public:
+  explicit OverlapAligner(const core::Params& p) : method_(p.text("method")), min_confidence_(p.number("min_confidence")) {
+    check_merge_method(method_);
+  }
   bool costly() const override { return true; }
   bool sends_map() const override { return true; }
   FrameAlignment align(const AlignmentRequest& q) const override {
     MergeOptions o;
-    o.method = q.method;
-    o.min_confidence = q.min_confidence;
+    o.method = method_;
+    o.min_confidence = min_confidence_;
     o.seed = q.seed;
     const MergeResult m = align_maps(*q.receiver_map, *q.sender_map, o);
     FrameAlignment out;
     out.attempted = true;
-    out.method = m.method.empty() ? q.method : m.method;
+    out.method = m.method.empty() ? method_ : m.method;
     out.confidence = m.confidence;
     out.merged = m.merged;
     out.reason = m.reason;
     if (m.merged) out.sender_to_receiver = world_from_cells(q.receiver_map->geometry(), q.sender_map->geometry(), m.transform);
     return out;
   }
+
+ private:
+  std::string method_;
+  double min_confidence_;
 };
 
 // The map-alignment paper, §III.A: the two landmark maps associated by RANSAC (eq. (2)-(6)), the
@@ -71,6 +78,8 @@ class OverlapAligner final : public MapAligner {
 // below that many supports (a few landmarks fit many placements).
 class LandmarkAligner final : public MapAligner {
  public:
+  explicit LandmarkAligner(const core::Params& p)
+      : min_confidence_(p.number("min_confidence")), support_distance_(p.number("support_distance")) {}
   bool costly() const override { return true; }
   bool needs_landmark_estimates() const override { return true; }
   FrameAlignment align(const AlignmentRequest& q) const override {
@@ -81,11 +90,8 @@ class LandmarkAligner final : public MapAligner {
       return m;
     };
     const LandmarkMap self = to_map(q.receiver_landmarks), other = to_map(q.sender_landmarks);
-    // Supports within 0.3 m, not the paper's 1 m: landmarks placed along every wall are dense enough
-    // that a wrong placement finds one within 1 m of most of them (EKF-SLAM estimates are good to a
-    // few centimetres).
     LandmarkAlignmentOptions options;
-    options.support_threshold = 0.3;
+    options.support_threshold = support_distance_;
     if (int(std::min(self.landmarks.size(), other.landmarks.size())) < options.min_supports) return out;  // too few yet
     out.attempted = true;
     out.method = "landmarks";
@@ -95,10 +101,10 @@ class LandmarkAligner final : public MapAligner {
     const double smaller = double(std::min(self.landmarks.size(), other.landmarks.size()));
     const double supports = double(a.supports.size());
     out.confidence = a.found ? supports / smaller * std::min(1.0, supports / double(options.overlap_threshold)) : 0.0;
-    if (!a.found || out.confidence < q.min_confidence) {
+    if (!a.found || out.confidence < min_confidence_) {
       out.reason = a.found ? fmt::format("{} of {} landmarks agree (trusted from {}): confidence {:.2f} < {:.2f}",
                                          a.supports.size(), int(smaller), options.overlap_threshold, out.confidence,
-                                         q.min_confidence)
+                                         min_confidence_)
                            : fmt::format("no placement has {} landmarks agreeing", options.min_supports);
       return out;
     }
@@ -106,11 +112,20 @@ class LandmarkAligner final : public MapAligner {
     out.sender_to_receiver = a.transform;
     return out;
   }
+
+ private:
+  double min_confidence_;
+  double support_distance_;
 };
 
 template <typename T>
 MapAlignerFactory make() {
-  return [] { return std::make_unique<T>(); };
+  return [](const core::Params&) { return std::make_unique<T>(); };
+}
+
+template <typename T>
+MapAlignerFactory make_with_params() {
+  return [](const core::Params& p) { return std::make_unique<T>(p); };
 }
 
 }  // namespace
@@ -127,22 +142,40 @@ core::Registry<MapAlignerFactory>& map_aligner_registry() {
     r.add("rendezvous",
           "robots that detect each other compute each other's frame from the detection (D'Alfonso et al., §3.2)",
           make<RendezvousAligner>());
+    using core::ParamSpec;
+    const auto min_confidence = [](const char* doc) {
+      return ParamSpec::number("min_confidence", 0.5, {0, 1}, "", doc);
+    };
     r.add("overlap", "robots that can talk search their maps for the best overlap (as fleetmap merge) and merge from a confidence on",
-          make<OverlapAligner>());
+          make_with_params<OverlapAligner>(),
+          {ParamSpec::text("method", "auto", {}, "the merge method searched with (fleetmap plugins --family merge-method)"),
+           min_confidence("a search's answer below this confidence is not merged")});
     r.add("landmarks",
           "robots that can talk associate their estimated landmark maps by RANSAC (map-alignment paper, eq. (2)-(6)) "
           "and merge once enough agree; needs a localizer that estimates landmarks (ekf-slam, fastslam2)",
-          make<LandmarkAligner>());
+          make_with_params<LandmarkAligner>(),
+          // Supports within 0.3 m, not the paper's 1 m: landmarks placed along every wall are dense
+          // enough that a wrong placement finds one within 1 m of most of them (EKF-SLAM estimates are
+          // good to a few centimetres).
+          {min_confidence("an association below this confidence is not merged"),
+           ParamSpec::number("support_distance", 0.3, {1e-3, 100}, "m",
+                             "a landmark supports a placement when one of the other map lies this close to it")});
     return true;
   }();
   (void)built_in;
   return registry;
 }
 
-void register_map_aligner(std::string name, std::string help, MapAlignerFactory make) {
-  map_aligner_registry().add(std::move(name), std::move(help), std::move(make));
+void register_map_aligner(std::string name, std::string help, MapAlignerFactory make, std::vector<core::ParamSpec> params) {
+  map_aligner_registry().add(std::move(name), std::move(help), std::move(make), std::move(params));
 }
 
-std::unique_ptr<MapAligner> make_map_aligner(const std::string& name) { return map_aligner_registry().get(name).make(); }
+core::Params map_aligner_options(const std::string& name, const core::Settings& settings) {
+  return map_aligner_registry().configure(name, settings);
+}
+
+std::unique_ptr<MapAligner> make_map_aligner(const std::string& name, const core::Settings& settings) {
+  return map_aligner_registry().get(name).make(map_aligner_options(name, settings));
+}
 
 }  // namespace fleetmap::merging

@@ -6,9 +6,11 @@
 //   rendezvous  both robots detect each other and exchange poses and readings (D'Alfonso et al.
 //               2013, §3.2);
 //   overlap     the two occupancy grids are searched for their best overlap (merge.h, the
-//               methods of `fleetmap merge`), accepted from a confidence on;
+//               methods of `fleetmap merge`), accepted from a confidence on (its parameters:
+//               method, min_confidence);
 //   landmarks   the two robots' landmark maps are associated by RANSAC (the map-alignment
-//               paper, §III.A, eq. (2)-(6)); robots that estimate landmarks (`ekf-slam`).
+//               paper, §III.A, eq. (2)-(6)); robots that estimate landmarks (`ekf-slam`);
+//               its parameters: min_confidence, support_distance.
 // A program that links fleetmap adds its own aligner with register_map_aligner; scenarios and
 // `--merging` then reach it by name like the built-in ones.
 #include <cstdint>
@@ -35,9 +37,6 @@ struct AlignmentRequest {
   // When both detect each other this step: what each measured of the other ("self" = receiver).
   std::optional<MutualObservation> detection;
   std::vector<localization::Landmark> receiver_landmarks, sender_landmarks;  // estimated, may be empty
-  // For methods that need them (overlap): the merge method and threshold of the scenario.
-  std::string method = "auto";
-  double min_confidence = 0.5;
   std::uint64_t seed = 1;
 };
 
@@ -67,13 +66,19 @@ class MapAligner {
   virtual FrameAlignment align(const AlignmentRequest& request) const = 0;
 };
 
-using MapAlignerFactory = std::function<std::unique_ptr<MapAligner>()>;
+// Makes an aligner from its declared parameters' values.
+using MapAlignerFactory = std::function<std::unique_ptr<MapAligner>(const core::Params&)>;
 
 // The built-in aligners (known, none, rendezvous, overlap, landmarks) and any registered since.
 core::Registry<MapAlignerFactory>& map_aligner_registry();
-// Adds an aligner under `name` (Error if the name is taken or unusable).
-void register_map_aligner(std::string name, std::string help, MapAlignerFactory make);
-// Throws InputError naming the valid names for an unknown one.
-std::unique_ptr<MapAligner> make_map_aligner(const std::string& name);
+// Adds an aligner under `name` (Error if the name is taken or unusable), with the parameters it
+// accepts (core/params.h).
+void register_map_aligner(std::string name, std::string help, MapAlignerFactory make,
+                          std::vector<core::ParamSpec> params = {});
+// The aligner's declared parameters with `settings` applied; throws InputError for an unknown name
+// (naming the valid ones), a setting it does not declare or a value it refuses.
+core::Params map_aligner_options(const std::string& name, const core::Settings& settings = {});
+// Throws as map_aligner_options, and InputError for a merge method the overlap aligner does not know.
+std::unique_ptr<MapAligner> make_map_aligner(const std::string& name, const core::Settings& settings = {});
 
 }  // namespace fleetmap::merging

@@ -11,6 +11,7 @@
 
 #include "core/angle.h"
 #include "core/error.h"
+#include "core/format.h"
 #include "mapping/state_mask.h"
 #include "merging/evaluation.h"
 #include "merging/grid_level.h"
@@ -175,65 +176,71 @@ std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGr
 
 namespace {
 
-constexpr const char* kAutoHelp =
-    "overlap's spectral pass; if not confident, the other methods and overlap's sweep too; the best wins";
-
-void add_builtin_methods(core::Registry<MergePasses>& registry) {
-  registry.add("overlap",
-               "grid overlap search (wave-algorithm paper, Birk & Carpin 2006): Hough-spectrum rotations (Carpin "
-               "2008), FFT correlation of walls for translations, coarse to fine; a rotation sweep when the spectra "
-               "find nothing",
-               {propose_overlap, propose_overlap_sweep});
-  registry.add("features", "ORB keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
-               {propose_features});
-}
-
-// The (method, pass) lists `auto` runs, each ending with a decision: the first method's first pass,
-// then every other method's passes, then the first method's remaining passes.
-std::vector<std::vector<const ProposeFn*>> auto_steps(const core::Registry<MergePasses>& registry) {
-  const auto names = registry.names();
-  const MergePasses& first = registry.get(names.front()).make;
-  std::vector<std::vector<const ProposeFn*>> steps(2);
-  steps[0].push_back(&first.front());
-  for (std::size_t i = 1; i < names.size(); ++i) {
-    for (const auto& pass : registry.get(names[i]).make) steps[1].push_back(&pass);
+// The steps of `auto`: the first other method's first pass, then every other method's passes, then
+// the first method's remaining passes.
+MergeSteps auto_steps(const core::Registry<MergeMethod>& registry) {
+  std::vector<MergePasses> methods;  // each other method's passes, in order
+  for (const auto& name : registry.names()) {
+    if (name == "auto") continue;
+    MergePasses passes;
+    for (const auto& step : registry.get(name).make()) passes.insert(passes.end(), step.begin(), step.end());
+    methods.push_back(std::move(passes));
   }
-  for (std::size_t p = 1; p < first.size(); ++p) steps[1].push_back(&first[p]);
+  MergeSteps steps(2);
+  if (methods.empty() || methods.front().empty()) return {};
+  steps[0].push_back(methods.front().front());
+  for (std::size_t i = 1; i < methods.size(); ++i) steps[1].insert(steps[1].end(), methods[i].begin(), methods[i].end());
+  steps[1].insert(steps[1].end(), methods.front().begin() + 1, methods.front().end());
   if (steps[1].empty()) steps.pop_back();
   return steps;
 }
 
+// One step per pass.
+MergeMethod in_steps(MergePasses passes) {
+  return [passes = std::move(passes)] {
+    MergeSteps steps;
+    for (const auto& pass : passes) steps.push_back({pass});
+    return steps;
+  };
+}
+
+void add_builtin_methods(core::Registry<MergeMethod>& registry) {
+  registry.add("auto",
+               "grid's spectral pass; if not confident, the other methods and grid's sweep too; the best wins",
+               [] { return auto_steps(merge_method_registry()); });
+  registry.add("grid",
+               "grid overlap search (wave-algorithm paper, Birk & Carpin 2006): Hough-spectrum rotations (Carpin "
+               "2008), FFT correlation of walls for translations, coarse to fine; a rotation sweep when the spectra "
+               "find nothing",
+               in_steps({propose_overlap, propose_overlap_sweep}));
+  registry.add("features", "ORB keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
+               in_steps({propose_features}));
+}
+
 }  // namespace
 
-core::Registry<MergePasses>& merge_method_registry() {
-  static core::Registry<MergePasses> registry("merge method");
+core::Registry<MergeMethod>& merge_method_registry() {
+  static core::Registry<MergeMethod> registry("merge method");
   static const bool built_in = (add_builtin_methods(registry), true);
   (void)built_in;
   return registry;
 }
 
 void register_merge_method(std::string name, std::string help, MergePasses passes) {
-  if (name == "auto") throw Error("register merge method: 'auto' is the name of all methods in turn");
   if (passes.empty() || std::any_of(passes.begin(), passes.end(), [](const ProposeFn& f) { return !f; })) {
     throw Error("register merge method: '" + name + "' needs at least one pass, and no empty one");
   }
-  merge_method_registry().add(std::move(name), std::move(help), std::move(passes));
+  merge_method_registry().add(std::move(name), std::move(help), in_steps(std::move(passes)));
 }
 
-std::vector<std::string> merge_method_names() {
-  std::vector<std::string> names = {"auto"};
-  for (auto& n : merge_method_registry().names()) names.push_back(std::move(n));
-  return names;
-}
+std::vector<std::string> merge_method_names() { return merge_method_registry().names(); }
 
-std::string merge_method_help() { return std::string("  auto: ") + kAutoHelp + "\n" + merge_method_registry().help(); }
+std::string merge_method_help() { return merge_method_registry().help(); }
 
 void check_merge_method(const std::string& name) {
-  const auto names = merge_method_names();
-  if (std::find(names.begin(), names.end(), name) != names.end()) return;
-  std::string list;
-  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-  throw InputError("unknown merge method '" + name + "' (valid: " + list + ")");
+  // The grid search was called "overlap" before the simulator's `overlap` aligner used the name.
+  if (name == "overlap") throw InputError("merge method 'overlap' is now called 'grid' (valid: " + core::join(merge_method_names()) + ")");
+  merge_method_registry().get(name);  // InputError naming the valid ones
 }
 
 namespace {
@@ -611,18 +618,12 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
   core::Random random(options.seed);
   // Steps: lists of passes. Candidates accumulate; each step ends with a decision, and a merge at
   // sure_confidence or more ends the search.
-  const auto& registry = merge_method_registry();
-  std::vector<std::vector<const ProposeFn*>> steps;
-  if (options.method == "auto") {
-    steps = auto_steps(registry);
-  } else {
-    for (const auto& pass : registry.get(options.method).make) steps.push_back({&pass});
-  }
+  const MergeSteps steps = merge_method_registry().get(options.method).make();
   std::vector<Hypothesis> candidates;
   MergeResult best;
   for (const auto& step : steps) {
-    for (const ProposeFn* pass : step) {
-      auto more = (*pass)(a, b, options, random);
+    for (const ProposeFn& pass : step) {
+      auto more = pass(a, b, options, random);
       candidates.insert(candidates.end(), more.begin(), more.end());
     }
     MergeResult r = decide(a, b, candidates, options);

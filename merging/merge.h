@@ -251,15 +251,19 @@ using ProposeFn = std::function<std::vector<Hypothesis>(const PreparedGrid& a, c
                                                         const MergeOptions& options, core::Random& random)>;
 // A method runs its passes in order, each adding candidates, until the decision is to merge.
 using MergePasses = std::vector<ProposeFn>;
+// What a registered method runs: steps, each a list of passes whose candidates are then decided on;
+// the search stops at a sure merge. Made when a merge starts (`auto` reads the registry then).
+using MergeSteps = std::vector<std::vector<ProposeFn>>;
+using MergeMethod = std::function<MergeSteps()>;
 
-// Every merge method by name, the built-in ones first (overlap, features).
-core::Registry<MergePasses>& merge_method_registry();
-// Adds a method that `merge --method`, scenarios (merging.method) and `auto` then use: auto runs the
-// first method's first pass (overlap's spectral search), and when that is not confident every other
-// method's passes in the order registered, then the first method's remaining passes. Throws Error
-// for an empty or taken name (including "auto") or no passes.
+// Every merge method by name: auto, grid, features, then the registered ones. `auto` is the first
+// pass of the first other method (grid's spectral search), then, when that is not confident, every
+// other method's passes in the order registered and the first method's remaining passes.
+core::Registry<MergeMethod>& merge_method_registry();
+// Adds a method that `merge --method`, the `overlap` aligner's `method` and `auto` then use, one
+// step per pass. Throws Error for an empty or taken name, or no passes.
 void register_merge_method(std::string name, std::string help, MergePasses passes);
-// "auto" and the registry's names, for --help and errors.
+// The registry's names, for --help and errors.
 std::vector<std::string> merge_method_names();
 // One line per name: "  name: help".
 std::string merge_method_help();

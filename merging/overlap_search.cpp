@@ -147,7 +147,7 @@ std::vector<Hypothesis> overlap_hypotheses_at(const PreparedGrid& a, const Prepa
       const int tx = p.at.x >= la.width() ? p.at.x - size.width : p.at.x;
       const int ty = p.at.y >= la.height() ? p.at.y - size.height : p.at.y;
       const core::Transform2 coarse(shift + Eigen::Vector2d(tx, ty), rotations[i]);
-      found[i].push_back({from_level(coarse, la.factor), p.value, level, "overlap"});
+      found[i].push_back({from_level(coarse, la.factor), p.value, level, "grid"});
     }
   };
   // b turned by theta + pi is b turned by theta reflected through the canvas centre (D - q for

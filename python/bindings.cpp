@@ -533,6 +533,11 @@ PYBIND11_MODULE(_fleetmap, m) {
       "localizers", [] { return registry_members(localization::localizer_registry()); },
       "Every localizer, built-in and registered: a list of {name, help, params} as strategies() gives them "
       "(scenario localization: {name: ..., KEY: VALUE}, --set localization.KEY=VALUE).");
+  m.def(
+      "map_aligners", [] { return registry_members(merging::map_aligner_registry()); },
+      "Every way robots bring a teammate's map into their frame (scenario merging), built-in and registered: a "
+      "list of {name, help, params} as strategies() gives them (merging: {mode: ..., KEY: VALUE}, --set "
+      "merging.KEY=VALUE).");
   m.def("planner_names", &planning::planner_names, "Every path planner's name (plan_path's `planner`).");
   m.def("merge_method_names", &merging::merge_method_names, "Every merge method's name (merge_maps's `method`).");
 

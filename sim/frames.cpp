@@ -37,8 +37,6 @@ void Simulation::try_merge(int i, int j) {
   if (rs != nullptr && sr != nullptr) request.detection = merging::MutualObservation{rs->range, rs->bearing, sr->range, sr->bearing};
   request.receiver_landmarks = r.localizer->landmark_estimates();
   request.sender_landmarks = s.localizer->landmark_estimates();
-  request.method = scenario_.merge_method;
-  request.min_confidence = scenario_.merge_min_confidence;
   request.seed = scenario_.seed;
   if (aligner_->sends_map()) bytes_sent_ += exchange_.send_without_fusing(sender, receiver);
   const merging::FrameAlignment m = aligner_->align(request);

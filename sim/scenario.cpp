@@ -267,17 +267,50 @@ void read_exploration(io::YamlMap& top, Scenario& s) {
   ex.finish();
 }
 
+// `merging`: an aligner's name, or a mapping of its name (`mode`, or `name`), the attempts' pace
+// shared by every aligner, and the parameters the aligner declares.
 void read_merging(io::YamlMap& top, Scenario& s) {
   if (const auto m = top.node("merging"); m && m->IsScalar()) {
     s.merging = top.choice("merging", s.merging, merging_names());
-  } else {
-    auto merge = top.map("merging");
-    s.merging = merge.choice("mode", s.merging, merging_names());
-    s.merge_method = merge.choice("method", s.merge_method, merging::merge_method_names());
-    s.merge_min_confidence = merge.number("min_confidence", s.merge_min_confidence, limits::kConfidence);
-    s.merge_attempt_every = int(merge.number("attempt_every", s.merge_attempt_every, limits::kCount));
-    merge.finish();
+    s.merging_settings.clear();
+    return;
   }
+  auto merge = top.map("merging");
+  if (merge.has("name") && merge.has("mode")) throw InputError(merge.where("mode") + ": give the aligner's 'name' only once");
+  const std::string name = merge.choice(merge.has("mode") ? "mode" : "name", s.merging, merging_names());
+  if (name != s.merging) s.merging_settings.clear();
+  s.merging = name;
+  s.merge_attempt_every = int(merge.number("attempt_every", s.merge_attempt_every, limits::kCount));
+  core::Params params = merging::map_aligner_options(name, s.merging_settings);
+  for (const auto& spec : params.specs()) {
+    const auto node = merge.node(spec.name);
+    if (!node) continue;
+    if (!node->IsScalar()) throw InputError(merge.where(spec.name) + ": expected a value, got " + io::describe_node(*node));
+    try {
+      params.set(spec.name, node->Scalar());
+    } catch (const InputError& e) {
+      throw InputError(merge.where(spec.name) + ": " + e.what());
+    }
+    std::erase_if(s.merging_settings, [&](const auto& kv) { return kv.first == spec.name; });
+    s.merging_settings.emplace_back(spec.name, params.value_text(spec.name));
+  }
+  // Files written before the aligners declared their parameters hold `method: auto` and
+  // `min_confidence: 0.5` whatever the mode: those defaults are read as before, ignored by the
+  // aligners that have no such parameter; another value there is a setting the aligner lacks.
+  const std::vector<std::pair<std::string, std::string>> written_by_older = {{"method", "auto"}, {"min_confidence", "0.5"}};
+  const auto others = merging::map_aligner_registry().parameter_names();
+  for (const auto& key : merge.keys()) {
+    if (params.declares(key) || std::find(others.begin(), others.end(), key) == others.end()) continue;
+    const auto node = *merge.node(key);
+    const bool older_default = std::any_of(written_by_older.begin(), written_by_older.end(), [&](const auto& kv) {
+      return kv.first == key && node.IsScalar() && (node.Scalar() == kv.second || (kv.second == "0.5" && node.Scalar() == ".5"));
+    });
+    if (!older_default) {
+      throw InputError(merge.where(key) + ": merging '" + name + "' has no parameter '" + key + "'" +
+                       (params.specs().empty() ? std::string(" (it has none)") : ""));
+    }
+  }
+  merge.finish();
 }
 
 // A setting's value as a YAML scalar: plain when it reads back as itself, quoted otherwise.
@@ -339,6 +372,10 @@ const std::vector<ParameterFamily>& parameter_families() {
        [](Scenario& s) -> core::Settings& { return s.localization_settings; },
        [](const std::string& m) { return localization::localizer_registry().params(m); },
        [] { return localization::localizer_registry().parameter_names(); }},
+      {"merging", "merging", [](const Scenario& s) { return s.merging; },
+       [](Scenario& s) -> core::Settings& { return s.merging_settings; },
+       [](const std::string& m) { return merging::map_aligner_registry().params(m); },
+       [] { return merging::map_aligner_registry().parameter_names(); }},
   };
   return kFamilies;
 }
@@ -405,7 +442,6 @@ void validate_scenario(const Scenario& s) {
   check("exploration.planning_resolution", e.planning_resolution_m, limits::kMargin);
   check("exploration.planner_time", s.planner_time_s, limits::kPlannerTime);
   check("exploration.planner_iterations", s.planner_iterations, limits::kPlannerIterations);
-  check("merging.min_confidence", s.merge_min_confidence, limits::kConfidence);
   check("merging.attempt_every", s.merge_attempt_every, limits::kCount);
   check("lookahead", s.lookahead_m, limits::kLookahead);
   check("map_resolution", s.map_resolution_m, io::kResolutionRange);
@@ -439,7 +475,13 @@ void validate_scenario(const Scenario& s) {
                      "or choose a localizer that needs none (odometry, scan-matching, rbpf, mcl, polynomial)");
   }
   check_name("merging", s.merging, merging_names());
-  if (merging::make_map_aligner(s.merging)->needs_landmark_estimates()) {
+  std::unique_ptr<merging::MapAligner> aligner;
+  try {
+    aligner = merging::make_map_aligner(s.merging, s.merging_settings);
+  } catch (const InputError& err) {
+    throw InputError(std::string("merging: ") + err.what());
+  }
+  if (aligner->needs_landmark_estimates()) {
     bool estimates = true;  // a localizer that cannot be made without a run is checked by the simulator
     try {
       estimates = localization::make_localizer(s.localization, {})->estimates_landmarks();
@@ -447,7 +489,6 @@ void validate_scenario(const Scenario& s) {
     }
     if (!estimates) throw InputError(landmark_merging_problem(s));
   }
-  check_name("merging.method", s.merge_method, merging::merge_method_names());
   check_name("exploration.path_planner", s.path_planner, path_planner_names());
 }
 
@@ -537,8 +578,8 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
     << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m)
     << "\n  planning_resolution: " << fmt(e.planning_resolution_m) << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s)
     << "\n  planner_iterations: " << s.planner_iterations << "\n";
-  y << "merging:\n  mode: " << s.merging << "\n  method: " << s.merge_method << "\n  min_confidence: "
-    << fmt(s.merge_min_confidence) << "\n  attempt_every: " << s.merge_attempt_every << "\n";
+  y << "merging:\n  mode: " << s.merging << "\n  attempt_every: " << s.merge_attempt_every << "\n";
+  for (const auto& [key, value] : s.merging_settings) y << "  " << key << ": " << yaml_scalar(value) << "\n";
   y << "lookahead: " << fmt(s.lookahead_m) << "\n";
   y << "outputs:\n  html: " << (s.html_replay ? "true" : "false") << "\n";
   return y.str();

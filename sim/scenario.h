@@ -95,8 +95,10 @@ struct Scenario {
   // al. §3.2), "overlap" (robots that can talk search their maps for the best overlap, merging/) or
   // "landmarks" (they associate their estimated landmark maps by RANSAC).
   std::string merging = "known";
-  std::string merge_method = "auto";         // overlap: a method of `fleetmap merge`
-  double merge_min_confidence = 0.5;         // overlap, landmarks: below, no merge
+  // The aligner's own parameters, as given (`merging: {mode: overlap, method: features}`, `--set
+  // merging.min_confidence=0.7`; overlap: method, min_confidence; landmarks: min_confidence,
+  // support_distance); checked against its declaration by validate_scenario.
+  core::Settings merging_settings;
   int merge_attempt_every = 20;              // overlap, landmarks: steps between attempts of the same pair
   double lookahead_m = 0.5;                  // path following
   // How robots get a path to their target: "wave" (the wave's steepest descent) or a planner of
@@ -133,7 +135,7 @@ std::string scenario_to_yaml(const Scenario& scenario, const std::filesystem::pa
 void validate_scenario(const Scenario& scenario);
 
 // A family whose members declare parameters that a scenario sets: its name in `--set` and
-// `--vary` (strategy, localization), the member the scenario chose and the settings given to it.
+// `--vary` (strategy, localization, merging), the member the scenario chose and the settings given to it.
 struct ParameterFamily {
   std::string name;
   std::string group;  // the scenario key whose mapping holds the member's name and parameters, dotted

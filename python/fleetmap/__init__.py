@@ -54,6 +54,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
     planner_names,
     strategies,
     localizers,
+    map_aligners,
     strategy_names,
     keep_freed_memory,
 )
@@ -61,7 +62,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
 __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
     "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
-    "map_names", "strategies", "localizers", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
+    "map_names", "strategies", "localizers", "map_aligners", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
 ]
 
 # The built-in maps ship beside the installed package (share/fleetmap/maps); the C++ side looks

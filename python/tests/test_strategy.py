@@ -124,6 +124,9 @@ class PythonStrategyTest(unittest.TestCase):
         self.assertEqual(run.steps, 5)
         with self.assertRaisesRegex(ValueError, "localization.particles.*a whole number from 1"):
             fleetmap.explore(map="empty", robots=1, steps=5, localization={"name": "rbpf", "particles": 0})
+        aligners = {a["name"]: a for a in fleetmap.map_aligners()}
+        self.assertEqual([(p["name"], p["default"]) for p in aligners["overlap"]["params"]],
+                         [("method", "auto"), ("min_confidence", "0.5")])
 
     def test_assign_must_take_the_four_arrays(self):
         class TooFew:

@@ -95,7 +95,7 @@ TEST(MergeCommand, MergesTwoMapsAndGivesThePixelPlacement) {
   EXPECT_GT(t["acceptance"].get<double>(), 0.95);
   EXPECT_GE(t["confidence"].get<double>(), 0.5);
   EXPECT_LE(t["confidence"].get<double>(), 1.0);
-  EXPECT_EQ(t["method"], "overlap");
+  EXPECT_EQ(t["method"], "grid");
   EXPECT_EQ(t["via"], "a.png");
   // The covariance of (tx_m, ty_m, theta): symmetric, its standard deviations as given, a fraction
   // of a cell (a bare image's cells are 0.05 m) and of a degree; and the summary line says them.
@@ -290,7 +290,7 @@ TEST(MergeCommand, AMapWithoutOverlapIsReportedNotMerged) {
   // A piece of the maze shares nothing with the office.
   const auto maze = maps::load_map_source("maze");
   io::save_map_image(merging::crop_grid(maze, 30, 30, 120, 120), dir / "maze.png");
-  const auto r = run_fleetmap("merge a.png maze.png b.png --method overlap --json r.json --out m.png", dir);
+  const auto r = run_fleetmap("merge a.png maze.png b.png --method grid --json r.json --out m.png", dir);
   EXPECT_EQ(r.exit_code, 1) << r.err;
   EXPECT_NE(r.err.find("2 of 3 maps merged"), std::string::npos) << r.err;
   const auto j = nlohmann::json::parse(slurp(dir / "r.json"));
@@ -404,7 +404,7 @@ TEST(MergeCommand, HelpStatesTheConventionAndEveryFlagWithItsDefault) {
   for (const char* part : {"R(theta) p + (tx_m, ty_m)", "metres", "degrees", "origin", "tx_px",
                            "R(theta_px) (u, v) + (tx_px, ty_px)", "u = column", "row from the top", "--method",
                            "=auto", "--out", "=merged.png", "--json", "default: none", "--min-confidence", "=0.5",
-                           "--seed", "--resolution", "else 0.05", "overlap:", "features:", "auto:", "merged: false",
+                           "--seed", "--resolution", "else 0.05", "grid:", "features:", "auto:", "merged: false",
                            "white when several did", "to the known cells and half a metre around them (its origin says where)"}) {
     EXPECT_NE(r.out.find(part), std::string::npos) << part;
   }

@@ -319,7 +319,7 @@ TEST(OwnMaps, MistypedFlagsValuesAndCommandsGetTheNearestName) {
   // Errors found after reading still name the file.
   dir.write("u.yaml", "map: office\nlocalization: {method: ekf_slam}\n");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario u.yaml", dir),
-                        "u.yaml: localization: unknown value 'ekf_slam' (did you mean 'ekf-slam'?)");
+                        "u.yaml:2: key 'localization.method': unknown value 'ekf_slam' (did you mean 'ekf-slam'?)");
   dir.write("v.yaml", "map: ofice\n");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario v.yaml", dir), "v.yaml: map: unknown map 'ofice' (did you mean 'office'?)");
 }

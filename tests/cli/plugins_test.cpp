@@ -131,5 +131,30 @@ TEST(PluginsCommand, BenchVariesAParameterOfTheLocalizersThatDeclareIt) {
             error.at("localization=fastslam-grid localization.particles=8"));
 }
 
+// The overlap aligner's method and threshold, as parameters like any other member's.
+TEST(PluginsCommand, TheAlignersParametersAreSetAndCheckedLikeTheOthers) {
+  TempDir dir;
+  write_bench_maps(dir);
+  const std::string run = "explore --map hall.yaml --robots 2 --steps 5 --merging overlap ";
+  const auto r = run_fleetmap(run + "--set merging.method=features --set merging.min_confidence=0.7 --out run", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string scenario = slurp(dir / "run" / "scenario.yaml");
+  EXPECT_NE(scenario.find("  mode: overlap\n  attempt_every: 20\n  method: features\n  min_confidence: 0.7\n"), std::string::npos)
+      << scenario;
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--set merging.method=overlap --out bad", dir), "'overlap' is now called 'grid'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--set merging.min_confidence=2 --out bad", dir), "min_confidence");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map hall.yaml --robots 2 --steps 5 --merging rendezvous "
+                                     "--set merging.method=grid --out bad", dir),
+                        "merging 'rendezvous' has no parameter 'method' (it has none)");
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
+  // A file written before the aligners declared their parameters still reads.
+  dir.write("old.yaml", "map: hall.yaml\nsteps: 5\nmerging: {mode: known, method: auto, min_confidence: 0.5, attempt_every: 20}\n");
+  const auto old = run_fleetmap("explore --scenario old.yaml --out old", dir);
+  EXPECT_EQ(old.exit_code, 0) << old.err;
+  dir.write("wrong.yaml", "map: hall.yaml\nsteps: 5\nmerging: {mode: rendezvous, min_confidence: 0.9}\n");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario wrong.yaml --out wrong", dir),
+                        "merging 'rendezvous' has no parameter 'min_confidence'");
+}
+
 }  // namespace
 }  // namespace fleetmap::cli

@@ -65,13 +65,14 @@ TEST(MapAligners, LandmarksRecoverTheTransformBetweenTwoLandmarkMaps) {
   AlignmentRequest q;
   q.receiver_landmarks = receiver;
   q.sender_landmarks = sender;
-  q.min_confidence = 0.5;
   const FrameAlignment a = make_map_aligner("landmarks")->align(q);
   ASSERT_TRUE(a.merged) << a.reason;
   EXPECT_GE(a.confidence, 0.9);
   // Noise of 0.05 m over landmarks metres apart: well under a degree and 0.1 m.
   EXPECT_LT(std::abs(core::rad2deg(core::normalize_angle(a.sender_to_receiver.rotation() - truth.rotation()))), 1.0);
   EXPECT_LT((a.sender_to_receiver.translation() - truth.translation()).norm(), 0.1);
+  // Its declared support distance reaches it: a landmark 0.05 m off supports nothing within 1 mm.
+  EXPECT_FALSE(make_map_aligner("landmarks", {{"support_distance", "0.001"}})->align(q).merged);
 }
 
 TEST(MapAligners, LandmarksRefuseTooFewOrUnrelatedLandmarks) {

@@ -208,7 +208,7 @@ TEST(AlignMaps, UnrelatedMapsLaidEdgeToEdgeAlongAWallAreRefused) {
   core::Random random(1000u * 7919u + 13u);
   const CropPair pair = make_world_pair(world, o, random);
   MergeOptions options;
-  options.method = "overlap";
+  options.method = "grid";
   const MergeResult r = align_maps(pair.a, pair.b, options);
   EXPECT_FALSE(r.merged) << "confidence " << r.confidence << ", acceptance " << r.acceptance;
   EXPECT_NE(r.reason.find("acceptance"), std::string::npos) << r.reason;
@@ -804,18 +804,22 @@ TEST(AlignMaps, AWallStandingInTheOtherMapsOpenSpaceIsRefused) {
   EXPECT_GT(uncounted.confidence, 0.9);
 }
 
+// `auto` is a member like the others: listed, made and run through the registry.
 TEST(MergeRegistry, NamesAutoFirstThenTheBuiltInMethods) {
   const auto names = merge_method_names();
   ASSERT_GE(names.size(), 3u);
   EXPECT_EQ(names[0], "auto");
-  EXPECT_EQ(names[1], "overlap");
+  EXPECT_EQ(names[1], "grid");
   EXPECT_EQ(names[2], "features");
   for (const auto& name : names) {
     EXPECT_NE(merge_method_help().find("  " + name + ": "), std::string::npos) << name;
-    if (name != "auto") {
-      EXPECT_FALSE(merge_method_registry().get(name).make.empty()) << name;
-    }
+    EXPECT_FALSE(merge_method_registry().get(name).make().empty()) << name;
   }
+  // auto: grid's first pass alone, then the other passes together.
+  const MergeSteps steps = merge_method_registry().get("auto").make();
+  ASSERT_EQ(steps.size(), 2u);
+  EXPECT_EQ(steps[0].size(), 1u);
+  EXPECT_GE(steps[1].size(), 2u);
 }
 
 // A program's own method: proposes the true transform, spoiled by a cell and a degree, while a
@@ -940,7 +944,7 @@ TEST(AlignMaps, OptionsThatCompareLongerDistancesGetTheWallDistancesTheyNeed) {
 
 TEST(MergeRegistry, RegisteringAutoATakenNameOrNoPassesIsAnError) {
   EXPECT_THROW(register_merge_method("auto", "x", {propose_oracle}), Error);
-  EXPECT_THROW(register_merge_method("overlap", "x", {propose_oracle}), Error);
+  EXPECT_THROW(register_merge_method("grid", "x", {propose_oracle}), Error);
   EXPECT_THROW(register_merge_method("nothing", "x", {}), Error);
   EXPECT_THROW(register_merge_method("empty-pass", "x", {ProposeFn{}}), Error);
   EXPECT_FALSE(merge_method_registry().contains("nothing"));
@@ -951,7 +955,10 @@ TEST(MergeRegistry, UnknownMethodIsAnInputErrorNamingTheValidOnes) {
   options.method = "spectral-magic";
   const auto g = testing::grid_from_text({"#.", ".#"});
   fleetmap::testing::expect_input_error([&] { align_maps(g, g, options); },
-                                        {"spectral-magic", "auto", "overlap", "features"});
+                                        {"spectral-magic", "auto", "grid", "features"});
+  // The grid search's name before the `overlap` aligner took it says its new name.
+  options.method = "overlap";
+  fleetmap::testing::expect_input_error([&] { align_maps(g, g, options); }, {"'overlap' is now called 'grid'"});
 }
 
 TEST(AlignMaps, MapsWithoutWallsAreRefusedWithAReason) {
@@ -972,7 +979,7 @@ TEST(AlignMaps, IdenticalMapsAlignAtTheIdentity) {
   ASSERT_TRUE(r.merged) << r.reason;
   EXPECT_TRUE(r.transform.is_approx(core::Transform2::identity(), 0.05)) << r.transform;
   EXPECT_NEAR(r.acceptance, 1.0, 1e-9);
-  EXPECT_EQ(r.method, "overlap");
+  EXPECT_EQ(r.method, "grid");
 }
 
 // A grid cannot place walls closer than a fraction of a cell: a fit tighter than 0.2 cells is walls

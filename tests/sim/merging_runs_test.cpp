@@ -61,11 +61,11 @@ TEST(MergingRuns, OverlapSearchMergesOnlyWithConfidence) {
   for (const auto& m : r.merges) {
     if (!m.merged) {
       EXPECT_FALSE(m.reason.empty());
-      EXPECT_LT(m.confidence, s.merge_min_confidence);
+      EXPECT_LT(m.confidence, merging::map_aligner_options(s.merging, s.merging_settings).number("min_confidence"));
       continue;
     }
     ++made;
-    EXPECT_GE(m.confidence, s.merge_min_confidence);
+    EXPECT_GE(m.confidence, merging::map_aligner_options(s.merging, s.merging_settings).number("min_confidence"));
     // A wrong merge is worse than none: every merge made is right to within a degree and a few cells.
     EXPECT_LT(m.rotation_error_deg, 1.0);
     EXPECT_LT(m.position_error_m, 0.3);
@@ -93,7 +93,7 @@ TEST(MergingRuns, LandmarkMapsMergeOnlyWhenEnoughLandmarksAgree) {
   for (const auto& m : r.merges) {
     EXPECT_EQ(m.method, "landmarks");
     if (!m.merged) {
-      EXPECT_LT(m.confidence, s.merge_min_confidence);
+      EXPECT_LT(m.confidence, merging::map_aligner_options(s.merging, s.merging_settings).number("min_confidence"));
       continue;
     }
     ++made;
@@ -120,7 +120,8 @@ class NeverAligner final : public merging::MapAligner {
 };
 
 TEST(MergingRuns, ARegisteredAlignerRunsByName) {
-  merging::register_map_aligner("never", "refuses every merge (a test's own)", [] { return std::make_unique<NeverAligner>(); });
+  merging::register_map_aligner("never", "refuses every merge (a test's own)",
+                                 [](const core::Params&) { return std::make_unique<NeverAligner>(); });
   const auto names = merging_names();
   EXPECT_NE(std::find(names.begin(), names.end(), "never"), names.end());
   const Scenario s = parse_scenario("map: office\nrobots: 2\nsteps: 30\nmerging: never\n", "never.yaml", "");
