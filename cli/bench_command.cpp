@@ -424,12 +424,13 @@ Command add_bench_command(CLI::App& root) {
   app->add_option("--vary", s.vary,
                   "A further sweep axis, SETTING=V1,V2,... (repeat for more): a scenario key such as "
                   "sensors.range.beams or communication.range, or beams, sensor_range, comm_range, localization, merging, "
-                  "path_planner, steps, noise_position, or a member's parameter strategy.KEY, localization.KEY or merging.KEY (the members "
+                  "path_planner, steps, noise_position, or a member's parameter strategy.KEY, localization.KEY, planner.KEY or merging.KEY (the members "
                   "that do not declare it run once per value unchanged); e.g. --vary beams=90,360 --vary strategy.beta=0.5,2")
       ->expected(1)
       ->take_all();
   app->add_option("--set", s.set,
-                  "A member's parameter in every run, FAMILY.KEY=VALUE with FAMILY strategy, localization or merging (repeat for more), "
+                  "A member's parameter in every run, FAMILY.KEY=VALUE with FAMILY strategy, localization, planner or merging (repeat "
+                  "for more), "
                   "e.g. --set strategy.beta=0.5 --set localization.particles=50; it applies to the members that declare it "
                   "(see `fleetmap plugins`)")
       ->expected(1)

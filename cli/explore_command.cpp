@@ -468,7 +468,8 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--strategy", f->strategy, "Coordination strategy [default: directional]")
       ->check(one_of(exploration::strategy_names()));
   app->add_option("--set", f->set,
-                  "A parameter of the strategy, the localizer or the aligner, FAMILY.KEY=VALUE (repeat for more), e.g. --set "
+                  "A parameter of the strategy, the localizer, the path planner or the aligner, FAMILY.KEY=VALUE (repeat for "
+                  "more), e.g. --set "
                   "strategy.beta=0.5 --set localization.particles=50 --set merging.method=features; each member's parameters and defaults are listed below and by "
                   "`fleetmap plugins`")
       ->expected(1)

@@ -15,6 +15,7 @@
 #include "cli/plan_output.h"
 #include "cli/validators.h"
 #include "core/error.h"
+#include "core/params.h"
 #include "io/file_io.h"
 #include "maps/builtin_maps.h"
 #include "io/map_io.h"
@@ -41,6 +42,7 @@ struct PlanCommandOptions {
   std::string out, json;
   double resolution = 0.05;
   bool resolution_given = false;  // --resolution was on the command line
+  std::vector<std::string> set;   // --set planner.KEY=VALUE
 };
 
 // An endpoint as the user gave it: the flag and its text, and the point in metres.
@@ -112,6 +114,13 @@ int run_plan(const PlanCommandOptions& o) {
   if (!o.out.empty()) io::check_picture_path(o.out, "--out");
   check_outputs(outputs, maps::map_source_files(o.map));
   std::FILE* report = report_stream(outputs);
+  core::Settings settings;
+  for (const auto& text : o.set) {
+    const auto a = core::parse_param_assignment(text, "--set " + text);
+    if (a.family != "planner") throw InputError("--set " + text + ": plan takes planner.KEY=VALUE, not " + a.family + "." + a.key);
+    settings.emplace_back(a.key, a.value);
+  }
+  auto planner = planning::make_planner(o.planner, settings);  // a bad setting is refused before the map is read
   io::MapLoadOptions load;
   load.default_resolution = o.resolution;
   const mapping::OccupancyGrid grid = maps::load_map_source(o.map, load);
@@ -125,7 +134,7 @@ int run_plan(const PlanCommandOptions& o) {
   planning::PlannerOptions search;
   search.time_budget_s = o.time_s;
   search.seed = o.seed;
-  const planning::PlanResult r = planning::make_planner(o.planner)->plan(space, start.point, goal.point, search);
+  const planning::PlanResult r = planner->plan(space, start.point, goal.point, search);
 
   using planning::PlanStatus;
   if (r.status == PlanStatus::StartOutsideMap || r.status == PlanStatus::StartInObstacle) {
@@ -169,6 +178,11 @@ Command add_plan_command(CLI::App& root) {
   plan->add_option("--planner", o->planner, "Planner name (see the list below)")
       ->capture_default_str()
       ->check(one_of(planning::planner_names()));
+  plan->add_option("--set", o->set,
+                   "A parameter of the planner, planner.KEY=VALUE (repeat for more), e.g. --planner reactive --set "
+                   "planner.turn_angle_deg=20; each planner's parameters are listed below and by `fleetmap plugins`")
+      ->expected(1)
+      ->take_all();
   plan->add_option("--time", o->time_s, "Time budget in seconds")->capture_default_str()->check(in_range(planning::kTimeBudgetRange));
   plan->add_option("--radius", o->radius_m, "Robot radius in metres")->capture_default_str()->check(in_range(kRadiusRange));
   plan->add_option("--unknown", o->unknown, "Unknown cells are 'obstacle' or 'free'")

@@ -41,7 +41,9 @@ std::vector<Family> families() {
        merging::map_aligner_registry().help()},
       {"merge-method", "merge --method NAME; the overlap aligner's method (--set merging.method=NAME)",
        merging::merge_method_registry().help()},
-      {"planner", "plan --planner NAME; explore --path-planner NAME", planning::planner_registry().help()},
+      {"planner", "plan --planner NAME --set planner.KEY=VALUE; explore --path-planner NAME; scenario "
+                  "exploration.path_planner: {name: NAME, KEY: VALUE}; --set planner.KEY=VALUE",
+       planning::planner_registry().help()},
       {"slam-method", "slam scenario files' methods", experiments::slam_method_registry().help()},
       {"map", "any --map NAME", maps::map_registry().help()},
   };

@@ -107,7 +107,7 @@ PlanResult Planner::plan(const FreeSpace& space, const Eigen::Vector2d& start, c
 
 PlanResult plan_path(const mapping::OccupancyGrid& grid, const Eigen::Vector2d& start_m, const Eigen::Vector2d& goal_m,
                      const PlanPathOptions& options) {
-  auto planner = make_planner(options.planner);
+  auto planner = make_planner(options.planner, options.planner_settings);
   const FreeSpace space(grid, options.space);
   return planner->plan(space, start_m, goal_m, options.search);
 }

@@ -57,17 +57,6 @@ struct PlanResult {
   bool success() const { return status == PlanStatus::Success; }
 };
 
-// The map-alignment paper, §VII: head for the target; when an obstacle cell lies within `look_ahead_m` (r_max)
-// and within `turn_angle_deg` of the heading, turn by that angle away from it and keep the new
-// heading until the obstacle is passed, then head for the target again.
-struct ReactiveOptions {
-  double turn_angle_deg = 10.0;
-  double look_ahead_m = 0.5;
-  double step_m = 0.0;  // distance per control step (v dt); 0: half a cell
-  // Gives up after travelling this many times the map's half perimeter.
-  double max_travel_factor = 4.0;
-};
-
 // The time budgets a planner accepts, in seconds (the CLI flags and scenario keys use it too).
 inline constexpr core::Range kTimeBudgetRange{1e-3, 3600};
 
@@ -90,7 +79,6 @@ struct PlannerOptions {
   // Answer Unreachable at once when start and goal lie in separate regions of free space, instead
   // of letting the planner spend its budget.
   bool check_reachability = true;
-  ReactiveOptions reactive;
 };
 
 class Planner {
@@ -127,9 +115,10 @@ struct PlannerInfo {
   bool complete = true;
 };
 
-// A registered planner: how to make one, and whether it is complete.
+// A registered planner: how to make one from its declared parameters' values, and whether it is
+// complete.
 struct PlannerMaker {
-  std::function<std::unique_ptr<Planner>()> make;
+  std::function<std::unique_ptr<Planner>(const core::Params&)> make;
   bool complete = true;
 };
 
@@ -137,18 +126,23 @@ struct PlannerMaker {
 core::Registry<PlannerMaker>& planner_registry();
 // Adds a planner: `fleetmap plan --planner NAME`, `--path-planner NAME` and the test harnesses
 // reach it. Throws Error when the name is taken or unusable.
-void register_planner(std::string name, std::string help, PlannerMaker maker);
+// `params` are the settings it accepts (core/params.h).
+void register_planner(std::string name, std::string help, PlannerMaker maker, std::vector<core::ParamSpec> params = {});
 
 // The registered planners, in the order --help lists them.
 std::vector<PlannerInfo> planner_infos();
 std::vector<std::string> planner_names();
 // One line per planner, for --help and README.
 std::string planner_help();
-// Throws InputError naming the valid names for an unknown one.
-std::unique_ptr<Planner> make_planner(const std::string& name);
+// The planner's declared parameters with `settings` applied; throws InputError for an unknown name
+// (naming the valid ones), a setting it does not declare or a value it refuses.
+core::Params planner_options(const std::string& name, const core::Settings& settings = {});
+// Throws as planner_options.
+std::unique_ptr<Planner> make_planner(const std::string& name, const core::Settings& settings = {});
 
 struct PlanPathOptions {
   std::string planner = "rrtstar";
+  core::Settings planner_settings;  // the planner's own parameters (planner_options)
   FreeSpaceOptions space;
   PlannerOptions search;
 };

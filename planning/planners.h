@@ -12,6 +12,6 @@ enum class OmplAlgorithm { RrtStar, InformedRrtStar, PrmStar, RrtConnect, BitSta
 std::unique_ptr<Planner> make_ompl_planner(OmplAlgorithm algorithm);
 
 std::unique_ptr<Planner> make_astar_planner();
-std::unique_ptr<Planner> make_reactive_planner();
+std::unique_ptr<Planner> make_reactive_planner(const core::Params& params);
 
 }  // namespace fleetmap::planning

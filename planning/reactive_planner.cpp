@@ -58,22 +58,20 @@ std::optional<Eigen::Vector2d> landmark_ahead(const FreeSpace& space, const Eige
 
 class ReactivePlanner final : public Planner {
  public:
+  explicit ReactivePlanner(const core::Params& p)
+      : turn_angle_deg_(p.number("turn_angle_deg")),
+        look_ahead_m_(p.number("look_ahead")),
+        step_m_(p.number("step")),
+        max_travel_factor_(p.number("max_travel_factor")) {}
   std::string name() const override { return "reactive"; }
 
  protected:
   Search search(const FreeSpace& space, const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
                 const PlannerOptions& options, Clock::time_point deadline) override {
-    const ReactiveOptions& o = options.reactive;
-    if (!(o.turn_angle_deg > 0.0 && o.turn_angle_deg < 180.0)) {
-      throw InputError("reactive planner: turn angle must lie in (0, 180) degrees, got " + std::to_string(o.turn_angle_deg));
-    }
-    if (!(o.look_ahead_m > 0.0) || !(o.step_m >= 0.0) || !(o.max_travel_factor > 0.0)) {
-      throw InputError("reactive planner: look-ahead, step and travel factor must be positive");
-    }
     const GridGeometry& g = space.geometry();
-    const double step = o.step_m > 0.0 ? o.step_m : 0.5 * g.resolution();
-    const double theta = core::deg2rad(o.turn_angle_deg);
-    const double max_travel = o.max_travel_factor * (g.width_m() + g.height_m());
+    const double step = step_m_ > 0.0 ? step_m_ : 0.5 * g.resolution();
+    const double theta = core::deg2rad(turn_angle_deg_);
+    const double max_travel = max_travel_factor_ * (g.width_m() + g.height_m());
     const int max_turns = static_cast<int>(std::ceil(2.0 * std::numbers::pi / theta));
 
     Search s;
@@ -107,7 +105,7 @@ class ReactivePlanner final : public Planner {
       Eigen::Vector2d next;
       for (int turns = 0;; ++turns) {
         std::optional<Eigen::Vector2d> blocker =
-            landmark_ahead(space, p, heading, std::min(o.look_ahead_m, to_goal.norm()), theta);
+            landmark_ahead(space, p, heading, std::min(look_ahead_m_, to_goal.norm()), theta);
         next = p + std::min(step, to_goal.norm()) * direction(heading);
         if (!blocker) {
           if (const auto hit = space.first_invalid_distance(p, next)) {
@@ -135,7 +133,7 @@ class ReactivePlanner final : public Planner {
       headings.push_back(heading);
       // The robot has passed its sub-target once it lies beside or behind it, or out of range.
       if (avoiding &&
-          (std::abs(bearing(p, heading, sub_target)) >= 0.5 * std::numbers::pi || (sub_target - p).norm() > o.look_ahead_m)) {
+          (std::abs(bearing(p, heading, sub_target)) >= 0.5 * std::numbers::pi || (sub_target - p).norm() > look_ahead_m_)) {
         avoiding = false;
       }
     }
@@ -156,10 +154,14 @@ class ReactivePlanner final : public Planner {
     s.path.push_back(points.back());
     return s;
   }
+ private:
+  double turn_angle_deg_, look_ahead_m_, step_m_, max_travel_factor_;
 };
 
 }  // namespace
 
-std::unique_ptr<Planner> make_reactive_planner() { return std::make_unique<ReactivePlanner>(); }
+std::unique_ptr<Planner> make_reactive_planner(const core::Params& params) {
+  return std::make_unique<ReactivePlanner>(params);
+}
 
 }  // namespace fleetmap::planning

@@ -68,6 +68,11 @@ std::string fmt(double v) {
 
 std::vector<std::string> merging_names() { return merging::map_aligner_registry().names(); }
 
+core::Params path_planner_options(const std::string& name) {
+  // The wave's steepest descent is no registered planner and has no parameters.
+  return name == "wave" ? core::Params("path planner 'wave'", {}) : planning::planner_registry().params(name);
+}
+
 std::vector<std::string> path_planner_names() {
   // OMPL's PRM* grows its roadmap for fixed wall-clock times in two threads: runs would not repeat.
   std::vector<std::string> names = {"wave"};
@@ -261,7 +266,9 @@ void read_exploration(io::YamlMap& top, Scenario& s) {
   e.targets.frontiers.min_region_cells = int(ex.number("min_frontier_cells", e.targets.frontiers.min_region_cells, limits::kCount));
   e.traversability.safety_margin_m = ex.number("safety_margin", e.traversability.safety_margin_m, limits::kMargin);
   e.planning_resolution_m = ex.number("planning_resolution", e.planning_resolution_m, limits::kMargin);
-  s.path_planner = ex.choice("path_planner", s.path_planner, path_planner_names());
+  const auto planner = ex.member("path_planner", {s.path_planner, s.planner_settings}, path_planner_names(), path_planner_options);
+  s.path_planner = planner.name;
+  s.planner_settings = planner.settings;
   s.planner_time_s = ex.number("planner_time", s.planner_time_s, limits::kPlannerTime);
   s.planner_iterations = int(ex.number("planner_iterations", s.planner_iterations, limits::kPlannerIterations));
   ex.finish();
@@ -320,6 +327,14 @@ std::string yaml_scalar(const std::string& value) {
   return plain ? value : io::yaml_quoted(value);
 }
 
+// A member as a scenario writes it: its name alone, or {name: NAME, KEY: VALUE, ...}.
+std::string member_yaml(const std::string& name, const core::Settings& settings) {
+  if (settings.empty()) return name;
+  std::string out = "{name: " + name;
+  for (const auto& [key, value] : settings) out += ", " + key + ": " + yaml_scalar(value);
+  return out + "}";
+}
+
 }  // namespace
 
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
@@ -372,6 +387,9 @@ const std::vector<ParameterFamily>& parameter_families() {
        [](Scenario& s) -> core::Settings& { return s.localization_settings; },
        [](const std::string& m) { return localization::localizer_registry().params(m); },
        [] { return localization::localizer_registry().parameter_names(); }},
+      {"planner", "exploration.path_planner", [](const Scenario& s) { return s.path_planner; },
+       [](Scenario& s) -> core::Settings& { return s.planner_settings; }, path_planner_options,
+       [] { return planning::planner_registry().parameter_names(); }},
       {"merging", "merging", [](const Scenario& s) { return s.merging; },
        [](Scenario& s) -> core::Settings& { return s.merging_settings; },
        [](const std::string& m) { return merging::map_aligner_registry().params(m); },
@@ -490,6 +508,12 @@ void validate_scenario(const Scenario& s) {
     if (!estimates) throw InputError(landmark_merging_problem(s));
   }
   check_name("exploration.path_planner", s.path_planner, path_planner_names());
+  try {
+    core::Params planner = path_planner_options(s.path_planner);
+    for (const auto& [key, value] : s.planner_settings) planner.set(key, value);
+  } catch (const InputError& err) {
+    throw InputError(std::string("exploration.path_planner: ") + err.what());
+  }
 }
 
 std::string landmark_merging_problem(const Scenario& s) {
@@ -576,7 +600,7 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
   y << "}\n  eight_connected: " << (e.wave.eight_connected ? "true" : "false") << "\n  occupancy_weight: " << fmt(e.wave.occupancy_weight)
     << "\n  stall_steps: " << e.stall_steps << "\n  piece_radius: " << fmt(e.targets.piece_radius_m)
     << "\n  min_frontier_cells: " << e.targets.frontiers.min_region_cells << "\n  safety_margin: " << fmt(e.traversability.safety_margin_m)
-    << "\n  planning_resolution: " << fmt(e.planning_resolution_m) << "\n  path_planner: " << s.path_planner << "\n  planner_time: " << fmt(s.planner_time_s)
+    << "\n  planning_resolution: " << fmt(e.planning_resolution_m) << "\n  path_planner: " << member_yaml(s.path_planner, s.planner_settings) << "\n  planner_time: " << fmt(s.planner_time_s)
     << "\n  planner_iterations: " << s.planner_iterations << "\n";
   y << "merging:\n  mode: " << s.merging << "\n  attempt_every: " << s.merge_attempt_every << "\n";
   for (const auto& [key, value] : s.merging_settings) y << "  " << key << ": " << yaml_scalar(value) << "\n";

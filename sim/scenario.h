@@ -106,6 +106,7 @@ struct Scenario {
   // `planner_iterations` iterations, so that a run is the same on every machine; `planner_time_s`
   // only caps a path's wall time (a run whose planner hits it may not repeat exactly).
   std::string path_planner = "wave";
+  core::Settings planner_settings;  // the planner's own parameters (`path_planner: {name: reactive, step: 0.1}`)
   double planner_time_s = 10.0;
   int planner_iterations = 2000;
   // Outputs beyond the standard ones (`outputs:` in a scenario file): replay.html, the run in the
@@ -117,6 +118,9 @@ struct Scenario {
 std::vector<std::string> merging_names();
 // "wave" and every planner of planning/.
 std::vector<std::string> path_planner_names();
+// The path planner's declared parameters at their defaults (none for "wave"); throws InputError for
+// an unknown name.
+core::Params path_planner_options(const std::string& name);
 
 // Parses scenario YAML; `source` names it in errors and `base_dir` anchors relative map paths.
 Scenario parse_scenario(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);

@@ -167,6 +167,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, S
   if (scenario_.path_planner != "wave") {
     planning::PlanPathOptions plan;
     plan.planner = scenario_.path_planner;
+    plan.planner_settings = scenario_.planner_settings;
     // The same clearance the explorer keeps, so the paths it gets are ones it accepts.
     plan.space.robot_radius_m = scenario_.exploration.traversability.robot_radius_m +
                                 scenario_.exploration.traversability.safety_margin_m;

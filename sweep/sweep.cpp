@@ -486,8 +486,8 @@ void validate_sweep(const Sweep& sweep) {
     } else {
       members.push_back(family.member(sweep.base));
       for (const auto& axis : sweep.axes) {
-        if (axis.scenario_key == family.group + ".method" || axis.scenario_key == family.group + ".name" ||
-            axis.scenario_key == family.group + ".mode") {
+        if (axis.scenario_key == family.group || axis.scenario_key == family.group + ".method" ||
+            axis.scenario_key == family.group + ".name" || axis.scenario_key == family.group + ".mode") {
           members.insert(members.end(), axis.values.begin(), axis.values.end());
         }
       }

@@ -156,5 +156,26 @@ TEST(PluginsCommand, TheAlignersParametersAreSetAndCheckedLikeTheOthers) {
                         "merging 'rendezvous' has no parameter 'min_confidence'");
 }
 
+// The planners' parameters: plan --set, and a path planner's in explore's scenario.
+TEST(PluginsCommand, APlannersParametersAreSetFromPlanAndExplore) {
+  TempDir dir;
+  write_bench_maps(dir);
+  const std::string plan = "plan --map hall.yaml --from 1,1 --to 5,3 --planner reactive ";
+  const auto narrow = run_fleetmap(plan + "--json a.json", dir);
+  const auto wide = run_fleetmap(plan + "--set planner.look_ahead=0.01 --json b.json", dir);
+  ASSERT_EQ(narrow.exit_code, 0) << narrow.err;
+  ASSERT_EQ(wide.exit_code, 0) << wide.err;
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(plan + "--set planner.turn_angle_deg=200 --json c.json", dir), "turn_angle_deg");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("plan --map hall.yaml --from 1,1 --to 5,3 --planner astar --set planner.step=1", dir),
+                        "planner 'astar' has no parameter 'step' (it has none)");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(plan + "--set strategy.beta=1", dir), "plan takes planner.KEY=VALUE");
+  EXPECT_FALSE(std::filesystem::exists(dir / "c.json"));
+  const auto r = run_fleetmap("explore --map hall.yaml --robots 1 --steps 5 --path-planner reactive "
+                              "--set planner.turn_angle_deg=20 --out run", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(slurp(dir / "run" / "scenario.yaml").find("path_planner: {name: reactive, turn_angle_deg: 20}"), std::string::npos)
+      << slurp(dir / "run" / "scenario.yaml");
+}
+
 }  // namespace
 }  // namespace fleetmap::cli

@@ -12,12 +12,11 @@ using testing::grid_from_ascii;
 using testing::path_clear_of_obstacles;
 
 PlanResult reactive(const mapping::OccupancyGrid& grid, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                    const ReactiveOptions& ro = {}) {
+                    const core::Settings& settings = {}) {
   const FreeSpace space(grid, {0.2, UnknownCells::Obstacle});
   PlannerOptions options;
   options.time_budget_s = 10.0;
-  options.reactive = ro;
-  return make_planner("reactive")->plan(space, a, b, options);
+  return make_planner("reactive", settings)->plan(space, a, b, options);
 }
 
 TEST(ReactivePlanner, HeadsStraightForAVisibleGoal) {
@@ -39,9 +38,7 @@ TEST(ReactivePlanner, TurnsAroundAnObstacleInItsWay) {
   EXPECT_GT(r.path.size(), 2u);
   EXPECT_GT(r.length_m, (b - a).norm() + 0.2);
   // With a wider turn per step the robot swerves differently.
-  ReactiveOptions wide;
-  wide.turn_angle_deg = 30.0;
-  const PlanResult w = reactive(grid, a, b, wide);
+  const PlanResult w = reactive(grid, a, b, {{"turn_angle_deg", "30"}});
   ASSERT_TRUE(w.success()) << w.detail;
   EXPECT_TRUE(path_clear_of_obstacles(grid, w.path, 0.2));
   EXPECT_NE(w.path, r.path);
@@ -82,12 +79,12 @@ TEST(ReactivePlanner, GetsCaughtInADeadEndThatAStarLeaves) {
 
 TEST(ReactivePlanner, RejectsBadOptions) {
   const auto grid = testing::walled_room(20, 20);
-  ReactiveOptions bad;
-  bad.turn_angle_deg = 0.0;
-  fleetmap::testing::expect_input_error([&] { reactive(grid, {0.5, 0.5}, {1.5, 1.5}, bad); }, {"turn angle"});
-  bad = {};
-  bad.look_ahead_m = -1.0;
-  fleetmap::testing::expect_input_error([&] { reactive(grid, {0.5, 0.5}, {1.5, 1.5}, bad); }, {"look-ahead"});
+  fleetmap::testing::expect_input_error([&] { reactive(grid, {0.5, 0.5}, {1.5, 1.5}, {{"turn_angle_deg", "0"}}); },
+                                        {"planner 'reactive'", "turn_angle_deg"});
+  fleetmap::testing::expect_input_error([&] { reactive(grid, {0.5, 0.5}, {1.5, 1.5}, {{"look_ahead", "-1"}}); },
+                                        {"look_ahead"});
+  fleetmap::testing::expect_input_error([&] { make_planner("astar", {{"look_ahead", "1"}}); },
+                                        {"planner 'astar' has no parameter 'look_ahead'"});
 }
 
 }  // namespace

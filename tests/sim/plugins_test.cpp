@@ -64,7 +64,7 @@ TEST(Plugins, ARegisteredStrategyLocalizerPlannerAndMapRunByName) {
   localization::register_localizer("counting", "dead reckoning that counts (a test's own)",
                                    [](const localization::LocalizerContext& c) { return std::make_unique<CountingLocalizer>(c); });
   planning::register_planner("grid-astar-again", "the grid A*, registered again under another name",
-                             {[] { return planning::make_planner("astar"); }});
+                             {[](const core::Params&) { return planning::make_planner("astar"); }});
   maps::register_map("test-room", "a walled 8 x 6 m room", [](const io::MapLoadOptions&) { return testing::walled_room(80, 60); });
 
   // Everything that lists names sees them; a second registration of a name is refused.
