@@ -7,6 +7,7 @@
 #include <cmath>
 #include <climits>
 #include <cstdint>
+#include <limits>
 #include <unordered_set>
 
 #include "core/angle.h"
@@ -119,6 +120,21 @@ double match_score(const SubmapGrid& grid, const PointCloud& points, const core:
   double sum = 0.0;
   for (const auto& c : cells_at(points, pose.theta, pose.position(), grid.resolution())) sum += grid.probability(c.x(), c.y());
   return sum / double(points.size());
+}
+
+double score_advantage(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& a, const core::Pose2& b) {
+  if (points.size() < 2) return 0.0;
+  const auto ca = cells_at(points, a.theta, a.position(), grid.resolution());
+  const auto cb = cells_at(points, b.theta, b.position(), grid.resolution());
+  double sum = 0.0, sum2 = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d = double(grid.probability(ca[i].x(), ca[i].y())) - double(grid.probability(cb[i].x(), cb[i].y()));
+    sum += d, sum2 += d * d;
+  }
+  const double n = double(points.size()), mean = sum / n;
+  const double error = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+  if (error == 0.0) return mean > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+  return mean / error;
 }
 
 MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
@@ -247,6 +263,10 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
     for (const auto& c : candidates) {
       if (c.score <= best_score) break;
       if (level == 0) {
+        if (o.exclude_center) {
+          const Eigen::Vector2d t(center.x + c.dx * r, center.y + c.dy * r);
+          if ((t - *o.exclude_center).norm() <= o.exclude_radius_m) continue;
+        }
         best = c, best_score = c.score;
         continue;
       }

@@ -78,6 +78,10 @@ struct BranchAndBoundOptions {
   // rotation_weight)^2) for its distance d (m) and turn a (rad) from the centre; 0: no prior.
   double translation_weight = 0.0;
   double rotation_weight = 0.0;
+  // Poses whose translation lies within exclude_radius_m of exclude_center (grid frame) are not
+  // answers: the search for a rival of a match found before, somewhere else.
+  std::optional<Eigen::Vector2d> exclude_center;
+  double exclude_radius_m = 0.0;
 };
 
 // The best pose within the window around `center` whose score exceeds min_score, found by branch
@@ -103,5 +107,9 @@ core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const
 
 // The mean probability of the grid at the points placed by `pose`.
 double match_score(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose);
+// How much better the points fit at `a` than at `b`, point by point: the mean of the differences
+// of the probabilities at each point, in standard errors of that mean (the differences' spread /
+// sqrt(points)). Two placements that explain the scan alike differ by a few errors at most.
+double score_advantage(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& a, const core::Pose2& b);
 
 }  // namespace fleetmap::localization
