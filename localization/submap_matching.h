@@ -96,7 +96,21 @@ struct RefineOptions {
   double translation_weight = 10.0;
   double rotation_weight = 40.0;
   int max_iterations = 20;
+  // When >= 0, the translation's pull is this in the direction the points fix best and
+  // translation_weight in a direction they leave free, blended along each eigenvector of the
+  // score's curvature at `initial` (score_curvature) by the square root of its eigenvalue over the
+  // largest: the scan decides where it can, the prediction holds a corridor's length. Below 0:
+  // translation_weight everywhere.
+  double fixed_translation_weight = -1.0;
 };
+
+// How well a placement fixes the scan's position in each direction: the curvature of the mean
+// probability at the points (read through the bicubic interpolation refine_match uses) at `pose`
+// over translations (the heading held), the quadratic form u' A u fitted to its drop when the
+// scan moves by +-`step_m` (best below a cell) along eight directions u (per m^2; eigenvalues
+// clamped at 0). Olson 2009 (sec. IV-D) reads a match's covariance off the same score surface: along a
+// corridor whose ends are out of range the score hardly drops, across it it drops fast.
+Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m);
 
 // Least-squares refinement (Ceres, bicubic interpolation of the grid) from `initial`, its
 // translation pulled toward `target`'s and its rotation toward `initial`'s (as Cartographer: the

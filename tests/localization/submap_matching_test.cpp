@@ -88,5 +88,40 @@ TEST(BranchAndBound, ExcludedPosesAreNeverTheAnswer) {
   EXPECT_GT(found->pose.position().norm(), 1.0) << found->pose;
 }
 
+// A corridor 2 m wide along x, 20 m long (its walls through the middle of a row of cells), seen from
+// its middle with its ends out of sight.
+SubmapGrid corridor() {
+  SubmapGrid grid;
+  for (double x0 = -8.0; x0 <= 8.0; x0 += 1.0) {
+    PointCloud walls;
+    for (double t = -3.0; t <= 3.0 + 1e-9; t += 0.05) walls.push_back({x0 + t, 1.025}), walls.push_back({x0 + t, -1.025});
+    for (int k = 0; k < 5; ++k) grid.insert({x0, 0.0}, walls);
+  }
+  return grid;
+}
+
+PointCloud corridor_scan() {
+  PointCloud out;
+  for (double t = -3.0; t <= 3.0 + 1e-9; t += 0.05) out.push_back({t, 1.025}), out.push_back({t, -1.025});
+  return out;
+}
+
+TEST(ScoreCurvature, ACorridorsMatchIsFixedAcrossItAndFreeAlongIt) {
+  const Eigen::Matrix2d a = score_curvature(corridor(), corridor_scan(), core::Pose2(0.0, 0.0, 0.0), 0.025);
+  EXPECT_GT(a(1, 1), 0.0);
+  EXPECT_LT(a(0, 0), 0.05 * a(1, 1)) << a;
+}
+
+TEST(RefineMatch, TheScanFixesTheCorridorsWidthAndThePredictionItsLength) {
+  const SubmapGrid grid = corridor();
+  // The prediction is 0.3 m along and 4 cm across from the truth (the origin).
+  const core::Pose2 prediction(0.3, 0.04, 0.0);
+  RefineOptions o;
+  o.fixed_translation_weight = 1.0;
+  const core::Pose2 refined = refine_match(grid, corridor_scan(), prediction, prediction, o);
+  EXPECT_NEAR(refined.y, 0.0, 0.015) << refined;  // the walls decide across (a third of a cell)
+  EXPECT_NEAR(refined.x, 0.3, 0.02) << refined;   // nothing along: the prediction holds
+}
+
 }  // namespace
 }  // namespace fleetmap::localization
