@@ -349,7 +349,12 @@ core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const
                            nullptr, pose);
   Eigen::Matrix2d translation_weights = o.translation_weight * Eigen::Matrix2d::Identity();
   if (o.fixed_translation_weight >= 0.0) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(score_curvature(grid, points, initial, 0.5 * grid.resolution()));
+    // The curvature is the whole scan's: points evenly spread through it estimate it for less.
+    constexpr std::size_t kCurvaturePoints = 100;
+    PointCloud spread;
+    const std::size_t stride = std::max<std::size_t>(1, points.size() / kCurvaturePoints);
+    for (std::size_t i = 0; i < points.size(); i += stride) spread.push_back(points[i]);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(score_curvature(grid, spread, initial, 0.5 * grid.resolution()));
     const double largest = eigen.eigenvalues()[1];
     Eigen::Vector2d w = Eigen::Vector2d::Constant(o.translation_weight);
     if (largest > 0.0) {
