@@ -304,14 +304,23 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
   double best_score = o.min_score;
   // Depth-first: a candidate at level h covers offsets [dx, dx + 2^h) x [dy, dy + 2^h), and its
   // level-h score bounds every pose it covers.
+  // Whether every offset a candidate of `level` covers lies in the excluded disc (its four corners
+  // do, and the disc is convex).
+  auto excluded = [&](const Candidate& c, int level) {
+    if (!o.exclude_center) return false;
+    const int size = (1 << level) - 1;
+    for (int cy : {c.dy, c.dy + size}) {
+      for (int cx : {c.dx, c.dx + size}) {
+        if ((Eigen::Vector2d(center.x + cx * r, center.y + cy * r) - *o.exclude_center).norm() > o.exclude_radius_m) return false;
+      }
+    }
+    return true;
+  };
   auto search = [&](auto&& self, const std::vector<Candidate>& candidates, int level) -> void {
     for (const auto& c : candidates) {
       if (c.score <= best_score) break;
+      if (excluded(c, level)) continue;
       if (level == 0) {
-        if (o.exclude_center) {
-          const Eigen::Vector2d t(center.x + c.dx * r, center.y + c.dy * r);
-          if ((t - *o.exclude_center).norm() <= o.exclude_radius_m) continue;
-        }
         best = c, best_score = c.score;
         continue;
       }
