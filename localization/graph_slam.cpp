@@ -66,7 +66,7 @@ struct GraphSlam::State {
   std::vector<std::size_t> active;  // at most two, oldest first
   std::vector<Node> nodes;
   std::vector<GraphConstraint> constraints;
-  std::size_t loops = 0, optimizations = 0, relocalized = 0;
+  std::size_t loops = 0, rejected_loops = 0, optimizations = 0, relocalized = 0;
   std::optional<core::Pose2> last_step;  // the local motion from the last but one node to the last
   double last_dt = 0.0;
   std::optional<core::Pose2> last_inserted;  // local
@@ -93,6 +93,18 @@ struct GraphSlam::State {
     const auto match = branch_and_bound_match(*m.precomputed, n.loop_points, in_submap, o.loop_search);
     if (!match) return;
     const core::Pose2 refined = refine_match(m.grid, n.loop_points, match->pose, match->pose, o.loop_refine);
+    // A match is a loop closure only where the window holds no rival, a match farther than
+    // loop_rival_radius_m from it, that the scan's points tell apart from it by less than
+    // loop_rival_errors standard errors: a corridor or a row of like rooms matches at several
+    // places, and the wrong one pulls the graph by metres.
+    BranchAndBoundOptions rival_search = o.loop_search;
+    rival_search.exclude_center = match->pose.position();
+    rival_search.exclude_radius_m = o.loop_rival_radius_m;
+    const auto rival = branch_and_bound_match(*m.precomputed, n.loop_points, in_submap, rival_search);
+    if (rival && score_advantage(m.grid, n.loop_points, match->pose, rival->pose) < o.loop_rival_errors) {
+      ++rejected_loops;
+      return;
+    }
     constraints.push_back({submap_index, node_index, refined, true, match->score});
     ++loops;
   }
@@ -307,6 +319,7 @@ std::size_t GraphSlam::nodes() const { return s_->nodes.size(); }
 std::size_t GraphSlam::submaps() const { return s_->submaps.size(); }
 std::size_t GraphSlam::loop_closures() const { return s_->loops; }
 std::size_t GraphSlam::optimizations() const { return s_->optimizations; }
+std::size_t GraphSlam::rejected_loop_closures() const { return s_->rejected_loops; }
 std::size_t GraphSlam::relocalized() const { return s_->relocalized; }
 const std::vector<GraphConstraint>& GraphSlam::constraints() const { return s_->constraints; }
 

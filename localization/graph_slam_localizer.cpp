@@ -47,6 +47,7 @@ class GraphSlamLocalizer final : public Localizer {
     return {{"nodes", double(slam_.nodes())},
             {"submaps", double(slam_.submaps())},
             {"loop_closures", double(slam_.loop_closures())},
+            {"rejected_loop_closures", double(slam_.rejected_loop_closures())},
             {"optimizations", double(slam_.optimizations())},
             {"relocalized_scans", double(slam_.relocalized())}};
   }

@@ -3,10 +3,14 @@
 #include <ceres/ceres.h>
 #include <ceres/cubic_interpolation.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <climits>
 #include <cstdint>
+#include <limits>
+#include <numbers>
 #include <unordered_set>
 
 #include "core/angle.h"
@@ -74,18 +78,22 @@ struct OccupiedSpaceCost {
   double weight_;
 };
 
+// The pull toward `target`: translation_weights (2x2, per metre) times the translation's offset,
+// rotation_weight times the rotation's.
 struct PriorCost {
-  PriorCost(const core::Pose2& target, double translation_weight, double rotation_weight)
-      : target_(target), tw_(translation_weight), rw_(rotation_weight) {}
+  PriorCost(const core::Pose2& target, const Eigen::Matrix2d& translation_weights, double rotation_weight)
+      : target_(target), tw_(translation_weights), rw_(rotation_weight) {}
   template <typename T>
   bool operator()(const T* pose, T* residual) const {
-    residual[0] = tw_ * (pose[0] - target_.x);
-    residual[1] = tw_ * (pose[1] - target_.y);
+    const T dx = pose[0] - target_.x, dy = pose[1] - target_.y;
+    residual[0] = tw_(0, 0) * dx + tw_(0, 1) * dy;
+    residual[1] = tw_(1, 0) * dx + tw_(1, 1) * dy;
     residual[2] = rw_ * (pose[2] - target_.theta);
     return true;
   }
   core::Pose2 target_;
-  double tw_, rw_;
+  Eigen::Matrix2d tw_;
+  double rw_;
 };
 
 }  // namespace
@@ -119,6 +127,59 @@ double match_score(const SubmapGrid& grid, const PointCloud& points, const core:
   double sum = 0.0;
   for (const auto& c : cells_at(points, pose.theta, pose.position(), grid.resolution())) sum += grid.probability(c.x(), c.y());
   return sum / double(points.size());
+}
+
+Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m) {
+  // The score read through the refinement's bicubic interpolation: smooth at shifts below a cell.
+  const GridAdapter adapter(grid);
+  const ceres::BiCubicInterpolator<GridAdapter> interpolator(adapter);
+  const double r = grid.resolution();
+  const auto score = [&](const core::Pose2& p) {
+    const double c = std::cos(p.theta), s = std::sin(p.theta);
+    double sum = 0.0;
+    for (const auto& q : points) {
+      const double x = c * q.x() - s * q.y() + p.x, y = s * q.x() + c * q.y() + p.y;
+      double value = 0.0;
+      interpolator.Evaluate(y / r - 0.5 - double(grid.min_y()), x / r - 0.5 - double(grid.min_x()), &value);
+      sum += value;
+    }
+    return points.empty() ? 0.0 : sum / double(points.size());
+  };
+  const double center = score(pose);
+  // Least squares for (a, b, c) in drop(u) = a ux^2 + 2 b ux uy + c uy^2 over unit directions u.
+  constexpr int kDirections = 8;
+  Eigen::Matrix<double, kDirections, 3> m;
+  Eigen::Matrix<double, kDirections, 1> drop;
+  for (int k = 0; k < kDirections; ++k) {
+    const double a = std::numbers::pi * k / kDirections;
+    const Eigen::Vector2d u(std::cos(a), std::sin(a));
+    const auto shifted = [&](double sign) {
+      return score(core::Pose2(pose.x + sign * step_m * u.x(), pose.y + sign * step_m * u.y(), pose.theta));
+    };
+    drop[k] = (center - 0.5 * (shifted(1.0) + shifted(-1.0))) / (step_m * step_m);
+    m.row(k) << u.x() * u.x(), 2.0 * u.x() * u.y(), u.y() * u.y();
+  }
+  const Eigen::Vector3d abc = m.colPivHouseholderQr().solve(drop);
+  Eigen::Matrix2d a;
+  a << abc[0], abc[1], abc[1], abc[2];
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(a);
+  const Eigen::Vector2d clamped = eigen.eigenvalues().cwiseMax(0.0);
+  return eigen.eigenvectors() * clamped.asDiagonal() * eigen.eigenvectors().transpose();
+}
+
+double score_advantage(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& a, const core::Pose2& b) {
+  if (points.size() < 2) return 0.0;
+  const auto ca = cells_at(points, a.theta, a.position(), grid.resolution());
+  const auto cb = cells_at(points, b.theta, b.position(), grid.resolution());
+  double sum = 0.0, sum2 = 0.0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double d = double(grid.probability(ca[i].x(), ca[i].y())) - double(grid.probability(cb[i].x(), cb[i].y()));
+    sum += d, sum2 += d * d;
+  }
+  const double n = double(points.size()), mean = sum / n;
+  const double error = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+  if (error == 0.0) return mean > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+  return mean / error;
 }
 
 MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
@@ -243,9 +304,22 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
   double best_score = o.min_score;
   // Depth-first: a candidate at level h covers offsets [dx, dx + 2^h) x [dy, dy + 2^h), and its
   // level-h score bounds every pose it covers.
+  // Whether every offset a candidate of `level` covers lies in the excluded disc (its four corners
+  // do, and the disc is convex).
+  auto excluded = [&](const Candidate& c, int level) {
+    if (!o.exclude_center) return false;
+    const int size = (1 << level) - 1;
+    for (int cy : {c.dy, c.dy + size}) {
+      for (int cx : {c.dx, c.dx + size}) {
+        if ((Eigen::Vector2d(center.x + cx * r, center.y + cy * r) - *o.exclude_center).norm() > o.exclude_radius_m) return false;
+      }
+    }
+    return true;
+  };
   auto search = [&](auto&& self, const std::vector<Candidate>& candidates, int level) -> void {
     for (const auto& c : candidates) {
       if (c.score <= best_score) break;
+      if (excluded(c, level)) continue;
       if (level == 0) {
         best = c, best_score = c.score;
         continue;
@@ -282,8 +356,27 @@ core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const
                                new OccupiedSpaceCost(grid, points, o.occupied_weight / std::sqrt(double(points.size()))),
                                int(points.size())),
                            nullptr, pose);
+  Eigen::Matrix2d translation_weights = o.translation_weight * Eigen::Matrix2d::Identity();
+  if (o.fixed_translation_weight >= 0.0) {
+    // The curvature is the whole scan's: points evenly spread through it estimate it for less.
+    constexpr std::size_t kCurvaturePoints = 100;
+    PointCloud spread;
+    const std::size_t stride = std::max<std::size_t>(1, points.size() / kCurvaturePoints);
+    for (std::size_t i = 0; i < points.size(); i += stride) spread.push_back(points[i]);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(score_curvature(grid, spread, initial, 0.5 * grid.resolution()));
+    const double largest = eigen.eigenvalues()[1];
+    Eigen::Vector2d w = Eigen::Vector2d::Constant(o.translation_weight);
+    if (largest > 0.0) {
+      // A residual's weight is the square root of its information, and the curvature is one.
+      for (int i = 0; i < 2; ++i) {
+        const double fixed = std::sqrt(std::max(0.0, eigen.eigenvalues()[i]) / largest);
+        w[i] = fixed * o.fixed_translation_weight + (1.0 - fixed) * o.translation_weight;
+      }
+    }
+    translation_weights = eigen.eigenvectors() * w.asDiagonal() * eigen.eigenvectors().transpose();
+  }
   problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(
-                               new PriorCost(core::Pose2(target.x, target.y, initial.theta), o.translation_weight, o.rotation_weight)),
+                               new PriorCost(core::Pose2(target.x, target.y, initial.theta), translation_weights, o.rotation_weight)),
                            nullptr, pose);
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;

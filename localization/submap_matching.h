@@ -78,6 +78,10 @@ struct BranchAndBoundOptions {
   // rotation_weight)^2) for its distance d (m) and turn a (rad) from the centre; 0: no prior.
   double translation_weight = 0.0;
   double rotation_weight = 0.0;
+  // Poses whose translation lies within exclude_radius_m of exclude_center (grid frame) are not
+  // answers: the search for a rival of a match found before, somewhere else.
+  std::optional<Eigen::Vector2d> exclude_center;
+  double exclude_radius_m = 0.0;
 };
 
 // The best pose within the window around `center` whose score exceeds min_score, found by branch
@@ -92,7 +96,21 @@ struct RefineOptions {
   double translation_weight = 10.0;
   double rotation_weight = 40.0;
   int max_iterations = 20;
+  // When >= 0, the translation's pull is this in the direction the points fix best and
+  // translation_weight in a direction they leave free, blended along each eigenvector of the
+  // score's curvature at `initial` (score_curvature) by the square root of its eigenvalue over the
+  // largest: the scan decides where it can, the prediction holds a corridor's length. Below 0:
+  // translation_weight everywhere.
+  double fixed_translation_weight = -1.0;
 };
+
+// How well a placement fixes the scan's position in each direction: the curvature of the mean
+// probability at the points (read through the bicubic interpolation refine_match uses) at `pose`
+// over translations (the heading held), the quadratic form u' A u fitted to its drop when the
+// scan moves by +-`step_m` (best below a cell) along eight directions u (per m^2; eigenvalues
+// clamped at 0). Olson 2009 (sec. IV-D) reads a match's covariance off the same score surface: along a
+// corridor whose ends are out of range the score hardly drops, across it it drops fast.
+Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m);
 
 // Least-squares refinement (Ceres, bicubic interpolation of the grid) from `initial`, its
 // translation pulled toward `target`'s and its rotation toward `initial`'s (as Cartographer: the
@@ -103,5 +121,9 @@ core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const
 
 // The mean probability of the grid at the points placed by `pose`.
 double match_score(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose);
+// How much better the points fit at `a` than at `b`, point by point: the mean of the differences
+// of the probabilities at each point, in standard errors of that mean (the differences' spread /
+// sqrt(points)). Two placements that explain the scan alike differ by a few errors at most.
+double score_advantage(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& a, const core::Pose2& b);
 
 }  // namespace fleetmap::localization

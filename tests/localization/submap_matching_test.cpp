@@ -1,0 +1,127 @@
+#include "localization/submap_matching.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+namespace fleetmap::localization {
+namespace {
+
+// The walls of a room open at the bottom, 2 m wide and 2 m deep, as points every 5 cm about
+// `origin`: the top wall, the two side walls and a post inside.
+PointCloud room(const Eigen::Vector2d& origin, bool with_sides) {
+  PointCloud out;
+  for (double t = -1.0; t <= 1.0 + 1e-9; t += 0.05) {
+    out.push_back(origin + Eigen::Vector2d(t, 1.0));
+    if (with_sides) {
+      out.push_back(origin + Eigen::Vector2d(-1.0, t));
+      out.push_back(origin + Eigen::Vector2d(1.0, t));
+    }
+  }
+  for (double t = -0.2; t <= 0.2 + 1e-9; t += 0.05) out.push_back(origin + Eigen::Vector2d(0.4 + t, 0.3));
+  return out;
+}
+
+// A submap holding the room at the origin and a second room 4 m to its right, each inserted as
+// seen from its centre ten times (so their walls are sure).
+SubmapGrid two_rooms(bool second_like_first) {
+  SubmapGrid grid;
+  for (int k = 0; k < 10; ++k) {
+    grid.insert({0.0, 0.0}, room({0.0, 0.0}, true));
+    grid.insert({4.0, 0.0}, room({4.0, 0.0}, second_like_first));
+  }
+  return grid;
+}
+
+// The rival check of a loop closure: the best match elsewhere in the window (farther than 1 m from
+// the match found), when the scan's points prefer the match to it by fewer than two standard errors.
+std::optional<MatchResult> rival_of(const SubmapGrid& grid, const PointCloud& scan, const core::Pose2& center,
+                                    const MatchResult& match) {
+  BranchAndBoundOptions o;
+  o.exclude_center = match.pose.position();
+  o.exclude_radius_m = 1.0;
+  const auto rival = branch_and_bound_match(PrecomputedGrids(grid, 7), scan, center, o);
+  if (rival && score_advantage(grid, scan, match.pose, rival->pose) < 2.0) return rival;
+  return std::nullopt;
+}
+
+TEST(BranchAndBound, ARoomRepeatedElsewhereInTheWindowIsARivalOfTheMatch) {
+  const SubmapGrid grid = two_rooms(true);
+  const PointCloud scan = room({0.0, 0.0}, true);  // the sensor at a room's centre
+  const core::Pose2 center(2.0, 0.0, 0.0);          // halfway: both rooms in the 7 m window
+  const PrecomputedGrids grids(grid, 7);
+  BranchAndBoundOptions o;
+  o.min_score = 0.0;
+  const auto match = branch_and_bound_match(grids, scan, center, o);
+  ASSERT_TRUE(match);
+  const double x = match->pose.x;
+  EXPECT_TRUE(std::abs(x) < 0.1 || std::abs(x - 4.0) < 0.1) << match->pose;
+  EXPECT_NEAR(match->pose.y, 0.0, 0.1);
+  const auto rival = rival_of(grid, scan, center, *match);
+  ASSERT_TRUE(rival) << "the other room is as good a match";
+  EXPECT_NEAR(std::abs(rival->pose.x - x), 4.0, 0.1) << rival->pose;
+  EXPECT_NEAR(rival->pose.y, 0.0, 0.1);
+}
+
+TEST(BranchAndBound, AMatchWithNoLikePlaceInTheWindowHasNoRival) {
+  const SubmapGrid grid = two_rooms(false);  // the second room has no side walls
+  const PointCloud scan = room({0.0, 0.0}, true);
+  const core::Pose2 center(2.0, 0.0, 0.0);
+  BranchAndBoundOptions o;
+  o.min_score = 0.0;
+  const auto match = branch_and_bound_match(PrecomputedGrids(grid, 7), scan, center, o);
+  ASSERT_TRUE(match);
+  EXPECT_NEAR(match->pose.x, 0.0, 0.1) << match->pose;
+  EXPECT_NEAR(match->pose.y, 0.0, 0.1);
+  EXPECT_FALSE(rival_of(grid, scan, center, *match));
+}
+
+TEST(BranchAndBound, ExcludedPosesAreNeverTheAnswer) {
+  const SubmapGrid grid = two_rooms(false);
+  const PointCloud scan = room({0.0, 0.0}, true);
+  BranchAndBoundOptions o;
+  o.min_score = 0.0;
+  o.exclude_center = Eigen::Vector2d(0.0, 0.0);
+  o.exclude_radius_m = 1.0;
+  const auto found = branch_and_bound_match(PrecomputedGrids(grid, 7), scan, core::Pose2(2.0, 0.0, 0.0), o);
+  ASSERT_TRUE(found);
+  EXPECT_GT(found->pose.position().norm(), 1.0) << found->pose;
+}
+
+// A corridor 2 m wide along x, 20 m long (its walls through the middle of a row of cells), seen from
+// its middle with its ends out of sight.
+SubmapGrid corridor() {
+  SubmapGrid grid;
+  for (double x0 = -8.0; x0 <= 8.0; x0 += 1.0) {
+    PointCloud walls;
+    for (double t = -3.0; t <= 3.0 + 1e-9; t += 0.05) walls.push_back({x0 + t, 1.025}), walls.push_back({x0 + t, -1.025});
+    for (int k = 0; k < 5; ++k) grid.insert({x0, 0.0}, walls);
+  }
+  return grid;
+}
+
+PointCloud corridor_scan() {
+  PointCloud out;
+  for (double t = -3.0; t <= 3.0 + 1e-9; t += 0.05) out.push_back({t, 1.025}), out.push_back({t, -1.025});
+  return out;
+}
+
+TEST(ScoreCurvature, ACorridorsMatchIsFixedAcrossItAndFreeAlongIt) {
+  const Eigen::Matrix2d a = score_curvature(corridor(), corridor_scan(), core::Pose2(0.0, 0.0, 0.0), 0.025);
+  EXPECT_GT(a(1, 1), 0.0);
+  EXPECT_LT(a(0, 0), 0.05 * a(1, 1)) << a;
+}
+
+TEST(RefineMatch, TheScanFixesTheCorridorsWidthAndThePredictionItsLength) {
+  const SubmapGrid grid = corridor();
+  // The prediction is 0.3 m along and 4 cm across from the truth (the origin).
+  const core::Pose2 prediction(0.3, 0.04, 0.0);
+  RefineOptions o;
+  o.fixed_translation_weight = 1.0;
+  const core::Pose2 refined = refine_match(grid, corridor_scan(), prediction, prediction, o);
+  EXPECT_NEAR(refined.y, 0.0, 0.015) << refined;  // the walls decide across (a third of a cell)
+  EXPECT_NEAR(refined.x, 0.3, 0.02) << refined;   // nothing along: the prediction holds
+}
+
+}  // namespace
+}  // namespace fleetmap::localization
