@@ -152,6 +152,12 @@ Command add_slam_command(CLI::App& root) {
   app->add_option("--method", f->log.method, "With --log: the SLAM method [default: graph-slam]")
       ->needs(log)
       ->check(one_of(experiments::log_slam_methods()));
+  app->add_option("--set", f->log.set,
+                  "With --log: a parameter of the method, localization.KEY=VALUE (repeat for more), e.g. --set "
+                  "localization.scans_per_submap=40; `fleetmap plugins --family localization` lists them")
+      ->needs(log)
+      ->expected(1)
+      ->take_all();
   app->add_option("--relations", f->log.relations,
                   "With --log: reference relations (`t1 t2 x y z roll pitch yaw`) to score the trajectory against")
       ->needs(log)

@@ -95,6 +95,15 @@ std::string slam_log_help() {
 int run_slam_log(const SlamLogFlags& f) {
   const fs::path log(f.log);
   const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + log_name(log)) : fs::path(f.out);
+  core::Settings settings;
+  for (const auto& text : f.set) {
+    const auto a = core::parse_param_assignment(text, "--set " + text);
+    if (a.family != "localization") {
+      throw InputError("--set " + text + ": slam --log takes localization.KEY=VALUE, not " + a.family + "." + a.key);
+    }
+    settings.emplace_back(a.key, a.value);
+  }
+  const core::Params params = localization::localizer_options(f.method, settings);  // refused before anything is written
   std::vector<fs::path> inputs{log};
   if (!f.relations.empty()) inputs.emplace_back(f.relations);
   io::OutputFolder folder(out, "slam", std::vector<std::string>(std::begin(kOutputs), std::end(kOutputs)), inputs,
@@ -104,6 +113,7 @@ int run_slam_log(const SlamLogFlags& f) {
 
   experiments::LogSlamOptions o;
   o.method = f.method;
+  o.localizer_settings = settings;
   if (f.seed) o.seed = *f.seed;
   const auto wall0 = std::chrono::steady_clock::now();
   const double cpu0 = cpu_seconds();
@@ -121,6 +131,7 @@ int run_slam_log(const SlamLogFlags& f) {
   m["log"] = log.filename().string();
   m["format"] = r.format;
   m["method"] = o.method;
+  for (const auto& spec : params.specs()) m["parameters"][spec.name] = params.value_text(spec.name);
   m["seed"] = o.seed;
   m["scans"] = r.trajectory.size();
   m["log_duration_s"] = r.log_duration_s;

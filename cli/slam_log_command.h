@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace fleetmap::cli {
 
@@ -14,6 +15,7 @@ struct SlamLogFlags {
   std::optional<std::uint64_t> seed;
   std::string out;        // empty: out/slam_<log name>
   bool quiet = false;
+  std::vector<std::string> set;  // --set localization.KEY=VALUE: the method's own parameters
 };
 
 // The --help text of the log mode (methods, outputs).

@@ -19,6 +19,7 @@ namespace {
 localization::LocalizerContext context_for(const LogSlamOptions& o) {
   localization::LocalizerContext c;
   c.options = o.localizer;
+  c.params = localization::localizer_options(o.method, o.localizer_settings);
   c.seed = o.seed;
   return c;  // the first scan at the origin; no known map, no landmarks
 }

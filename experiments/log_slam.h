@@ -22,6 +22,8 @@ struct LogSlamOptions {
   // cost time and add little to an indoor map. Cartographer's 2D default.
   double mapping_range_m = 30.0;
   std::uint64_t seed = 1;
+  // The method's own parameters (localization::localizer_options), as given.
+  core::Settings localizer_settings;
   io::LaserLogOptions log;
   // Particles and noise. A real robot's odometry over the motion between two scans is far less
   // sure than the simulator's default: 5 cm and 0.05 rad (3 degrees) per step, the scale of

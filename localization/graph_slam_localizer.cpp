@@ -9,9 +9,23 @@ namespace fleetmap::localization {
 
 namespace {
 
+// The declared parameters (localizer_registry.cpp) over GraphSlamOptions' defaults.
+GraphSlamOptions options_from(const core::Params& p) {
+  GraphSlamOptions o;
+  if (p.specs().empty()) return o;
+  o.max_range_m = p.number("max_range");
+  o.scans_per_submap = int(p.number("scans_per_submap"));
+  o.insert_min_distance_m = p.number("insert_min_distance");
+  o.max_constraint_distance_m = p.number("max_constraint_distance");
+  o.loop_sampling_ratio = p.number("loop_sampling_ratio");
+  o.loop_rival_errors = p.number("loop_rival_errors");
+  o.huber_scale = p.number("huber_scale");
+  return o;
+}
+
 class GraphSlamLocalizer final : public Localizer {
  public:
-  explicit GraphSlamLocalizer(const LocalizerContext& c) : slam_(GraphSlamOptions{}, c.initial_pose), pose_(c.initial_pose) {
+  explicit GraphSlamLocalizer(const LocalizerContext& c) : slam_(options_from(c.params), c.initial_pose), pose_(c.initial_pose) {
     const double xy = c.options.initial_xy, th = c.options.initial_theta;
     covariance_ = Eigen::Vector3d(xy * xy, xy * xy, th * th).asDiagonal();
   }

@@ -55,7 +55,20 @@ core::Registry<LocalizerFactory>& localizer_registry() {
     r.add("graph-slam",
           "graph SLAM: scans matched to submaps (correlative search + least squares), loop closures by branch and "
           "bound, pose graph with a robust loss on Ceres (Hess et al. 2016)",
-          make_graph_slam_localizer);
+          make_graph_slam_localizer,
+          // Defaults: GraphSlamOptions' (graph_slam.h), chosen on the training logs.
+          {ParamSpec::number("max_range", 30, {0.1, 1e3}, "m", "beams are used up to this range"),
+           ParamSpec::number("scans_per_submap", 30, {1, 1e4, true}, "",
+                             "a new submap starts every this many inserted scans (each takes twice as many)"),
+           ParamSpec::number("insert_min_distance", 0.2, {0, 1e3}, "m",
+                             "a scan joins the submaps when the robot moved this far since the last one"),
+           ParamSpec::number("max_constraint_distance", 15, {0, 1e6}, "m",
+                             "loop closures are searched between scans and submaps at most this far apart"),
+           ParamSpec::number("loop_sampling_ratio", 0.1, {0, 1}, "", "share of (scan, submap) pairs searched for closures"),
+           ParamSpec::number("loop_rival_errors", 2, {0, 1e3}, "",
+                             "a closure is refused unless it beats a rival match elsewhere by this many standard errors"),
+           ParamSpec::number("huber_scale", 30, {1e-3, 1e6}, "",
+                             "loop closures' robust loss scale, in standard deviations")});
     r.add("fastslam2",
           "FastSLAM 2.0: particles over the path, an EKF per landmark in each, proposal including the readings "
           "(Montemerlo et al. 2003)",

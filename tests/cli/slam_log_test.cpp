@@ -52,6 +52,19 @@ TEST(SlamLogCommand, WritesTheMapTrajectoryAndMetrics) {
   EXPECT_GT(m["log_duration_s"].get<double>(), 0.0);
   EXPECT_GT(m["distance_m"].get<double>(), 10.0);
   EXPECT_TRUE(m.contains("real_time_factor"));
+  EXPECT_EQ(m["parameters"]["scans_per_submap"], "30");
+}
+
+// The method's declared parameters reach it: submaps of 5 scans make another graph, and say so.
+TEST(SlamLogCommand, SetGivesTheMethodItsParameters) {
+  TempDir dir;
+  LogFiles files(dir);
+  const auto a = run_fleetmap("slam --log sim.log --out a -q", dir);
+  const auto b = run_fleetmap("slam --log sim.log --set localization.scans_per_submap=5 --out b -q", dir);
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir / "b" / "metrics.json"))["parameters"]["scans_per_submap"], "5");
+  EXPECT_NE(slurp(dir / "a" / "trajectory.txt"), slurp(dir / "b" / "trajectory.txt"));
 }
 
 TEST(SlamLogCommand, SameLogAndSeedGiveTheSameBytes) {
@@ -120,6 +133,11 @@ TEST(SlamLogCommand, BadInputGetsOneLineAndWritesNothing) {
   EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --log sim.log --method magic --out o", dir), "magic");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --log sim.log --runs 3 --out o", dir), "--runs");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --method rbpf --out o", dir), "--log");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --log sim.log --set localization.scans_per_submp=5 --out o", dir),
+                        "did you mean 'scans_per_submap'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --log sim.log --method rbpf --set localization.huber_scale=5 --out o", dir),
+                        "localization 'rbpf' has no parameter 'huber_scale'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --log sim.log --set strategy.beta=1 --out o", dir), "localization.KEY=VALUE");
   EXPECT_FALSE(std::filesystem::exists(dir / "o"));
 }
 
