@@ -439,7 +439,9 @@ Command add_explore_command(CLI::App& root) {
       exploration::strategy_help() + "\nLocalization (--localization):\n" + localization::localizer_help() +
       "\nMerging (--merging): how robots bring each other's maps into their own frame (all but known: each "
       "robot maps in its own frame until it merges)\n" +
-      merging::map_aligner_registry().help());
+      merging::map_aligner_registry().help() +
+      "\nPath planners (--path-planner): wave (the wave's steepest descent, the default) or\n" + planning::planner_help() +
+      "\nEvery parameter line above is set by --set FAMILY.KEY=VALUE (strategy, localization, merging, planner).\n");
   auto f = std::make_shared<ExploreFlags>();
   app->add_option("--scenario", f->scenario, "Scenario YAML file (see scenarios/); flags below override it")
       ->check(CLI::ExistingFile);
