@@ -129,7 +129,7 @@ int run(const Options& o) {
   for (const auto& [map, grid] : grids)
     for (const auto& strategy : o.strategies)
       for (const int robots : o.robots)
-        for (int s = 0; s < o.seeds; ++s) runs.push_back({map, strategy, robots, std::uint64_t(1 + s), 0.0, false, {}, {}, 0.0, {}});
+        for (int s = 0; s < o.seeds; ++s) runs.push_back({map, strategy, robots, std::uint64_t(1 + s), 0.0, false, {}, {}, 0.0, {}, 0, {}, {}});
   int done = 0;
   const auto progress = [&](int) {
     if (++done % 25 == 0 || done == int(runs.size())) fmt::print(stderr, "{} of {} runs\n", done, runs.size());
