@@ -4,7 +4,9 @@
 // itself. Prints, per strategy and team size, the runs below 99% or not finished, the efficiency
 // (lower bound / steps to 99%) as mean with its 95% confidence interval and as median, the median
 // ratio of the step a run ended at to the step it reached 99%, the median share of robot-steps
-// blocked, and every run that fell short with what it left (metrics.json's "unexplored"). Exit
+// blocked, per run what the explorer's approaches came to (targets reached, of them reached with
+// the unseen cell still unseen; given up stalled or cut off; frontiers abandoned), and every run
+// that fell short with what it left (metrics.json's "unexplored"). Exit
 // status 1 when a run fell short, 2 on bad arguments. Results: bench/README.md, "## Real floor
 // plans" and "## Exploring real laser maps".
 //
@@ -98,6 +100,9 @@ struct Run {
   std::optional<double> end_over_99;  // the step it ended at / the step it reached 99%
   double blocked_share = 0.0;         // blocked moves per robot-step
   std::string left;  // what a run that fell short left
+  int steps = 0;
+  std::optional<int> steps_to_99;
+  exploration::TeamExplorer::Stats stats;
 };
 
 double median(std::vector<double> v) {
@@ -124,7 +129,7 @@ int run(const Options& o) {
   for (const auto& [map, grid] : grids)
     for (const auto& strategy : o.strategies)
       for (const int robots : o.robots)
-        for (int s = 0; s < o.seeds; ++s) runs.push_back({map, strategy, robots, std::uint64_t(1 + s), 0.0, false, {}, {}, 0.0, {}});
+        for (int s = 0; s < o.seeds; ++s) runs.push_back({map, strategy, robots, std::uint64_t(1 + s), 0.0, false, {}, {}, 0.0, {}, 0, {}, {}});
   int done = 0;
   const auto progress = [&](int) {
     if (++done % 25 == 0 || done == int(runs.size())) fmt::print(stderr, "{} of {} runs\n", done, runs.size());
@@ -143,6 +148,9 @@ int run(const Options& o) {
     const sim::RunResult result = simulation.run();
     r.coverage = result.coverage.back();
     r.finished = result.finished;
+    r.steps = result.steps;
+    r.steps_to_99 = result.steps_to_99;
+    r.stats = result.exploration;
     sweep::LowerBoundOptions lb;
     lb.sensor_range_m = s.range.max_range_m;
     lb.step_length_m = s.robot.max_speed_mps * s.period_s;
@@ -185,6 +193,15 @@ int run(const Options& o) {
                  bad, 100.0 * lowest, lowest_map, e.mean, e.ci_low, e.ci_high, median(efficiency), median(end_ratio),
                  median(blocked));
     }
+  }
+  // Per run: what the explorer did (reached targets, of them unobservable; given up stalled / cut off).
+  for (const auto& r : runs) {
+    fmt::print("run: {} {} {} robots seed {}: {:.2f}%{}, 99% at {}, efficiency {:.3f}, targets reached {} (unobservable {}), "
+               "given up {} (stalled {}, cut off {}), abandoned {}\n",
+               r.map, r.strategy, r.robots, r.seed, 100.0 * r.coverage, r.finished ? fmt::format(", ended at {}", r.steps) : ", step limit",
+               r.steps_to_99 ? std::to_string(*r.steps_to_99) : std::string("-"), r.efficiency.value_or(0.0),
+               r.stats.targets_reached, r.stats.unobservable, r.stats.targets_given_up, r.stats.given_up_stalled,
+               r.stats.given_up_unreachable, r.stats.frontiers_abandoned);
   }
   for (const auto& r : runs) {
     if (r.coverage >= 0.99 && r.finished) continue;
