@@ -94,8 +94,10 @@ std::string ParamSpec::expected() const {
 }
 
 std::string ParamSpec::describe() const {
-  return name + " = " + default_value + (type == Type::Number && !unit.empty() ? " " + unit : "") + "  (" +
-         expected() + "): " + doc;
+  // The unit follows the default, so the accepted numbers need not repeat it.
+  const bool with_unit = type == Type::Number && !unit.empty();
+  return name + " = " + default_value + (with_unit ? " " + unit : "") + "  (" +
+         (with_unit ? expected_text(range) : expected()) + "): " + doc;
 }
 
 Params::Params(std::string owner, std::vector<ParamSpec> specs) : owner_(std::move(owner)), specs_(std::move(specs)) {
