@@ -138,8 +138,9 @@ std::string scenario_to_yaml(const Scenario& scenario, const std::filesystem::pa
 // localizer meets). Throws InputError naming the key.
 void validate_scenario(const Scenario& scenario);
 
-// A family whose members declare parameters that a scenario sets: its name in `--set` and
-// `--vary` (strategy, localization, merging), the member the scenario chose and the settings given to it.
+// A family whose members declare parameters that a scenario sets: its name in `--set` and `--vary`
+// (strategy, localization, planner, merging), the member the scenario chose and the settings
+// given to it.
 struct ParameterFamily {
   std::string name;
   std::string group;  // the scenario key whose mapping holds the member's name and parameters, dotted
