@@ -931,7 +931,7 @@ int main(int argc, char** argv) {
           try {
             merging::CropPair c = merging::make_crop_pair(m.map, crop, random);
             clutter_pair(c.a, c.b, random);
-            pairs.push_back(std::make_unique<Pair>(Pair{"house300", m.id, f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+            pairs.push_back(std::make_unique<Pair>(Pair{"house300", m.id, f, std::move(c.a), std::move(c.b), c.b_to_a, {}, {}}));
             break;
           } catch (const Error&) {
             // This plan has no such windows (too small for this overlap): the next one.
@@ -982,7 +982,7 @@ int main(int argc, char** argv) {
             core::Transform2 truth = c.b_to_a;
             if (args.two_robots_mixed > 1) mix_resolutions(b, {&truth, &reference}, args.two_robots_mixed, random);
             pairs.push_back(std::make_unique<Pair>(
-                Pair{"house300x2", maps[i].id, f, std::move(c.a), std::move(b), truth, reference}));
+                Pair{"house300x2", maps[i].id, f, std::move(c.a), std::move(b), truth, reference, {}}));
             break;
           } catch (const Error&) {
           }
@@ -1003,7 +1003,7 @@ int main(int argc, char** argv) {
           merging::CropPair cj = merging::make_crop_pair(maps[j].map, single, random);
           clutter_pair(ci.a, cj.b, random);
           pairs.push_back(std::make_unique<Pair>(
-              Pair{"unrelated", maps[i].id + "/" + maps[j].id, 0.0, std::move(ci.a), std::move(cj.b), std::nullopt, {}}));
+              Pair{"unrelated", maps[i].id + "/" + maps[j].id, 0.0, std::move(ci.a), std::move(cj.b), std::nullopt, {}, {}}));
           break;
         } catch (const Error&) {
         }
@@ -1024,7 +1024,7 @@ int main(int argc, char** argv) {
             try {
               merging::CropPair c = merging::make_crop_pair(map, window, random);
               if (args.real_mixed > 1) mix_resolutions(c, args.real_mixed, random);
-              pairs.push_back(std::make_unique<Pair>(Pair{set, name, f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+              pairs.push_back(std::make_unique<Pair>(Pair{set, name, f, std::move(c.a), std::move(c.b), c.b_to_a, {}, {}}));
             } catch (const Error&) {
               missing += fmt::format("{}{}%", missing.empty() ? "" : ", ", overlap_percent(f));
               break;
@@ -1065,7 +1065,7 @@ int main(int argc, char** argv) {
       for (int k = 0; k < args.campus_pairs; ++k) {
         merging::CropPair c = merging::make_crop_pair(campus, campus_crop, random);
         clutter_pair(c.a, c.b, random);
-        pairs.push_back(std::make_unique<Pair>(Pair{"campus1000", "campus", f, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+        pairs.push_back(std::make_unique<Pair>(Pair{"campus1000", "campus", f, std::move(c.a), std::move(c.b), c.b_to_a, {}, {}}));
       }
     }
     if (args.large_pairs > 0) {
@@ -1077,7 +1077,7 @@ int main(int argc, char** argv) {
       for (int k = 0; k < args.large_pairs; ++k) {
         big.overlap = k % 2 ? 0.2 : 0.5;
         merging::CropPair c = merging::make_crop_pair(fine, big, random);
-        pairs.push_back(std::make_unique<Pair>(Pair{"campus4000", "campus", big.overlap, std::move(c.a), std::move(c.b), c.b_to_a, {}}));
+        pairs.push_back(std::make_unique<Pair>(Pair{"campus4000", "campus", big.overlap, std::move(c.a), std::move(c.b), c.b_to_a, {}, {}}));
       }
     }
 
