@@ -538,6 +538,10 @@ PYBIND11_MODULE(_fleetmap, m) {
       "Every way robots bring a teammate's map into their frame (scenario merging), built-in and registered: a "
       "list of {name, help, params} as strategies() gives them (merging: {mode: ..., KEY: VALUE}, --set "
       "merging.KEY=VALUE).");
+  m.def(
+      "planners", [] { return registry_members(planning::planner_registry()); },
+      "Every path planner, built-in and registered: a list of {name, help, params} as strategies() gives them "
+      "(plan_path's `planner` and `params`, fleetmap plan --set planner.KEY=VALUE).");
   m.def("planner_names", &planning::planner_names, "Every path planner's name (plan_path's `planner`).");
   m.def("merge_method_names", &merging::merge_method_names, "Every merge method's name (merge_maps's `method`).");
 
@@ -667,18 +671,19 @@ PYBIND11_MODULE(_fleetmap, m) {
   m.def(
       "_plan_path",
       [](const mapping::OccupancyGrid& map, std::pair<double, double> start, std::pair<double, double> goal,
-         const std::string& planner, double robot_radius, double time_budget, std::uint64_t seed) {
+         const std::string& planner, double robot_radius, double time_budget, std::uint64_t seed,
+         const core::Settings& params) {
+        auto made = planning::make_planner(planner, params);  // a bad parameter is refused before any work
         planning::FreeSpaceOptions space_options;
         space_options.robot_radius_m = robot_radius;
         const planning::FreeSpace space(map, space_options);
         planning::PlannerOptions options;
         options.time_budget_s = time_budget;
         options.seed = seed;
-        return planning::make_planner(planner)->plan(space, {start.first, start.second}, {goal.first, goal.second},
-                                                     options);
+        return made->plan(space, {start.first, start.second}, {goal.first, goal.second}, options);
       },
       py::arg("map"), py::arg("start"), py::arg("goal"), py::arg("planner"), py::arg("robot_radius"),
-      py::arg("time_budget"), py::arg("seed"), py::call_guard<py::gil_scoped_release>());
+      py::arg("time_budget"), py::arg("seed"), py::arg("params"), py::call_guard<py::gil_scoped_release>());
 
   m.def("_register_strategy", &register_python_strategy, py::arg("name"), py::arg("cls"), py::arg("help"),
         py::arg("joint"), py::arg("with_context"), py::arg("params"));

@@ -55,6 +55,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
     strategies,
     localizers,
     map_aligners,
+    planners,
     strategy_names,
     keep_freed_memory,
 )
@@ -62,7 +63,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
 __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
     "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
-    "map_names", "strategies", "localizers", "map_aligners", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
+    "map_names", "strategies", "localizers", "map_aligners", "planners", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
 ]
 
 # The built-in maps ship beside the installed package (share/fleetmap/maps); the C++ side looks
@@ -256,15 +257,19 @@ def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5
 
 
 def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: str = "astar",
-              robot_radius: float = 0.2, time_budget: float = 1.0, seed: int = 1) -> PlanResult:
+              robot_radius: float = 0.2, time_budget: float = 1.0, seed: int = 1,
+              params: Mapping[str, Any] | None = None) -> PlanResult:
     """Plans a path for a round robot from `start` to `goal` (x, y in metres) on `map`, unknown
-    cells counting as obstacles. `planner` is one of planner_names(). The result's `path` is an
-    (N, 2) array of waypoints; `status` says why there is none."""
+    cells counting as obstacles. `planner` is one of planner_names(); `params` its own parameters
+    (planners() lists them, e.g. {"look_ahead": 1.0} for "reactive"), checked as `fleetmap plan
+    --set planner.KEY=VALUE` checks them. The result's `path` is an (N, 2) array of waypoints;
+    `status` says why there is none."""
     if not isinstance(map, Map):
         got = "None (a merge_maps result that did not merge has no map)" if map is None else type(map).__name__
         raise InputError(f"plan_path: map must be a fleetmap.Map, got {got}")
+    settings = [(str(k), ("true" if v else "false") if isinstance(v, bool) else str(v)) for k, v in (params or {}).items()]
     return _fleetmap._plan_path(map, (float(start[0]), float(start[1])), (float(goal[0]), float(goal[1])),
-                                planner, float(robot_radius), float(time_budget), int(seed))
+                                planner, float(robot_radius), float(time_budget), int(seed), settings)
 
 
 def _takes_context(name: str, cls: Any) -> bool:

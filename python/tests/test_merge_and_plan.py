@@ -108,6 +108,24 @@ class MergeTest(unittest.TestCase):
         self.assertTrue(path.success, path.detail)
         self.assertGreater(path.path[:, 0].max(), 6.5)
 
+    def test_a_planners_own_parameters_reach_it_and_are_checked(self):
+        room = np.full((60, 80), 254, np.uint8)
+        room[[0, -1], :] = 0
+        room[:, [0, -1]] = 0
+        room[10:50, 38:42] = 0  # a wall in the way
+        grid = fleetmap.Map.from_image(room, 0.1)
+        reactive = {p["name"]: p for p in fleetmap.planners()}["reactive"]
+        self.assertIn("turn_angle_deg", [p["name"] for p in reactive["params"]])
+        narrow = fleetmap.plan_path(grid, (1.0, 3.0), (7.0, 3.0), planner="reactive")
+        wide = fleetmap.plan_path(grid, (1.0, 3.0), (7.0, 3.0), planner="reactive", params={"turn_angle_deg": 20})
+        self.assertTrue(narrow.success, narrow.detail)
+        self.assertTrue(wide.success, wide.detail)
+        self.assertNotAlmostEqual(narrow.length_m, wide.length_m, places=3)  # another swerve around the wall
+        with self.assertRaisesRegex(fleetmap.InputError, "planner 'astar' has no parameter 'turn_angle_deg'"):
+            fleetmap.plan_path(grid, (1.0, 3.0), (7.0, 3.0), params={"turn_angle_deg": 30})
+        with self.assertRaisesRegex(fleetmap.InputError, "turn_angle_deg"):
+            fleetmap.plan_path(grid, (1.0, 3.0), (7.0, 3.0), planner="reactive", params={"turn_angle_deg": 500})
+
     def test_a_merge_refused_has_no_map_and_planning_on_it_says_so(self):
         empty = np.full((60, 60), 205, np.uint8)
         empty[10:50, 10:50] = 254
