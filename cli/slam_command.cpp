@@ -49,7 +49,8 @@ std::string method_names() { return core::join(experiments::slam_method_names())
 // Refuses each of `unused` that was given: the scenario's experiment has no use for it.
 void refuse_unused_flags(const SlamFlags& f, const std::string& experiment, const std::vector<std::string>& unused) {
   const std::pair<const char*, bool> given[] = {
-      {"--runs", f.runs.has_value()}, {"--jobs", f.jobs.has_value()}, {"--sampled-start", f.sampled_start}, {"--exact-start", f.exact_start}};
+      {"--runs", f.runs.has_value()}, {"--jobs", f.jobs.has_value()}, {"--sampled-start", f.sampled_start},
+      {"--exact-start", f.exact_start}, {"--set", !f.log.set.empty()}};
   for (const auto& [flag, set] : given) {
     if (set && std::find(unused.begin(), unused.end(), flag) != unused.end()) {
       throw InputError(std::string(flag) + " does not apply to " +
@@ -70,12 +71,12 @@ int run_slam(SlamFlags f) {
   const fs::path out = f.out.empty() ? fs::path("out") / ("slam_" + fs::path(f.scenario).stem().string()) : fs::path(f.out);
   // The corridor loop of León et al. (experiment: leon_corridor) has its own runner.
   if (is_corridor_scenario_file(f.scenario)) {
-    refuse_unused_flags(f, "leon_corridor", {"--runs", "--jobs", "--sampled-start", "--exact-start"});
+    refuse_unused_flags(f, "leon_corridor", {"--runs", "--jobs", "--sampled-start", "--exact-start", "--set"});
     return run_corridor_scenario(f.scenario, out, f.seed, f.quiet);
   }
   // The map-alignment paper's experiments (experiment: landmark_alignment) too.
   if (is_landmark_scenario_file(f.scenario)) {
-    refuse_unused_flags(f, "landmark_alignment", {"--sampled-start", "--exact-start"});
+    refuse_unused_flags(f, "landmark_alignment", {"--sampled-start", "--exact-start", "--set"});
     return run_landmark_scenario(f.scenario, out, f.runs, f.seed, f.jobs.value_or(1), f.quiet);
   }
   experiments::SlamScenario s = experiments::load_slam_scenario(f.scenario);
@@ -83,6 +84,20 @@ int run_slam(SlamFlags f) {
   if (f.seed) s.seed = *f.seed;
   if (f.sampled_start) s.sampled_start = true;
   if (f.exact_start) s.sampled_start = false;
+  for (const auto& text : f.log.set) {
+    const auto a = core::parse_param_assignment(text, "--set " + text);
+    if (a.family != "method") {
+      throw InputError("--set " + text + ": a SLAM scenario takes method.KEY=VALUE (the parameters of its method '" +
+                       s.method + "'), not " + a.family + "." + a.key);
+    }
+    std::erase_if(s.method_settings, [&](const auto& kv) { return kv.first == a.key; });
+    s.method_settings.emplace_back(a.key, a.value);
+    try {
+      experiments::make_slam_method(s.method, s.method_settings);
+    } catch (const InputError& e) {
+      throw InputError("--set " + text + ": " + e.what());
+    }
+  }
   io::OutputFolder folder(out, "slam", experiments::slam_output_files(s), {f.scenario}, "--out " + out.string());
   const experiments::SlamSetup setup = experiments::prepare_slam(s);
   folder.claim();
@@ -134,7 +149,9 @@ Command add_slam_command(CLI::App& root) {
       "table1.csv, runs.csv, rendezvous.csv, and the first run's maps as map_<robot>.png (and map_<robot>_alone.png\n"
       "for the scenario's single_robot). Scenario keys: scenarios/dalfonso_3robots.yaml (commented) and README.md,\n\"Polynomial SLAM (D'Alfonso et al.)\".\n\n"
       "Methods (the scenario's `method`): " + method_names() +
-      "\n  polynomial: D'Alfonso et al.'s polynomial EKF-SLAM with polynomial map exchange at rendezvous\n\n"
+      "\n  polynomial: D'Alfonso et al.'s polynomial EKF-SLAM with polynomial map exchange at rendezvous\n"
+      "A method's parameters are set in the scenario (`method: {name: polynomial, order: 2}`, or the\n"
+      "`polynomial:` block) or with --set method.order=2; `fleetmap plugins --family slam-method` lists them.\n\n"
       "Example: fleetmap slam --scenario scenarios/dalfonso_3robots.yaml --runs 100 --jobs 2 --out out/dalfonso\n\n"
       "Scenarios with `experiment: leon_corridor` (scenarios/leon_corridor.yaml) run León et al.'s corridor comparison\n"
       "and merging by detection instead (--runs, --jobs, --sampled-start and --exact-start do not apply);\n"
@@ -153,9 +170,10 @@ Command add_slam_command(CLI::App& root) {
       ->needs(log)
       ->check(one_of(experiments::log_slam_methods()));
   app->add_option("--set", f->log.set,
-                  "With --log: a parameter of the method, localization.KEY=VALUE (repeat for more), e.g. --set "
-                  "localization.scans_per_submap=40; `fleetmap plugins --family localization` lists them")
-      ->needs(log)
+                  "A parameter of the method (repeat for more). With --log: localization.KEY=VALUE, e.g. --set "
+                  "localization.scans_per_submap=40 (`fleetmap plugins --family localization` lists them); with a "
+                  "SLAM scenario: method.KEY=VALUE, e.g. --set method.order=2 (`fleetmap plugins --family "
+                  "slam-method`)")
       ->expected(1)
       ->take_all();
   app->add_option("--relations", f->log.relations,

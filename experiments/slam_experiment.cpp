@@ -95,7 +95,8 @@ std::vector<localization::Odometry> path_commands(const core::Pose2& start, cons
 
 SlamSetup prepare_slam(const SlamScenario& scenario) {
   validate_slam_scenario(scenario);
-  SlamSetup setup{scenario, sim::World(rasterize_room(scenario.room), {}), room_walls(scenario.room), {}, {}};
+  SlamSetup setup{scenario, make_slam_method(scenario.method, scenario.method_settings),
+                  sim::World(rasterize_room(scenario.room), {}), room_walls(scenario.room), {}, {}};
   for (std::size_t i = 0; i < scenario.robots.size(); ++i) {
     const SlamRobot& r = scenario.robots[i];
     const std::string key = "robots.team[" + std::to_string(i) + "] (" + r.name + ")";
@@ -219,7 +220,8 @@ class PolynomialExchange {
 
 // D'Alfonso et al.'s polynomial SLAM, one filter per robot, on the simulator: each robot in its own
 // frame R_j,0, driven by its precomputed commands, its camera on a stream of its own.
-SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange, int only) {
+SlamRunResult run_polynomial_slam(const SlamSetup& setup, const localization::PolynomialSlamOptions& options, int run,
+                                  bool exchange, int only) {
   const SlamScenario& sc = setup.scenario;
   std::vector<int> team;  // scenario robot index of each robot in this run
   for (int i = 0; i < int(sc.robots.size()); ++i) {
@@ -272,10 +274,10 @@ SlamRunResult run_polynomial_slam(const SlamSetup& setup, int run, bool exchange
     for (const auto& u : setup.commands[std::size_t(r)]) commands.push_back({u.v, u.omega});
     rs.driver = std::make_shared<sim::CommandScript>(std::move(commands));
     // The simulator's initial pose is x_j,0 in the robot's own frame; the filter starts there or at
-    // the draw, with the scenario's `polynomial:` options, P0 and Q, reading every distance sensor.
+    // the draw, with the method's options, P0 and Q, reading every distance sensor.
     rs.localizer = [&, start_estimate](const localization::LocalizerContext& c) {
       return std::make_unique<localization::PolynomialLocalizer>(c.initial_pose.compose(start_estimate), p0, q,
-                                                                 sc.polynomial);
+                                                                 options);
     };
     // Streams by the robot's index in the scenario, so that a robot alone has its noise in the team.
     rs.motion_rng = std::make_shared<core::Random>(run_rng.fork(100 + std::uint64_t(r)));
@@ -358,21 +360,38 @@ core::Registry<SlamMethod>& slam_method_registry() {
     registry.add("polynomial",
                  "D'Alfonso et al.'s polynomial EKF-SLAM, one filter per robot, polynomials exchanged at a rendezvous "
                  "(§3.2)",
-                 run_polynomial_slam);
+                 [](const core::Params& params) -> SlamRun {
+                   localization::polynomial_slam_options(params, 0.0);  // values that do not fit together
+                   return [params](const SlamSetup& setup, int run, bool exchange, int only) {
+                     const auto& sc = setup.scenario;
+                     const auto options =
+                         localization::polynomial_slam_options(params, sc.filter_range_noise_m.value_or(sc.range.noise_m));
+                     return run_polynomial_slam(setup, options, run, exchange, only);
+                   };
+                 },
+                 localization::polynomial_slam_params());
     return true;
   }();
   (void)built_in;
   return registry;
 }
 
-void register_slam_method(std::string name, std::string help, SlamMethod method) {
-  slam_method_registry().add(std::move(name), std::move(help), std::move(method));
+void register_slam_method(std::string name, std::string help, SlamMethod method, std::vector<core::ParamSpec> params) {
+  slam_method_registry().add(std::move(name), std::move(help), std::move(method), std::move(params));
 }
 
 std::vector<std::string> slam_method_names() { return slam_method_registry().names(); }
 
+core::Params slam_method_options(const std::string& name, const core::Settings& settings) {
+  return slam_method_registry().configure(name, settings);
+}
+
+SlamRun make_slam_method(const std::string& name, const core::Settings& settings) {
+  return slam_method_registry().get(name).make(slam_method_options(name, settings));
+}
+
 SlamRunResult run_slam(const SlamSetup& setup, int run, bool exchange, int only) {
-  return slam_method_registry().get(setup.scenario.method).make(setup, run, exchange, only);
+  return setup.method(setup, run, exchange, only);
 }
 
 }  // namespace fleetmap::experiments

@@ -6,7 +6,7 @@
 // A run is a sim::Simulation set up for it: each robot driven by its commands (sim::CommandScript),
 // in its own frame, with the filter as its localizer; a meeting handler exchanges the polynomials.
 // `method` picks the SLAM method by name from slam_method_registry(): `polynomial`, and any a
-// program registers with register_slam_method.
+// program registers with register_slam_method, each built from the parameters it declares.
 #include <Eigen/Core>
 
 #include <cstdint>
@@ -38,16 +38,24 @@ std::vector<localization::Odometry> path_commands(const core::Pose2& start, cons
                                                   double speed, int steps, double period_s, double max_turn_rate);
 
 // What every run of a scenario shares.
+// One run of the team: the prepared scenario, the run index, exchange on or off, one robot by index
+// or all with -1 (run_slam).
+struct SlamSetup;
+struct SlamRunResult;
+using SlamRun = std::function<SlamRunResult(const SlamSetup&, int run, bool exchange, int only)>;
+
 struct SlamSetup {
   SlamScenario scenario;
+  SlamRun method;  // the scenario's method, built from its parameters
   sim::World world;
   std::vector<mapping::WallSegment> walls;
   std::vector<std::vector<localization::Odometry>> commands;  // per robot, per step
   std::vector<std::vector<core::Pose2>> planned;              // per robot, the noise-free poses, k = 0..steps
 };
 
-// Rasterises the room and precomputes the paths. Throws InputError naming the robot when a start
-// or a step of its noise-free path is within the robot's radius of a wall.
+// Rasterises the room, precomputes the paths and builds the method. Throws InputError naming the
+// robot when a start or a step of its noise-free path is within the robot's radius of a wall, and
+// as make_slam_method for the method's parameters.
 SlamSetup prepare_slam(const SlamScenario& scenario);
 
 struct SlamRendezvous {
@@ -88,15 +96,20 @@ struct SlamRunResult {
 // robot by index (-1: all), for the single-robot runs of D'Alfonso et al. Fig. 8.
 SlamRunResult run_slam(const SlamSetup& setup, int run, bool exchange, int only = -1);
 
-// A SLAM method: one run of the team as run_slam describes it (the scenario, its prepared room and
-// paths, the run index, exchange on or off, one robot by index or all with -1).
-using SlamMethod = std::function<SlamRunResult(const SlamSetup&, int run, bool exchange, int only)>;
+// A SLAM method: its runs made from its declared parameters' values. May throw InputError for
+// values that do not fit together.
+using SlamMethod = std::function<SlamRun(const core::Params&)>;
 // Every SLAM method by name: the built-in `polynomial`, then those registered by the program.
 core::Registry<SlamMethod>& slam_method_registry();
-// Adds a method: a scenario's `method:` (and `fleetmap slam`) then reaches it. Throws Error when
-// the name is taken or unusable.
-void register_slam_method(std::string name, std::string help, SlamMethod method);
+// Adds a method with the parameters it accepts (core/params.h): a scenario's `method:` (and
+// `fleetmap slam`) then reaches it. Throws Error when the name is taken or unusable.
+void register_slam_method(std::string name, std::string help, SlamMethod method, std::vector<core::ParamSpec> params = {});
 // The registered names, in the order --help lists them.
 std::vector<std::string> slam_method_names();
+// The method's declared parameters with `settings` applied. Throws InputError for an unknown method
+// (naming the valid ones), a setting it does not declare or a value it refuses.
+core::Params slam_method_options(const std::string& name, const core::Settings& settings = {});
+// The method built from them; throws as slam_method_options and as the method's factory.
+SlamRun make_slam_method(const std::string& name, const core::Settings& settings = {});
 
 }  // namespace fleetmap::experiments

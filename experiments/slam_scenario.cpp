@@ -44,18 +44,28 @@ std::vector<Eigen::Vector2d> points(io::YamlMap& m, const std::string& key) {
   return points_at(*n, m, key);
 }
 
-// [low, high] for a threshold pair such as rho: [0.08, 0.24].
-std::pair<double, double> range_pair(io::YamlMap& m, const std::string& key, std::pair<double, double> fallback) {
-  if (!m.has(key)) {
-    m.node(key);
-    return fallback;
+// The method's own block (`polynomial: {order: 2}`): each key a declared parameter, set in `params`
+// and `settings`. Older files write a pair of parameters K_min and K_max as `K: [minimum, maximum]`
+// (D'Alfonso et al.'s `rho: [0.08, 0.24]`).
+void read_method_block(io::YamlMap& m, core::Params& params, core::Settings& settings) {
+  const auto set = [&](const std::string& key, const std::string& value, const std::string& where) {
+    io::set_declared(params, settings, key, value, where);
+  };
+  for (const auto& key : m.keys()) {
+    const auto node = m.node(key);
+    if (node->IsSequence() && params.declares(key + "_min") && params.declares(key + "_max")) {
+      const auto v = m.numbers(key, 2);
+      if (!(v[1] >= v[0])) {
+        throw InputError(m.where(key) + ": expected [minimum, maximum] with minimum <= maximum, got [" + core::exact(v[0]) +
+                         ", " + core::exact(v[1]) + "]");
+      }
+      set(key + "_min", core::exact(v[0]), m.where(key));
+      set(key + "_max", core::exact(v[1]), m.where(key));
+      continue;
+    }
+    if (!node->IsScalar()) throw InputError(m.where(key) + ": expected a value, got " + io::describe_node(*node));
+    set(key, node->Scalar(), m.where(key));
   }
-  const auto v = m.numbers(key, 2);
-  if (!(v[0] > 0.0) || !(v[1] >= v[0])) {
-    throw InputError(m.where(key) + ": expected [minimum, maximum] with 0 < minimum <= maximum, got [" +
-                     std::to_string(v[0]) + ", " + std::to_string(v[1]) + "]");
-  }
-  return {v[0], v[1]};
 }
 
 }  // namespace
@@ -76,7 +86,10 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
   io::check_yaml_file_kind(root, source, io::YamlFileKind::SlamScenario);
   io::YamlMap top(root, source);
   SlamScenario s;
-  s.method = top.choice("method", s.method, slam_method_names());
+  const auto method = top.member("method", {s.method, s.method_settings}, slam_method_names(),
+                                  [](const std::string& name) { return slam_method_options(name); });
+  s.method = method.name;
+  s.method_settings = method.settings;
   s.seed = top.seed("seed", 1);
   s.runs = int(top.number("runs", s.runs, kSlamRunsRange));
   s.steps = int(top.integer("steps", s.steps, 1, 1'000'000));
@@ -165,33 +178,18 @@ SlamScenario parse_slam_scenario(const std::string& text, const std::string& sou
   }
   s.single_robot = top.text("single_robot", s.single_robot);
   s.paper_table = top.boolean("paper_table", s.paper_table);
-  {
-    auto p = top.map("polynomial");
-    auto& o = s.polynomial;
-    o.order = int(p.integer("order", o.order, 1, 9));
-    std::tie(o.rho_min, o.rho_max) = range_pair(p, "rho", {o.rho_min, o.rho_max});
-    std::tie(o.sigma_min, o.sigma_max) = range_pair(p, "sigma", {o.sigma_min, o.sigma_max});
-    o.epsilon_m = int(p.integer("epsilon_m", o.epsilon_m, 1, 100000));
-    o.epsilon_z = int(p.integer("epsilon_z", o.epsilon_z, 1, 100000));
-    o.k = p.number("k", o.k, 1e-9, 1e12);
-    o.cluster_radius = p.number("cluster_radius", o.cluster_radius, 1e-6, 100.0);
-    o.gamma_m = p.number("gamma_m", o.gamma_m, 1e-9, 100.0);
-    o.min_overlap = p.number("min_overlap", o.min_overlap, 1e-6, 1.0);
-    o.merge_max_angle = deg2rad(p.number("merge_max_angle_deg", rad2deg(o.merge_max_angle), 1e-6, 90.0));
-    o.min_merge_length = p.number("min_merge_length", o.min_merge_length, 0.0, 100.0);
-    o.innovation_gate = p.number("innovation_gate", o.innovation_gate, 1e-9, 1e12);
-    o.min_incidence_cos = p.number("min_incidence_cos", o.min_incidence_cos, 0.0, 0.999);
-    o.domain_margin = p.number("domain_margin", o.domain_margin, -10.0, 10.0);
-    o.cluster_tolerance = p.number("cluster_tolerance", o.cluster_tolerance, 1e-6, 10.0);
-    o.shape_noise = p.boolean("shape_noise", o.shape_noise);
-    o.lowest_order = p.boolean("lowest_order", o.lowest_order);
-    o.shape_in_state = p.boolean("shape_in_state", o.shape_in_state);
-    o.first_estimate_jacobians = p.boolean("first_estimate_jacobians", o.first_estimate_jacobians);
-    o.feature_noise = p.number("feature_noise", o.feature_noise, 0.0, 1.0);
-    p.finish();
+  // A block named after a method holds its parameters; only the chosen method's is read.
+  for (const auto& name : slam_method_names()) {
+    if (!top.has(name)) continue;
+    if (name != s.method) {
+      throw InputError(top.where(name) + ": holds the parameters of method '" + name + "', but the method is '" + s.method + "'");
+    }
+    auto block = top.map(name);
+    core::Params params = slam_method_options(s.method, s.method_settings);
+    read_method_block(block, params, s.method_settings);
+    block.finish();
   }
   top.finish();
-  s.polynomial.range_noise = s.range.noise_m;
   try {
     validate_slam_scenario(s);
   } catch (const InputError& e) {
@@ -222,7 +220,7 @@ void validate_slam_scenario(const SlamScenario& s) {
       std::none_of(s.robots.begin(), s.robots.end(), [&](const SlamRobot& r) { return r.name == s.single_robot; })) {
     throw InputError("single_robot: no robot is named '" + s.single_robot + "'");
   }
-  localization::validate(s.polynomial);
+  make_slam_method(s.method, s.method_settings);  // the method's parameters, alone and together
 }
 
 }  // namespace fleetmap::experiments

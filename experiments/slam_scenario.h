@@ -2,18 +2,20 @@
 // A SLAM experiment (`fleetmap slam`): robots driven along precomputed paths in a room given as
 // polygons, sensing with distance sensors and a camera, each running a SLAM method on its own
 // and exchanging maps when two see each other (D'Alfonso et al., §4). Loaded from YAML: every key checked,
-// errors name the file, line and key. `method` picks the SLAM method; each method reads its own
-// options block (`polynomial:` for D'Alfonso et al.).
+// errors name the file, line and key. `method` picks the SLAM method and sets the parameters it
+// declares (`method: {name: polynomial, order: 2}`); a block named after the method holds them too
+// (`polynomial: {order: 2}`, as D'Alfonso et al.'s scenarios write them).
 #include <Eigen/Core>
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/params.h"
 #include "core/range.h"
 #include "core/transform2.h"
-#include "localization/polynomial_slam.h"
 #include "mapping/polynomial_map.h"
 #include "sim/motion.h"
 #include "sim/sensors.h"
@@ -64,7 +66,11 @@ struct SlamScenario {
   double grid_patch_resolution_m = 0.05;  // the equivalent occupancy-grid patch's cells
   std::string single_robot;               // also run this robot alone (D'Alfonso et al., Fig. 8); "" for none
   bool paper_table = false;               // print D'Alfonso et al.'s Table 1 beside the results (its own experiment)
-  localization::PolynomialSlamOptions polynomial;
+  // The method's own parameters as given (slam_method_options checks them), in the order given.
+  core::Settings method_settings;
+  // The filter's distance-reading noise V, m, when it differs from the sensors' (range.noise_m):
+  // exact readings still need a V > 0. Not a scenario key.
+  std::optional<double> filter_range_noise_m;
 };
 
 // Parses scenario YAML; `source` names it in errors.

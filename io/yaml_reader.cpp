@@ -165,15 +165,29 @@ YamlMap::Member YamlMap::member(const std::string& key, const Member& fallback, 
       throw InputError(m.where(k) + ": expected " + (params.declares(k) ? "a value" : "a parameter") + ", got " +
                        describe_node(kv.second));
     }
-    try {
-      params.set(k, kv.second.Scalar());
-    } catch (const InputError& e) {
-      throw InputError(m.where(k) + ": " + e.what());
-    }
-    std::erase_if(out.settings, [&](const auto& s) { return s.first == k; });
-    out.settings.emplace_back(k, params.value_text(k));
+    set_declared(params, out.settings, k, kv.second.Scalar(), m.where(k));
   }
   return out;
+}
+
+void set_declared(core::Params& params, core::Settings& settings, const std::string& key, const std::string& value,
+                  const std::string& where) {
+  try {
+    params.set(key, value);
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+  std::erase_if(settings, [&](const auto& kv) { return kv.first == key; });
+  settings.emplace_back(key, params.value_text(key));
+}
+
+void read_declared(YamlMap& m, core::Params& params, core::Settings& settings) {
+  for (const auto& spec : params.specs()) {
+    const auto node = m.node(spec.name);
+    if (!node) continue;
+    if (!node->IsScalar()) throw InputError(m.where(spec.name) + ": expected a value, got " + describe_node(*node));
+    set_declared(params, settings, spec.name, node->Scalar(), m.where(spec.name));
+  }
 }
 
 std::vector<double> YamlMap::numbers(const std::string& key, std::size_t size) {

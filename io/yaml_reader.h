@@ -72,6 +72,13 @@ class YamlMap {
   std::vector<std::string> asked_;
 };
 
+// Sets a member's declared parameter and records it among `settings` (replacing an earlier value);
+// errors are prefixed with `where`.
+void set_declared(core::Params& params, core::Settings& settings, const std::string& key, const std::string& value,
+                  const std::string& where);
+// Reads the keys of `m` that `params` declares (each a scalar) into params and settings.
+void read_declared(YamlMap& m, core::Params& params, core::Settings& settings);
+
 // Parses YAML text; syntax errors become InputError "source:line: not valid YAML (...)".
 YAML::Node parse_yaml(const std::string& text, const std::string& source);
 

@@ -1,5 +1,6 @@
 #include "localization/localizer.h"
 #include "localization/localizers.h"
+#include "localization/polynomial_slam.h"
 
 namespace fleetmap::localization {
 
@@ -31,7 +32,7 @@ core::Registry<LocalizerFactory>& localizer_registry() {
     r.add("polynomial",
           "polynomial EKF-SLAM (D'Alfonso et al.): walls as polynomials learnt from the range scan, c0 "
           "coefficients in the state",
-          make_polynomial_localizer);
+          make_polynomial_localizer, polynomial_slam_params());
     r.add("scan-matching",
           "ML incremental mapping: each scan aligned to the robot's own grid replaces the odometry step (León et al. "
           "2009, sec. II.A)",

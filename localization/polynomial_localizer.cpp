@@ -15,12 +15,6 @@ namespace {
 // spaced beams.
 constexpr std::size_t kMaxBeams = 36;
 
-PolynomialSlamOptions slam_options(const LocalizerOptions& o) {
-  PolynomialSlamOptions p;
-  p.range_noise = o.scan_range_noise;
-  return p;
-}
-
 }  // namespace
 
 PolynomialLocalizer::PolynomialLocalizer(const core::Pose2& start, const Eigen::Matrix3d& initial_covariance,
@@ -60,7 +54,7 @@ std::vector<std::pair<std::string, double>> PolynomialLocalizer::counters() cons
 std::unique_ptr<Localizer> make_polynomial_localizer(const LocalizerContext& c) {
   validate_options(c.options);
   return std::make_unique<PolynomialLocalizer>(c.initial_pose, initial_covariance(c.options), process_noise(c.options),
-                                               slam_options(c.options), kMaxBeams);
+                                               polynomial_slam_options(c.params, c.options.scan_range_noise), kMaxBeams);
 }
 
 }  // namespace fleetmap::localization

@@ -11,6 +11,7 @@
 #include <limits>
 #include <string>
 
+#include "core/angle.h"
 #include "core/error.h"
 #include "localization/metrics.h"
 
@@ -72,6 +73,70 @@ void validate(const PolynomialSlamOptions& o) {
   if (!std::isfinite(o.domain_margin)) fail("domain_margin", "a finite number", o.domain_margin);
   if (!(o.cluster_tolerance > 0.0)) fail("cluster_tolerance", "a positive number", o.cluster_tolerance);
   if (!(o.feature_noise >= 0.0) || !std::isfinite(o.feature_noise)) fail("feature_noise", "a finite number >= 0", o.feature_noise);
+}
+
+std::vector<core::ParamSpec> polynomial_slam_params() {
+  using core::ParamSpec;
+  const PolynomialSlamOptions d;
+  const core::Range metres{1e-6, 100.0};
+  const core::Range count{1, 100000, true};
+  return {
+      ParamSpec::number("order", d.order, {1, 9, true}, "", "m, the polynomials' highest order (§4)"),
+      ParamSpec::number("rho_min", d.rho_min, metres, "m", "rho underbar: a reading this close to a polynomial is good (Q_good) when P is small (§3.1)"),
+      ParamSpec::number("rho_max", d.rho_max, metres, "m", "rho bar: the same threshold when P has grown to K P0"),
+      ParamSpec::number("sigma_min", d.sigma_min, metres, "m", "beyond rho and within this a reading is bad (Q_bad); farther, a new cluster point"),
+      ParamSpec::number("sigma_max", d.sigma_max, metres, "m", "the same threshold when P has grown to K P0"),
+      ParamSpec::number("epsilon_m", d.epsilon_m, count, "points", "bad points that trigger a refit; points per polynomial kept for refits and merges"),
+      ParamSpec::number("epsilon_z", d.epsilon_z, count, "points", "cluster points that make a new polynomial (at least the order)"),
+      ParamSpec::number("k", d.k, {1e-9, 1e12}, "", "K: the thresholds grow from their minimum to their maximum as P goes from 0 to K P0"),
+      ParamSpec::number("cluster_radius", d.cluster_radius, metres, "m", "R: a point this close to a cluster joins it"),
+      ParamSpec::number("gamma_m", d.gamma_m, {1e-9, 100.0}, "m", "gamma_m: two polynomials' curves this close are one wall, merged"),
+      ParamSpec::number("min_overlap", d.min_overlap, {1e-6, 1.0}, "", "share of the shorter polynomial two must overlap to merge (Fig. 3(b))"),
+      ParamSpec::number("merge_max_angle_deg", core::rad2deg(d.merge_max_angle), {1e-6, 90.0}, "deg", "tangents in the overlap may differ at most this for a merge"),
+      ParamSpec::number("min_merge_length", d.min_merge_length, {0.0, 100.0}, "m", "a polynomial shorter than this is not merged (0: any length, as the paper)"),
+      ParamSpec::number("innovation_gate", d.innovation_gate, {1e-9, 1e12}, "", "a reading farther than this (squared Mahalanobis) from its prediction is not used"),
+      ParamSpec::number("min_incidence_cos", d.min_incidence_cos, {0.0, 0.999}, "", "an axis meeting a curve at a cosine below this to its normal is not used"),
+      ParamSpec::number("domain_margin", d.domain_margin, {-10.0, 10.0}, "m", "an axis may meet a polynomial this far beyond its ends (< 0: not near them)"),
+      ParamSpec::number("cluster_tolerance", d.cluster_tolerance, {1e-6, 10.0}, "m", "a cluster becomes a polynomial only when the fit leaves no point farther than this"),
+      ParamSpec::flag("shape_noise", d.shape_noise, "the fixed shape's uncertainty is added to each reading's noise (false: the sensor's alone)"),
+      ParamSpec::flag("lowest_order", d.lowest_order, "a new polynomial takes the lowest order that fits as well as order m (false: always m, as the paper)"),
+      ParamSpec::flag("shape_in_state", d.shape_in_state, "each polynomial's shape is in the state with its c_0, so that readings correct it (false: c_0 only, as the paper)"),
+      ParamSpec::flag("first_estimate_jacobians", d.first_estimate_jacobians, "Jacobians at first estimates (Huang et al. 2008), so that the filter does not become overconfident"),
+      ParamSpec::number("feature_noise", d.feature_noise, {0.0, 1.0}, "m^2", "process noise on each landmark's entries per step (0: walls do not move)"),
+  };
+}
+
+PolynomialSlamOptions polynomial_slam_options(const core::Params& p, double range_noise) {
+  PolynomialSlamOptions o;
+  o.order = int(p.number("order"));
+  o.rho_min = p.number("rho_min");
+  o.rho_max = p.number("rho_max");
+  o.sigma_min = p.number("sigma_min");
+  o.sigma_max = p.number("sigma_max");
+  o.epsilon_m = int(p.number("epsilon_m"));
+  o.epsilon_z = int(p.number("epsilon_z"));
+  o.k = p.number("k");
+  o.cluster_radius = p.number("cluster_radius");
+  o.gamma_m = p.number("gamma_m");
+  o.min_overlap = p.number("min_overlap");
+  o.merge_max_angle = core::deg2rad(p.number("merge_max_angle_deg"));
+  o.min_merge_length = p.number("min_merge_length");
+  o.innovation_gate = p.number("innovation_gate");
+  o.min_incidence_cos = p.number("min_incidence_cos");
+  o.domain_margin = p.number("domain_margin");
+  o.cluster_tolerance = p.number("cluster_tolerance");
+  o.shape_noise = p.flag("shape_noise");
+  o.lowest_order = p.flag("lowest_order");
+  o.shape_in_state = p.flag("shape_in_state");
+  o.first_estimate_jacobians = p.flag("first_estimate_jacobians");
+  o.feature_noise = p.number("feature_noise");
+  o.range_noise = range_noise;
+  try {
+    validate(o);
+  } catch (const InputError& e) {
+    throw InputError(p.owner() + ": " + e.what());
+  }
+  return o;
 }
 
 Eigen::VectorXd ShapeBasis::at(double xi) const {

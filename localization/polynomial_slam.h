@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/params.h"
 #include "core/transform2.h"
 #include "localization/localizer.h"
 #include "localization/polynomial_ekf.h"
@@ -114,6 +115,14 @@ std::vector<Eigen::MatrixXd> fit_gradient(const mapping::Polynomial& polynomial,
 
 // Throws InputError naming the option for a value the algorithm cannot use.
 void validate(const PolynomialSlamOptions& options);
+
+// The options a user sets, as declared parameters (core/params.h) of the `polynomial` localizer and
+// of `fleetmap slam`'s `polynomial` method; the defaults are PolynomialSlamOptions'. The merge angle
+// is given in degrees (`merge_max_angle_deg`).
+std::vector<core::ParamSpec> polynomial_slam_params();
+// The options those parameters give, with the distance readings' noise V from the caller (the
+// sensor's). Throws InputError as validate() for values that do not fit together (rho_max < rho_min).
+PolynomialSlamOptions polynomial_slam_options(const core::Params& params, double range_noise);
 
 // The thresholds of one step (§3.1): rho_k = rho_min + (rho_max - rho_min) f,
 // sigma_k = sigma_min + (sigma_max - sigma_min) f, f = (||K P0|| - ||K P0 - P||) / ||K P0||

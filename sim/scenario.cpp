@@ -166,29 +166,6 @@ void read_landmarks(io::YamlMap& top, Scenario& s) {
   lm.finish();
 }
 
-// Sets a member's declared parameter and records it among `settings` (replacing an earlier value);
-// errors are prefixed with `where`.
-void set_declared(core::Params& params, core::Settings& settings, const std::string& key, const std::string& value,
-                  const std::string& where) {
-  try {
-    params.set(key, value);
-  } catch (const InputError& e) {
-    throw InputError(where + ": " + e.what());
-  }
-  std::erase_if(settings, [&](const auto& kv) { return kv.first == key; });
-  settings.emplace_back(key, params.value_text(key));
-}
-
-// Reads the keys of `m` that `params` declares (each a scalar) into params and settings.
-void read_declared(io::YamlMap& m, core::Params& params, core::Settings& settings) {
-  for (const auto& spec : params.specs()) {
-    const auto node = m.node(spec.name);
-    if (!node) continue;
-    if (!node->IsScalar()) throw InputError(m.where(spec.name) + ": expected a value, got " + io::describe_node(*node));
-    set_declared(params, settings, spec.name, node->Scalar(), m.where(spec.name));
-  }
-}
-
 // The member-specific keys of `localization` before each localizer declared its own parameters, and
 // the localizers whose `particles` each set. Old files still read: the key sets `particles` of the
 // localizers it named and is ignored by the others, as it always was.
@@ -230,11 +207,11 @@ void read_localization(io::YamlMap& top, Scenario& s) {
     const std::string value = loc.text(old, "");
     if (std::find(members.begin(), members.end(), name) == members.end()) continue;
     if (loc.has("particles")) throw InputError(loc.where(old) + ": give 'particles' only (" + old + " is its older name)");
-    set_declared(params, s.localization_settings, "particles", value, loc.where(old));
+    io::set_declared(params, s.localization_settings, "particles", value, loc.where(old));
   }
   // The localizer's own parameters; a key another localizer declares is named as such, any other
   // unknown key gets the reader's "did you mean" over every key `localization` accepts.
-  read_declared(loc, params, s.localization_settings);
+  io::read_declared(loc, params, s.localization_settings);
   const auto others = localization::localizer_registry().parameter_names();
   for (const auto& key : loc.keys()) {
     if (std::find(others.begin(), others.end(), key) != others.end() && !params.declares(key)) {
@@ -298,7 +275,7 @@ void read_merging(io::YamlMap& top, Scenario& s) {
   s.merging = name;
   s.merge_attempt_every = int(merge.number("attempt_every", s.merge_attempt_every, limits::kCount));
   core::Params params = merging::map_aligner_options(name, s.merging_settings);
-  read_declared(merge, params, s.merging_settings);
+  io::read_declared(merge, params, s.merging_settings);
   // Files written before the aligners declared their parameters hold `method: auto` and
   // `min_confidence: 0.5` whatever the mode: those defaults are read as before, ignored by the
   // aligners that have no such parameter; another value there is a setting the aligner lacks.

@@ -85,6 +85,37 @@ TEST(SlamCommand, FlagsTheExperimentDoesNotUseAreRefused) {
   EXPECT_EQ(r.out, "short/table1.md\n");
 }
 
+// The scenario's method is built from its declared parameters; --set changes one for this run.
+TEST(SlamCommand, SetsTheMethodsParameters) {
+  TempDir dir;
+  const auto base = run_fleetmap("slam --scenario " + scenario() + " --runs 1 -q -o base", dir);
+  ASSERT_EQ(base.exit_code, 0) << base.err;
+  // Straight lines only: the maps hold other polynomials, so the table differs.
+  const auto lines = run_fleetmap("slam --scenario " + scenario() + " --runs 1 --set method.order=1 -q -o lines", dir);
+  ASSERT_EQ(lines.exit_code, 0) << lines.err;
+  EXPECT_NE(slurp(dir / "base" / "runs.csv"), slurp(dir / "lines" / "runs.csv"));
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario " + scenario() + " --set method.ordr=1 -o bad", dir),
+                        "did you mean 'order'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario " + scenario() + " --set method.order=12 -o bad", dir),
+                        "a whole number from 1 to 9");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario " + scenario() + " --set method.rho_min=0.5 -o bad", dir),
+                        "rho_max");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario " + scenario() + " --set localization.order=1 -o bad", dir),
+                        "takes method.KEY=VALUE");
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
+  const std::string corridor = std::string(FLEETMAP_SOURCE_DIR) + "/scenarios/leon_corridor.yaml";
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("slam --scenario " + corridor + " --set method.order=1 -o bad", dir),
+                        "--set does not apply to the leon_corridor experiment");
+  // The explorer's `polynomial` localizer declares the same parameters.
+  const auto listed = run_fleetmap("plugins --family slam-method", dir);
+  EXPECT_NE(listed.out.find("order = 3"), std::string::npos) << listed.out;
+  const auto r = run_fleetmap("explore --map office --robots 1 --localization polynomial --set localization.order=1 "
+                              "--steps 20 --out ex",
+                              dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(slurp(dir / "ex" / "scenario.yaml").find("order: 1"), std::string::npos);
+}
+
 TEST(SlamCommand, ExploreUsesThePolynomialLocalizer) {
   // The same filter as `explore --localization polynomial`: it learns polynomials from the scan
   // and keeps every robot within 3 sigma of P0 (0.05 m) of the truth over a short run.

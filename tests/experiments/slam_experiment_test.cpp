@@ -31,8 +31,8 @@ SlamScenario noise_free_rectangle() {
   s.range.noise_m = 0.0;
   s.camera.range_noise_m = 0.0;
   s.camera.bearing_noise_rad = 0.0;
-  s.polynomial.range_noise = 0.005;       // the filter's V
-  s.polynomial.cluster_tolerance = 0.001;  // 3 sigma of exact readings
+  s.filter_range_noise_m = 0.005;                    // the filter's V
+  s.method_settings = {{"cluster_tolerance", "0.001"}};  // 3 sigma of exact readings
   return s;
 }
 
@@ -115,7 +115,7 @@ TEST(SlamExperiment, ShapeInTheStateIsNotOverconfidentOnThePapersExperiment) {
   // runs, and the median of 6 runs does so with probability below 0.3%. With only c_0 in the state
   // (D'Alfonso et al.'s filter) the medians on these runs are 9 (r1) and 20 (r2, r3).
   SlamScenario s = dalfonso();
-  ASSERT_TRUE(s.polynomial.shape_in_state);
+  ASSERT_TRUE(slam_method_options(s.method, s.method_settings).flag("shape_in_state"));
   s.sampled_start = true;
   const PerRun m = per_run(s, 6);
   const double limit = localization::chi_square_quantile(3, 0.95);
@@ -153,7 +153,7 @@ TEST(SlamExperiment, WithOdometryNoiseEveryRobotsNeesIsInsideItsChiSquareBand) {
   // probability 0.95. Linearised at the current estimates instead of the first ones (Huang, Mourikis
   // & Roumeliotis 2008) these runs give 3.92 / 4.68 / 4.30: r2 above it (checked).
   const SlamScenario s = load_slam_scenario(std::string(FLEETMAP_SOURCE_DIR) + "/scenarios/dalfonso_odometry.yaml");
-  ASSERT_TRUE(s.polynomial.first_estimate_jacobians);
+  ASSERT_TRUE(slam_method_options(s.method, s.method_settings).flag("first_estimate_jacobians"));
   const int runs = 12;
   const PerRun m = per_run(s, runs);
   const localization::ChiSquareBand band = localization::average_chi_square_band(3, runs);
@@ -240,8 +240,9 @@ TEST(SlamExperiment, OutputsTableAndFigures) {
   EXPECT_EQ(files.size(), 8u);
 }
 
-// A program that links the library adds its own SLAM method; a scenario's `method:` then names it
-// (before, the same file is refused naming the valid methods).
+// A program that links the library adds its own SLAM method with a parameter of its own; a
+// scenario's `method:` then names it and sets the parameter (before, the same file is refused
+// naming the valid methods).
 TEST(SlamMethods, AProgramAddsItsOwnMethodAndScenariosReachItByName) {
   const std::string text = R"(
 method: planned-path
@@ -254,20 +255,26 @@ robots:
 )";
   if (!slam_method_registry().contains("planned-path")) {
     expect_input_error([&] { parse_slam_scenario(text, "mine.yaml"); }, {"mine.yaml", "method", "planned-path", "polynomial"});
-    // Its estimate is the noise-free path: a baseline a user might compare with.
-    register_slam_method("planned-path", "the noise-free path as the estimate", [](const SlamSetup& setup, int run, bool exchange, int only) {
-      SlamRunResult r;
-      r.run = run;
-      r.exchange = exchange;
-      for (std::size_t i = 0; i < setup.scenario.robots.size(); ++i) {
-        if (only >= 0 && int(i) != only) continue;
-        SlamRobotResult robot;
-        robot.name = setup.scenario.robots[i].name;
-        robot.estimate = setup.planned[i];
-        r.robots.push_back(std::move(robot));
-      }
-      return r;
-    });
+    // Its estimate is the noise-free path, moved by `shift` along x: a baseline a user might compare with.
+    register_slam_method(
+        "planned-path", "the noise-free path as the estimate",
+        [](const core::Params& params) -> SlamRun {
+          const double shift = params.number("shift");
+          return [shift](const SlamSetup& setup, int run, bool exchange, int only) {
+            SlamRunResult r;
+            r.run = run;
+            r.exchange = exchange;
+            for (std::size_t i = 0; i < setup.scenario.robots.size(); ++i) {
+              if (only >= 0 && int(i) != only) continue;
+              SlamRobotResult robot;
+              robot.name = setup.scenario.robots[i].name;
+              for (const auto& p : setup.planned[i]) robot.estimate.emplace_back(p.x + shift, p.y, p.theta);
+              r.robots.push_back(std::move(robot));
+            }
+            return r;
+          };
+        },
+        {core::ParamSpec::number("shift", 0.0, {-10.0, 10.0}, "m", "the estimate is the path moved this far along x")});
   }
   EXPECT_THROW(register_slam_method("polynomial", "again", {}), Error);
   const auto names = slam_method_names();
@@ -279,6 +286,23 @@ robots:
   ASSERT_EQ(r.robots.size(), 1u);
   EXPECT_EQ(r.robots[0].estimate.size(), 41u);  // the start and one pose per step
   EXPECT_NEAR(r.robots[0].estimate.back().x, 3.0, 0.1);
+  // Its parameter from `method: {name, KEY}` or from a block named after it; checked as declared.
+  const auto end_x = [](const std::string& scenario) {
+    return run_slam(prepare_slam(parse_slam_scenario(scenario, "mine.yaml")), 0, false).robots[0].estimate.back().x;
+  };
+  const auto replace = [&](const std::string& with) {
+    std::string t = text;
+    t.replace(t.find("method: planned-path\n"), std::string("method: planned-path\n").size(), with);
+    return t;
+  };
+  EXPECT_NEAR(end_x(replace("method: {name: planned-path, shift: 0.5}\n")), 3.5, 0.1);
+  EXPECT_NEAR(end_x(text + "planned-path: {shift: -0.5}\n"), 2.5, 0.1);
+  expect_input_error([&] { parse_slam_scenario(replace("method: {name: planned-path, shift: 11}\n"), "mine.yaml"); },
+                     {"mine.yaml", "method.shift", "10"});
+  expect_input_error([&] { parse_slam_scenario(replace("method: {name: planned-path, shfit: 1}\n"), "mine.yaml"); },
+                     {"mine.yaml", "shfit", "shift"});
+  expect_input_error([&] { parse_slam_scenario(text + "polynomial: {order: 2}\n", "mine.yaml"); },
+                     {"mine.yaml", "polynomial", "planned-path"});
 }
 
 }  // namespace
