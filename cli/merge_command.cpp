@@ -53,6 +53,7 @@ bool is_bare_image(const std::string& source) {
 struct MergeCommandOptions {
   std::vector<std::string> maps;
   std::string method = "auto";
+  std::vector<std::string> set;  // --set METHOD.KEY=VALUE
   std::string out = "merged.png";
   std::string picture;
   std::string json;
@@ -149,7 +150,19 @@ int run_merge(const MergeCommandOptions& o) {
   if (o.maps.size() < 2) {
     throw InputError("merge needs at least two maps, got one: " + o.maps.front());
   }
-  merging::check_merge_method(o.method);
+  merging::MergeMethodSettings method_settings;
+  for (const auto& text : o.set) {
+    const auto a = core::parse_param_assignment(text, "--set " + text);
+    auto it = std::find_if(method_settings.begin(), method_settings.end(), [&](const auto& m) { return m.first == a.family; });
+    if (it == method_settings.end()) it = method_settings.insert(method_settings.end(), {a.family, {}});
+    it->second.emplace_back(a.key, a.value);
+    try {
+      merging::check_merge_method(o.method, method_settings);
+    } catch (const InputError& e) {
+      throw InputError("--set " + text + ": " + e.what());
+    }
+  }
+  merging::check_merge_method(o.method, method_settings);
   // --out is the picture, or a map file when its name says so (then --picture may add the picture).
   const bool out_is_map = !o.out.empty() && !io::is_standard_output(o.out) && io::is_map_file_name(o.out);
   const std::string picture_path = out_is_map ? o.picture : o.out;
@@ -218,6 +231,7 @@ int run_merge(const MergeCommandOptions& o) {
 
   merging::MergeOptions options;
   options.method = o.method;
+  options.method_settings = method_settings;
   options.min_confidence = o.min_confidence;
   options.seed = o.seed;
   const merging::MergedMaps result = merging::merge_and_fuse(pointers, options);
@@ -235,6 +249,13 @@ int run_merge(const MergeCommandOptions& o) {
   j["pixel_convention"] = kPixelConvention;
   j["reference"] = o.maps.front();
   j["method"] = o.method;
+  if (!method_settings.empty()) {
+    auto& p = j["method_parameters"];
+    for (const auto& [method, settings] : method_settings) {
+      const core::Params values = merging::merge_method_registry().configure(method, settings);
+      for (const auto& key : values.changed()) p[method][key] = values.value_text(key);
+    }
+  }
   j["transforms"] = nlohmann::json::array();
   int placed = 1;
   fmt::print(report, "{}: the reference (first input)\n", o.maps.front());
@@ -351,6 +372,12 @@ Command add_merge_command(CLI::App& root) {
       ->required();
   // Checked by check_merge_method, which also says the new name of a renamed method.
   merge->add_option("--method", o->method, "Alignment method: auto, grid or features (see below)")->capture_default_str();
+  merge->add_option("--set", o->set,
+                    "A merge method's parameter, METHOD.KEY=VALUE (repeat for more), e.g. --set features.ratio=0.7 or "
+                    "--set grid.sweep_step_deg=2: for --method's own, or under auto for any method it runs "
+                    "(parameters listed below)")
+      ->expected(1)
+      ->take_all();
   merge->add_option("--out,-o", o->out,
                     "Merged map: a picture (.png; - for the standard output) or a map file in the first map's metres "
                     "(.yaml for map_server with a .pgm beside it, or a bare .pgm) that plan and explore read")

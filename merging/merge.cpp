@@ -176,14 +176,28 @@ std::vector<Candidate> refine_candidates(const PreparedGrid& a, const PreparedGr
 
 namespace {
 
+// The settings given to method `name` (none when it has none).
+core::Settings settings_of(const MergeMethodSettings& all, const std::string& name) {
+  core::Settings out;
+  for (const auto& [method, settings] : all) {
+    if (method == name) out.insert(out.end(), settings.begin(), settings.end());
+  }
+  return out;
+}
+
+// Method `name`'s steps, built from its settings among `all`.
+MergeSteps method_steps(const core::Registry<MergeMethod>& registry, const std::string& name, const MergeMethodSettings& all) {
+  return registry.get(name).make(registry.configure(name, settings_of(all, name)), all);
+}
+
 // The steps of `auto`: the first other method's first pass, then every other method's passes, then
 // the first method's remaining passes.
-MergeSteps auto_steps(const core::Registry<MergeMethod>& registry) {
+MergeSteps auto_steps(const core::Registry<MergeMethod>& registry, const MergeMethodSettings& all) {
   std::vector<MergePasses> methods;  // each other method's passes, in order
   for (const auto& name : registry.names()) {
     if (name == "auto") continue;
     MergePasses passes;
-    for (const auto& step : registry.get(name).make()) passes.insert(passes.end(), step.begin(), step.end());
+    for (const auto& step : method_steps(registry, name, all)) passes.insert(passes.end(), step.begin(), step.end());
     methods.push_back(std::move(passes));
   }
   MergeSteps steps(2);
@@ -196,25 +210,97 @@ MergeSteps auto_steps(const core::Registry<MergeMethod>& registry) {
 }
 
 // One step per pass.
-MergeMethod in_steps(MergePasses passes) {
-  return [passes = std::move(passes)] {
-    MergeSteps steps;
-    for (const auto& pass : passes) steps.push_back({pass});
-    return steps;
+MergeSteps in_steps(const MergePasses& passes) {
+  MergeSteps steps;
+  for (const auto& pass : passes) steps.push_back({pass});
+  return steps;
+}
+
+// `pass` run with the options `apply` sets from a method's own parameters.
+ProposeFn with_options(ProposeFn pass, std::function<void(MergeOptions&)> apply) {
+  return [pass = std::move(pass), apply = std::move(apply)](const PreparedGrid& a, const PreparedGrid& b,
+                                                             const MergeOptions& options, core::Random& random) {
+    MergeOptions own = options;
+    apply(own);
+    return pass(a, b, own, random);
   };
+}
+
+// The grid search's parameters; the defaults are MergeOptions' own.
+std::vector<core::ParamSpec> grid_params() {
+  using core::ParamSpec;
+  const MergeOptions d;
+  const core::Range cells{16, 4096, true};
+  return {
+      ParamSpec::number("search_cells", d.overlap.search_cells, cells, "cells",
+                        "the translation search runs on the finest level whose larger side is at most this"),
+      ParamSpec::number("spectrum_peaks", d.overlap.spectrum_peaks, {1, 64, true}, "",
+                        "rotations kept from the Hough spectra's correlation (each also turned by 180 degrees)"),
+      ParamSpec::number("translation_peaks", d.overlap.translation_peaks, {1, 256, true}, "",
+                        "correlation maxima kept per rotation (repeated places give several)"),
+      ParamSpec::number("sweep_step_deg", d.sweep_step_deg, {0.25, 90.0}, "deg",
+                        "the second pass's rotation sweep step, run when the spectra find nothing reliable"),
+      ParamSpec::number("sweep_search_cells", d.sweep_search_cells, cells, "cells",
+                        "the sweep's translation search level, as search_cells"),
+  };
+}
+
+void apply_grid(const core::Params& p, MergeOptions& o) {
+  o.overlap.search_cells = int(p.number("search_cells"));
+  o.overlap.spectrum_peaks = int(p.number("spectrum_peaks"));
+  o.overlap.translation_peaks = int(p.number("translation_peaks"));
+  o.sweep_step_deg = p.number("sweep_step_deg");
+  o.sweep_search_cells = int(p.number("sweep_search_cells"));
+}
+
+// Feature matching's parameters; the defaults are FeatureMatchingOptions' own.
+std::vector<core::ParamSpec> feature_params() {
+  using core::ParamSpec;
+  const FeatureMatchingOptions d;
+  return {
+      ParamSpec::text("detectors", d.detectors.size() == 2 ? "both" : d.detectors.front(), {"orb", "akaze", "both"},
+                      "keypoint detectors: AKAZE finds a few more matches on large smooth maps at ten times ORB's time"),
+      ParamSpec::number("max_features", d.max_features, {10, 100000, true}, "", "ORB's keypoint budget per image"),
+      ParamSpec::number("ratio", d.ratio, {0.05, 1.0}, "", "Lowe's ratio test on the two nearest descriptors"),
+      ParamSpec::number("inlier_distance", d.inlier_distance, {0.1, 100.0}, "cells", "RANSAC inlier distance"),
+      ParamSpec::number("ransac_iterations", d.ransac_iterations, {10, 1e6, true}, "", "RANSAC iterations per model"),
+      ParamSpec::number("min_inliers", d.min_inliers, {3, 10000, true}, "", "inliers a model needs to be proposed"),
+  };
+}
+
+void apply_features(const core::Params& p, MergeOptions& o) {
+  const std::string& d = p.text("detectors");
+  o.features.detectors = d == "both" ? std::vector<std::string>{"orb", "akaze"} : std::vector<std::string>{d};
+  o.features.max_features = int(p.number("max_features"));
+  o.features.ratio = p.number("ratio");
+  o.features.inlier_distance = p.number("inlier_distance");
+  o.features.ransac_iterations = int(p.number("ransac_iterations"));
+  o.features.min_inliers = int(p.number("min_inliers"));
+}
+
+// A method from passes made of its own parameters.
+MergeMethod from_passes(std::function<MergePasses(const core::Params&)> make) {
+  return [make = std::move(make)](const core::Params& own, const MergeMethodSettings&) { return in_steps(make(own)); };
 }
 
 void add_builtin_methods(core::Registry<MergeMethod>& registry) {
   registry.add("auto",
                "grid's spectral pass; if not confident, the other methods and grid's sweep too; the best wins",
-               [] { return auto_steps(merge_method_registry()); });
+               [](const core::Params&, const MergeMethodSettings& all) { return auto_steps(merge_method_registry(), all); });
   registry.add("grid",
                "grid overlap search (wave-algorithm paper, Birk & Carpin 2006): Hough-spectrum rotations (Carpin "
                "2008), FFT correlation of walls for translations, coarse to fine; a rotation sweep when the spectra "
                "find nothing",
-               in_steps({propose_overlap, propose_overlap_sweep}));
+               from_passes([](const core::Params& p) {
+                 const auto apply = [p](MergeOptions& o) { apply_grid(p, o); };
+                 return MergePasses{with_options(propose_overlap, apply), with_options(propose_overlap_sweep, apply)};
+               }),
+               grid_params());
   registry.add("features", "ORB keypoints, ratio test, rigid RANSAC (the common ROS merger's approach)",
-               in_steps({propose_features}));
+               from_passes([](const core::Params& p) {
+                 return MergePasses{with_options(propose_features, [p](MergeOptions& o) { apply_features(p, o); })};
+               }),
+               feature_params());
 }
 
 }  // namespace
@@ -226,21 +312,46 @@ core::Registry<MergeMethod>& merge_method_registry() {
   return registry;
 }
 
+void register_merge_method(std::string name, std::string help, std::function<MergePasses(const core::Params&)> make,
+                           std::vector<core::ParamSpec> params) {
+  if (!make) throw Error("register merge method: '" + name + "' needs a function that makes its passes");
+  merge_method_registry().add(
+      name, std::move(help),
+      from_passes([name, make = std::move(make)](const core::Params& p) {
+        MergePasses passes = make(p);
+        if (passes.empty() || std::any_of(passes.begin(), passes.end(), [](const ProposeFn& f) { return !f; })) {
+          throw Error("merge method '" + name + "' made no passes, or an empty one");
+        }
+        return passes;
+      }),
+      std::move(params));
+}
+
 void register_merge_method(std::string name, std::string help, MergePasses passes) {
   if (passes.empty() || std::any_of(passes.begin(), passes.end(), [](const ProposeFn& f) { return !f; })) {
     throw Error("register merge method: '" + name + "' needs at least one pass, and no empty one");
   }
-  merge_method_registry().add(std::move(name), std::move(help), in_steps(std::move(passes)));
+  register_merge_method(std::move(name), std::move(help), [passes](const core::Params&) { return passes; }, {});
 }
 
 std::vector<std::string> merge_method_names() { return merge_method_registry().names(); }
 
 std::string merge_method_help() { return merge_method_registry().help(); }
 
-void check_merge_method(const std::string& name) {
+void check_merge_method(const std::string& name, const MergeMethodSettings& settings) {
   // The grid search was called "overlap" before the simulator's `overlap` aligner used the name.
   if (name == "overlap") throw InputError("merge method 'overlap' is now called 'grid' (valid: " + core::join(merge_method_names()) + ")");
-  merge_method_registry().get(name);  // InputError naming the valid ones
+  const auto& registry = merge_method_registry();
+  registry.get(name);  // InputError naming the valid ones
+  for (const auto& [method, given] : settings) {
+    registry.get(method);
+    if (method != name && name != "auto") {
+      throw InputError("merge method '" + name + "' does not run '" + method + "', so its parameters do not apply (only auto runs every method)");
+    }
+  }
+  for (const auto& method : registry.names()) {
+    if (method == name || name == "auto") registry.configure(method, settings_of(settings, method));
+  }
 }
 
 namespace {
@@ -597,7 +708,7 @@ PrepareOptions prepare_options(const MergeOptions& options) {
 }
 
 MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const MergeOptions& options) {
-  check_merge_method(options.method);
+  check_merge_method(options.method, options.method_settings);
   check_search_options(options);
   const double ra = a.grid().resolution(), rb = b.grid().resolution();
   if (std::abs(ra - rb) > 1e-9 * ra)
@@ -618,7 +729,7 @@ MergeResult align_prepared(const PreparedGrid& a, const PreparedGrid& b, const M
   core::Random random(options.seed);
   // Steps: lists of passes. Candidates accumulate; each step ends with a decision, and a merge at
   // sure_confidence or more ends the search.
-  const MergeSteps steps = merge_method_registry().get(options.method).make();
+  const MergeSteps steps = method_steps(merge_method_registry(), options.method, options.method_settings);
   std::vector<Hypothesis> candidates;
   MergeResult best;
   for (const auto& step : steps) {

@@ -160,8 +160,12 @@ struct ConfidenceOptions {
 // The confidences a threshold may be (the scenario's merging.min_confidence, merge --min-confidence).
 inline constexpr core::Range kConfidenceRange{0, 1};
 
+// Per merge method by name, the values given to its declared parameters (`--set features.ratio=0.7`).
+using MergeMethodSettings = std::vector<std::pair<std::string, core::Settings>>;
+
 struct MergeOptions {
   std::string method = "auto";   // a name of merge_method_names()
+  MergeMethodSettings method_settings;  // for `method` and, under `auto`, the methods it runs
   double min_confidence = 0.5;   // below: not merged, "no reliable overlap"
   // A step's merge below this confidence does not end the search: the next step runs too, its
   // candidates join, and the higher confidence wins. A first step that missed the right rotation
@@ -252,9 +256,10 @@ using ProposeFn = std::function<std::vector<Hypothesis>(const PreparedGrid& a, c
 // A method runs its passes in order, each adding candidates, until the decision is to merge.
 using MergePasses = std::vector<ProposeFn>;
 // What a registered method runs: steps, each a list of passes whose candidates are then decided on;
-// the search stops at a sure merge. Made when a merge starts (`auto` reads the registry then).
+// the search stops at a sure merge. Made when a merge starts, from the method's own parameters'
+// values and, for `auto`, which runs the other methods, every method's settings.
 using MergeSteps = std::vector<std::vector<ProposeFn>>;
-using MergeMethod = std::function<MergeSteps()>;
+using MergeMethod = std::function<MergeSteps(const core::Params& own, const MergeMethodSettings& all)>;
 
 // Every merge method by name: auto, grid, features, then the registered ones. `auto` is the first
 // pass of the first other method (grid's spectral search), then, when that is not confident, every
@@ -263,12 +268,17 @@ core::Registry<MergeMethod>& merge_method_registry();
 // Adds a method that `merge --method`, the `overlap` aligner's `method` and `auto` then use, one
 // step per pass. Throws Error for an empty or taken name, or no passes.
 void register_merge_method(std::string name, std::string help, MergePasses passes);
+// The same for a method with parameters of its own (core/params.h): `make` gets their values
+// (`merge --set NAME.KEY=VALUE`, MergeOptions::method_settings) and returns the passes.
+void register_merge_method(std::string name, std::string help, std::function<MergePasses(const core::Params&)> make,
+                           std::vector<core::ParamSpec> params);
 // The registry's names, for --help and errors.
 std::vector<std::string> merge_method_names();
-// One line per name: "  name: help".
+// One line per name: "  name: help", and its parameters.
 std::string merge_method_help();
-// Throws InputError naming the valid names unless `name` is one of merge_method_names().
-void check_merge_method(const std::string& name);
+// Throws InputError unless `name` is one of merge_method_names() (naming the valid ones) and each
+// of `settings` is for a method that `name` runs (itself, or any under `auto`) and declared by it.
+void check_merge_method(const std::string& name, const MergeMethodSettings& settings = {});
 
 // A map cut to the box of its known cells (with a margin), so that the search does not pay for
 // the unknown around what a robot saw (a robot's map is often allocated far larger).

@@ -410,6 +410,33 @@ TEST(MergeCommand, HelpStatesTheConventionAndEveryFlagWithItsDefault) {
   }
 }
 
+// A merge method's declared parameters, set with --set METHOD.KEY=VALUE and recorded in the JSON.
+TEST(MergeCommand, SetsAMergeMethodsParameters) {
+  TempDir dir;
+  write_pair(dir, "a.png", "b.png", 5);
+  // These small crops give ORB too few matches for a model of 8 inliers; a looser ratio test and
+  // fewer inliers give it candidates.
+  const auto strict = run_fleetmap("merge a.png b.png --method features --out s.png --json s.json", dir);
+  ASSERT_NE(strict.exit_code, 2) << strict.err;
+  EXPECT_NE(slurp(dir / "s.json").find("no candidate transform"), std::string::npos);
+  const auto loose = run_fleetmap(
+      "merge a.png b.png --method features --set features.ratio=1 --set features.min_inliers=3 --out l.png --json l.json", dir);
+  ASSERT_NE(loose.exit_code, 2) << loose.err;
+  const auto j = nlohmann::json::parse(slurp(dir / "l.json"));
+  EXPECT_EQ(j["method_parameters"]["features"]["min_inliers"], "3");
+  EXPECT_EQ(j["method_parameters"]["features"]["ratio"], "1");
+  EXPECT_EQ(slurp(dir / "l.json").find("no candidate transform"), std::string::npos) << slurp(dir / "l.json");
+  // Under auto, each method run gets its own.
+  const auto with_auto = run_fleetmap("merge a.png b.png --set features.min_inliers=10000 --set grid.sweep_step_deg=2 --out x.png", dir);
+  EXPECT_EQ(with_auto.exit_code, 0) << with_auto.err;
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge a.png b.png --method grid --set features.ratio=0.5 --out bad.png", dir),
+                        "merge method 'grid' does not run 'features'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge a.png b.png --set features.ratoi=0.5 --out bad.png", dir), "did you mean 'ratio'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge a.png b.png --set grid.sweep_step_deg=0 --out bad.png", dir), ">= 0.25");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("merge a.png b.png --set grd.search_cells=64 --out bad.png", dir), "did you mean 'grid'");
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.png"));
+}
+
 TEST(MergeCommand, BadInputGetsOneLineNamingItAndExitCode2) {
   TempDir dir;
   write_pair(dir, "a.png", "b.png", 8);

@@ -813,10 +813,10 @@ TEST(MergeRegistry, NamesAutoFirstThenTheBuiltInMethods) {
   EXPECT_EQ(names[2], "features");
   for (const auto& name : names) {
     EXPECT_NE(merge_method_help().find("  " + name + ": "), std::string::npos) << name;
-    EXPECT_FALSE(merge_method_registry().get(name).make().empty()) << name;
+    EXPECT_FALSE(merge_method_registry().get(name).make(merge_method_registry().params(name), {}).empty()) << name;
   }
   // auto: grid's first pass alone, then the other passes together.
-  const MergeSteps steps = merge_method_registry().get("auto").make();
+  const MergeSteps steps = merge_method_registry().get("auto").make(merge_method_registry().params("auto"), {});
   ASSERT_EQ(steps.size(), 2u);
   EXPECT_EQ(steps[0].size(), 1u);
   EXPECT_GE(steps[1].size(), 2u);
@@ -874,6 +874,67 @@ TEST(MergeRegistry, AProgramsOwnMethodIsReachedByNameAndRefinedByTheCommonPipeli
   const MergeResult none = align_prepared(a, b, options);
   EXPECT_FALSE(none.merged);
   EXPECT_EQ(none.candidates, 0);
+}
+
+// A program's method with a parameter of its own: the oracle's answer moved by `offset` cells along
+// x. The value reaches its passes from MergeOptions::method_settings, directly and under `auto`.
+TEST(MergeRegistry, AProgramsOwnMethodGetsItsDeclaredParameter) {
+  if (!merge_method_registry().contains("offset-oracle")) {
+    register_merge_method(
+        "offset-oracle", "the true transform moved along x (a test's own)",
+        [](const core::Params& p) {
+          const double offset = p.number("offset");
+          return MergePasses{[offset](const PreparedGrid&, const PreparedGrid&, const MergeOptions&, core::Random&) {
+            if (!oracle_answer) return std::vector<Hypothesis>{};
+            const core::Transform2 moved(oracle_answer->translation() + Eigen::Vector2d(offset, 0.0), oracle_answer->rotation());
+            return std::vector<Hypothesis>{Hypothesis{moved, 1.0, 0, "offset-oracle"}};
+          }};
+        },
+        {core::ParamSpec::number("offset", 0.0, {-100, 100}, "cells", "the answer moved this far along x")});
+  }
+  EXPECT_NE(merge_method_help().find("offset = 0 cells"), std::string::npos);
+  const CropPair pair = furnished_half_overlap_pair();
+  const PreparedGrid a(pair.a), b(pair.b);
+  MergeOptions options;
+  options.method = "offset-oracle";
+  options.refine = false;  // the method's raw answer
+  oracle_answer = pair.b_to_a;
+  const auto x_of = [&](const MergeMethodSettings& settings) {
+    options.method_settings = settings;
+    return align_prepared(a, b, options).transform.translation().x() - pair.b_to_a.translation().x();
+  };
+  EXPECT_NEAR(x_of({}), 0.0, 1e-9);
+  EXPECT_NEAR(x_of({{"offset-oracle", {{"offset", "7"}}}}), 7.0, 1e-9);
+  oracle_answer.reset();
+  // Refused: a parameter it does not declare, a value out of its range, another method's parameters.
+  options.method_settings = {{"offset-oracle", {{"ofset", "1"}}}};
+  EXPECT_THROW(align_prepared(a, b, options), InputError);
+  options.method_settings = {{"offset-oracle", {{"offset", "1000"}}}};
+  EXPECT_THROW(align_prepared(a, b, options), InputError);
+  options.method_settings = {{"features", {{"ratio", "0.5"}}}};
+  EXPECT_THROW(align_prepared(a, b, options), InputError);
+  // Under auto every method's parameters apply; the built-ins' defaults are their options' own.
+  options.method = "auto";
+  options.method_settings = {{"features", {{"ratio", "0.5"}}}, {"grid", {{"sweep_step_deg", "2"}}}};
+  EXPECT_NO_THROW(check_merge_method(options.method, options.method_settings));
+  EXPECT_EQ(merge_method_registry().params("features").number("ratio"), FeatureMatchingOptions().ratio);
+  EXPECT_EQ(merge_method_registry().params("grid").number("sweep_step_deg"), MergeOptions().sweep_step_deg);
+  EXPECT_EQ(merge_method_registry().params("grid").number("search_cells"), OverlapSearchOptions().search_cells);
+}
+
+// Feature matching's parameters reach its pass: a model needing more inliers than the maps have
+// keypoints proposes nothing.
+TEST(MergeRegistry, FeatureMatchingsParametersReachItsPass) {
+  const CropPair pair = furnished_half_overlap_pair();
+  const PreparedGrid a(pair.a), b(pair.b);
+  MergeOptions options;
+  options.method = "features";
+  const MergeResult found = align_prepared(a, b, options);
+  EXPECT_GT(found.candidates, 0);
+  options.method_settings = {{"features", {{"min_inliers", "10000"}}}};
+  const MergeResult none = align_prepared(a, b, options);
+  EXPECT_EQ(none.candidates, 0);
+  EXPECT_FALSE(none.merged);
 }
 
 int second_pass_calls = 0;
