@@ -426,6 +426,17 @@ std::vector<core::ParamSpec> param_specs(const std::vector<PythonParam>& params)
   return specs;
 }
 
+// Makes a plug-in's object from its registered class; an exception raised in Python becomes a
+// fleetmap Error naming the plug-in.
+template <typename... Args>
+py::object make_plugin(const std::string& who, PyObject* cls, Args&&... args) {
+  try {
+    return py::reinterpret_borrow<py::object>(cls)(std::forward<Args>(args)...);
+  } catch (py::error_already_set& e) {
+    throw Error(fmt::format("{}: making it raised {}", who, e.what()));
+  }
+}
+
 void register_python_strategy(const std::string& name, const py::object& cls, const std::string& help, bool joint,
                               bool with_context, const std::vector<PythonParam>& params) {
   if (!py::hasattr(cls, "assign")) throw InputError("register_strategy '" + name + "': the class has no assign method");
@@ -433,7 +444,7 @@ void register_python_strategy(const std::string& name, const py::object& cls, co
   exploration::register_strategy(name, help.empty() ? "written in Python" : help,
                                  [name, held, joint, with_context](const exploration::StrategyOptions& options) {
                                    py::gil_scoped_acquire gil;
-                                   py::object instance = py::reinterpret_borrow<py::object>(held)();
+                                   py::object instance = make_plugin("strategy '" + name + "'", held);
                                    return std::make_unique<PythonStrategy>(name, joint, with_context,
                                                                            std::move(instance), options);
                                  },
@@ -468,17 +479,6 @@ std::vector<double> finite_numbers(const py::handle& answer, std::size_t count, 
     throw Error(fmt::format("{}: {} must return {}, got {}", who, method, expected, std::string(py::repr(answer))));
   }
   return out;
-}
-
-// Makes a plug-in's object from its registered class; an exception raised in Python becomes a
-// fleetmap Error naming the plug-in.
-template <typename... Args>
-py::object make_plugin(const std::string& who, PyObject* cls, Args&&... args) {
-  try {
-    return py::reinterpret_borrow<py::object>(cls)(std::forward<Args>(args)...);
-  } catch (py::error_already_set& e) {
-    throw Error(fmt::format("{}: making it raised {}", who, e.what()));
-  }
 }
 
 // A planner whose search is a Python object's method:

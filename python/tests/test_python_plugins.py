@@ -306,6 +306,16 @@ class PythonLocalizerTest(unittest.TestCase):
                                                   "wheel fell off"):
             fleetmap.explore(TWO_ROBOTS, steps=5, localization="py-raising-localizer")
 
+    def test_an_exception_in_its_constructor_names_the_localizer(self):
+        class RefusesToStart(BiasedDeadReckoning):
+            def __init__(self, initial_pose, params, seed):
+                raise ValueError(f"no start at {initial_pose}")
+
+        fleetmap.register_localizer("py-refuses-to-start", RefusesToStart)
+        with self.assertRaisesRegex(RuntimeError, "localizer 'py-refuses-to-start': making it raised ValueError: "
+                                                  "no start at \\(1.0, 1.0, 0.0\\)"):
+            fleetmap.explore(TWO_ROBOTS, steps=5, localization="py-refuses-to-start")
+
     def test_sweeps_run_it_on_several_threads(self):
         rows = fleetmap.sweep(maps=["empty"], strategies=["coordinated"], robots=2, seeds=2, steps=10, jobs=2,
                               localization="py-biased")
