@@ -1,14 +1,16 @@
 // The C++ half of the Python package `fleetmap` (pybind11): maps as numpy arrays, exploration runs,
-// map merging, path planning, sweeps, and coordination strategies written in Python. The Python
-// half (fleetmap/__init__.py) turns scenario dicts and files into the YAML text read here and wraps
-// the results; fleetmap/__init__.pyi documents both.
+// map merging, path planning, sweeps, and coordination strategies, planners, map aligners and
+// localizers written in Python. The Python half (fleetmap/__init__.py) turns scenario dicts and files
+// into the YAML text read here and wraps the results; fleetmap/__init__.pyi documents both.
 #include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -22,7 +24,9 @@
 #include "core/memory.h"
 #include "exploration/strategy.h"
 #include "io/map_io.h"
+#include "localization/localizer.h"
 #include "maps/builtin_maps.h"
+#include "merging/map_aligner.h"
 #include "merging/merge.h"
 #include "merging/multi_merge.h"
 #include "planning/free_space.h"
@@ -233,6 +237,20 @@ void write_results(const std::vector<std::string>& lines, const std::string& pat
   sweep::write_results(path, records);
 }
 
+// A member's declared parameters with their values, as every Python plug-in gets them: numbers as
+// float, flags as bool, words as str.
+py::dict params_dict(const core::Params& params) {
+  py::dict out;
+  for (const auto& spec : params.specs()) {
+    switch (spec.type) {
+      case core::ParamSpec::Type::Number: out[py::str(spec.name)] = params.number(spec.name); break;
+      case core::ParamSpec::Type::Flag: out[py::str(spec.name)] = params.flag(spec.name); break;
+      case core::ParamSpec::Type::Text: out[py::str(spec.name)] = params.text(spec.name); break;
+    }
+  }
+  return out;
+}
+
 // What a Python strategy gets besides the arrays (its assign's optional fifth argument): the
 // robots' places in the team, the strategy options, and the lazily computed target-to-target wave
 // costs and unknown areas, which exist only while assign runs.
@@ -251,17 +269,7 @@ class AssignmentContext {
   int team_size() const { return live().robots.empty() ? 0 : live().robots.front().team_size; }
   double sensor_range() const { return live().sensor_range_m; }
   // The strategy's declared parameters with this run's values: numbers as float, flags as bool.
-  py::dict params() const {
-    py::dict out;
-    for (const auto& spec : options_.specs()) {
-      switch (spec.type) {
-        case core::ParamSpec::Type::Number: out[py::str(spec.name)] = options_.number(spec.name); break;
-        case core::ParamSpec::Type::Flag: out[py::str(spec.name)] = options_.flag(spec.name); break;
-        case core::ParamSpec::Type::Text: out[py::str(spec.name)] = options_.text(spec.name); break;
-      }
-    }
-    return out;
-  }
+  py::dict params() const { return params_dict(options_); }
   py::array_t<double> target_costs() const {
     const auto& input = live();
     Eigen::MatrixXd costs;
@@ -297,6 +305,24 @@ class AssignmentContext {
   exploration::StrategyOptions options_;
 };
 
+// A Python object a C++ plug-in owns: released with the GIL held, on whichever thread the plug-in
+// dies (simulations run with the GIL released).
+class PluginObject {
+ public:
+  explicit PluginObject(py::object object) : object_(std::move(object)) {}
+  PluginObject(const PluginObject&) = delete;
+  PluginObject& operator=(const PluginObject&) = delete;
+  ~PluginObject() {
+    py::gil_scoped_acquire gil;
+    object_ = py::object();
+  }
+  operator const py::object&() const { return object_; }
+  py::object attr(const char* name) const { return object_.attr(name); }
+
+ private:
+  py::object object_;
+};
+
 // A coordination strategy whose assign() is a Python object's method:
 //   assign(poses (R, 3): x, y, heading, targets (T, 4): goal x, goal y, frontier cells, region,
 //          costs (R, T) wave metres (inf: unreachable), claimed (K, 2)[, context]) -> R target indices or -1.
@@ -307,10 +333,6 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
                  const exploration::StrategyOptions& options)
       : name_(std::move(name)), joint_(joint), with_context_(with_context), instance_(std::move(instance)),
         options_(options) {}
-  ~PythonStrategy() override {
-    py::gil_scoped_acquire gil;
-    instance_ = py::object();
-  }
   std::string name() const override { return name_; }
   bool joint() const override { return joint_; }
 
@@ -365,7 +387,7 @@ class PythonStrategy final : public exploration::CoordinationStrategy {
   std::string name_;
   bool joint_;
   bool with_context_;
-  py::object instance_;
+  PluginObject instance_;
   exploration::StrategyOptions options_;
 };
 
@@ -389,25 +411,303 @@ core::ParamSpec param_spec(const PythonParam& p) {
   return spec;
 }
 
+// Keeps a registered Python class alive for the life of the process: the registries keep their
+// factories beyond the interpreter's, so the reference is never released and no Python object dies
+// without it.
+PyObject* hold_forever(const py::object& cls) {
+  PyObject* held = cls.ptr();
+  Py_INCREF(held);
+  return held;
+}
+
+std::vector<core::ParamSpec> param_specs(const std::vector<PythonParam>& params) {
+  std::vector<core::ParamSpec> specs;
+  for (const auto& p : params) specs.push_back(param_spec(p));
+  return specs;
+}
+
+// Makes a plug-in's object from its registered class; an exception raised in Python becomes a
+// fleetmap Error naming the plug-in.
+template <typename... Args>
+py::object make_plugin(const std::string& who, PyObject* cls, Args&&... args) {
+  try {
+    return py::reinterpret_borrow<py::object>(cls)(std::forward<Args>(args)...);
+  } catch (py::error_already_set& e) {
+    throw Error(fmt::format("{}: making it raised {}", who, e.what()));
+  }
+}
+
 void register_python_strategy(const std::string& name, const py::object& cls, const std::string& help, bool joint,
                               bool with_context, const std::vector<PythonParam>& params) {
   if (!py::hasattr(cls, "assign")) throw InputError("register_strategy '" + name + "': the class has no assign method");
-  // The registry keeps its factories for the life of the process, beyond the interpreter's; the
-  // class is held by a reference that is never released, so no Python object dies without it.
-  PyObject* held = cls.ptr();
-  Py_INCREF(held);
+  PyObject* held = hold_forever(cls);
   exploration::register_strategy(name, help.empty() ? "written in Python" : help,
                                  [name, held, joint, with_context](const exploration::StrategyOptions& options) {
                                    py::gil_scoped_acquire gil;
-                                   py::object instance = py::reinterpret_borrow<py::object>(held)();
+                                   py::object instance = make_plugin("strategy '" + name + "'", held);
                                    return std::make_unique<PythonStrategy>(name, joint, with_context,
                                                                            std::move(instance), options);
                                  },
-                                 [&] {
-                                   std::vector<core::ParamSpec> specs;
-                                   for (const auto& p : params) specs.push_back(param_spec(p));
-                                   return specs;
-                                 }());
+                                 param_specs(params));
+}
+
+// Calls a Python plug-in's method; the caller holds the GIL. An exception raised in Python becomes a
+// fleetmap Error naming the plug-in (`who`, e.g. "planner 'my-planner'") and the method.
+template <typename... Args>
+py::object call_plugin(const std::string& who, const py::object& instance, const char* method, Args&&... args) {
+  try {
+    return instance.attr(method)(std::forward<Args>(args)...);
+  } catch (py::error_already_set& e) {
+    throw Error(fmt::format("{}: {} raised {}", who, method, e.what()));
+  }
+}
+
+// Reads `count` finite numbers from what a plug-in's `method` returned, or throws Error naming the
+// plug-in, the method, what it must return and what it did.
+std::vector<double> finite_numbers(const py::handle& answer, std::size_t count, const std::string& who,
+                                   const char* method, const char* expected) {
+  std::vector<double> out;
+  bool read = py::isinstance<py::sequence>(answer) && !py::isinstance<py::str>(answer);
+  if (read) {
+    try {
+      for (const auto& item : py::reinterpret_borrow<py::sequence>(answer)) out.push_back(item.cast<double>());
+    } catch (const py::cast_error&) {
+      read = false;
+    }
+  }
+  if (!read || out.size() != count || !std::all_of(out.begin(), out.end(), [](double v) { return std::isfinite(v); })) {
+    throw Error(fmt::format("{}: {} must return {}, got {}", who, method, expected, std::string(py::repr(answer))));
+  }
+  return out;
+}
+
+// A planner whose search is a Python object's method:
+//   search(free, resolution, origin, start, goal, params) -> [(x, y), ...] or None
+// `free` is a bool (height, width) array, top row first as Map.image, true where the robot's centre
+// may be; origin is the map's lower-left corner (x, y, theta). The path it returns is checked as
+// every planner's must be: from the start to the goal (within half a cell's diagonal, then snapped to
+// them) and every segment inside the free space.
+class PythonPlanner final : public planning::Planner {
+ public:
+  PythonPlanner(std::string name, py::object instance, const core::Params& params)
+      : name_(std::move(name)), instance_(std::move(instance)), params_(params) {}
+  std::string name() const override { return name_; }
+
+ protected:
+  Search search(const planning::FreeSpace& space, const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
+                const planning::PlannerOptions& /*options*/, Clock::time_point /*deadline*/) override {
+    const std::string who = "planner '" + name_ + "'";
+    const auto& g = space.geometry();
+    py::gil_scoped_acquire gil;
+    py::array_t<bool> free({py::ssize_t(g.height()), py::ssize_t(g.width())});
+    auto f = free.mutable_unchecked<2>();
+    for (int y = 0; y < g.height(); ++y)
+      for (int x = 0; x < g.width(); ++x) f(py::ssize_t(g.height() - 1 - y), py::ssize_t(x)) = space.valid(planning::Cell{x, y});
+    const py::object answer = call_plugin(who, instance_, "search", free, g.resolution(), pose_tuple(g.origin()),
+                                          py::make_tuple(start.x(), start.y()), py::make_tuple(goal.x(), goal.y()),
+                                          params_dict(params_));
+    Search out;
+    if (answer.is_none()) {
+      out.detail = who + " found no path";
+      return out;
+    }
+    const char* expected = "a list of (x, y) waypoints in metres, or None";
+    if (!py::isinstance<py::sequence>(answer) || py::isinstance<py::str>(answer)) {
+      throw Error(fmt::format("{}: search must return {}, got {}", who, expected, std::string(py::repr(answer))));
+    }
+    for (const auto& point : py::reinterpret_borrow<py::sequence>(answer)) {
+      const auto xy = finite_numbers(point, 2, who, "search", expected);
+      out.path.emplace_back(xy[0], xy[1]);
+    }
+    // An end within half a cell's diagonal counts as the start or goal itself, so that a planner on
+    // cells may answer with the centres of their cells; the segments are checked after snapping.
+    const double tolerance = std::sqrt(0.5) * g.resolution() * (1.0 + 1e-9);  // a corner's rounding too
+    if (out.path.size() < 2) {
+      throw Error(fmt::format("{}: search returned {} waypoint(s); a path needs the start and the goal", who,
+                              out.path.size()));
+    }
+    const auto check_end = [&](const Eigen::Vector2d& got, const Eigen::Vector2d& want, const char* end) {
+      if ((got - want).norm() > tolerance) {
+        throw Error(fmt::format("{}: the path's {} ({:.3f}, {:.3f}) is {:.3f} m from the {} ({:.3f}, {:.3f}), more "
+                                "than half a cell's diagonal ({:.3f} m)",
+                                who, end == std::string("start") ? "first waypoint" : "last waypoint", got.x(), got.y(),
+                                (got - want).norm(), end, want.x(), want.y(), tolerance));
+      }
+    };
+    check_end(out.path.front(), start, "start");
+    check_end(out.path.back(), goal, "goal");
+    out.path.front() = start;
+    out.path.back() = goal;
+    for (std::size_t i = 0; i + 1 < out.path.size(); ++i) {
+      if (const auto d = space.first_invalid_distance(out.path[i], out.path[i + 1])) {
+        const Eigen::Vector2d at = out.path[i] + *d * (out.path[i + 1] - out.path[i]).normalized();
+        throw Error(fmt::format("{}: segment {} of the path, ({:.3f}, {:.3f}) to ({:.3f}, {:.3f}), leaves the free "
+                                "space at ({:.3f}, {:.3f}) (an obstacle, unknown space or closer to one than the robot "
+                                "radius {:.2f} m)",
+                                who, i, out.path[i].x(), out.path[i].y(), out.path[i + 1].x(), out.path[i + 1].y(),
+                                at.x(), at.y(), space.robot_radius()));
+      }
+    }
+    out.found = true;
+    out.first_solution = Clock::now();
+    return out;
+  }
+
+ private:
+  std::string name_;
+  PluginObject instance_;
+  core::Params params_;
+};
+
+void register_python_planner(const std::string& name, const py::object& cls, const std::string& help, bool complete,
+                             const std::vector<PythonParam>& params) {
+  if (!py::hasattr(cls, "search")) throw InputError("register_planner '" + name + "': the class has no search method");
+  PyObject* held = hold_forever(cls);
+  planning::PlannerMaker maker;
+  maker.complete = complete;
+  maker.make = [name, held](const core::Params& values) -> std::unique_ptr<planning::Planner> {
+    py::gil_scoped_acquire gil;
+    py::object instance = make_plugin("planner '" + name + "'", held);
+    return std::make_unique<PythonPlanner>(name, std::move(instance), values);
+  };
+  planning::register_planner(name, help.empty() ? "written in Python" : help, std::move(maker), param_specs(params));
+}
+
+// A map aligner whose align is a Python object's method:
+//   align(receiver_map, sender_map, receiver_pose, sender_pose, params) -> None or (tx, ty, theta, confidence)
+// The maps are fleetmap.Map copies, each in its robot's own frame; the answer takes the sender's
+// frame into the receiver's (metres, radians). None: tried, not merged.
+class PythonMapAligner final : public merging::MapAligner {
+ public:
+  PythonMapAligner(std::string name, py::object instance, const core::Params& params)
+      : name_(std::move(name)), instance_(std::move(instance)), params_(params) {}
+  bool costly() const override { return true; }
+  bool sends_map() const override { return true; }
+  merging::FrameAlignment align(const merging::AlignmentRequest& request) const override {
+    const std::string who = "map aligner '" + name_ + "'";
+    py::gil_scoped_acquire gil;
+    const py::object answer =
+        call_plugin(who, instance_, "align", py::cast(*request.receiver_map), py::cast(*request.sender_map),
+                    pose_tuple(request.receiver_pose), pose_tuple(request.sender_pose), params_dict(params_));
+    merging::FrameAlignment out;
+    out.attempted = true;
+    out.method = name_;
+    if (answer.is_none()) {
+      out.reason = name_ + " found no alignment";
+      return out;
+    }
+    const auto t = finite_numbers(answer, 4, who, "align", "None or (tx, ty, theta, confidence)");
+    if (!(t[3] >= 0.0 && t[3] <= 1.0)) {
+      throw Error(fmt::format("{}: align's confidence must be in [0, 1], got {}", who, t[3]));
+    }
+    out.merged = true;
+    out.sender_to_receiver = core::Transform2(t[0], t[1], t[2]);
+    out.confidence = t[3];
+    return out;
+  }
+
+ private:
+  std::string name_;
+  PluginObject instance_;
+  core::Params params_;
+};
+
+void register_python_map_aligner(const std::string& name, const py::object& cls, const std::string& help,
+                                 const std::vector<PythonParam>& params) {
+  if (!py::hasattr(cls, "align")) throw InputError("register_map_aligner '" + name + "': the class has no align method");
+  PyObject* held = hold_forever(cls);
+  merging::register_map_aligner(
+      name, help.empty() ? "written in Python" : help,
+      [name, held](const core::Params& values) -> std::unique_ptr<merging::MapAligner> {
+        py::gil_scoped_acquire gil;
+        py::object instance = make_plugin("map aligner '" + name + "'", held);
+        return std::make_unique<PythonMapAligner>(name, std::move(instance), values);
+      },
+      param_specs(params));
+}
+
+// Whether a plug-in's object has `method` (an attribute set to None does not count).
+bool has_method(const py::object& object, const char* method) {
+  return py::hasattr(object, method) && !object.attr(method).is_none();
+}
+
+// A localizer whose methods are a Python object's, made as cls(initial_pose, params, seed):
+//   predict(dx, dy, dtheta): the step's odometry as the motion in the robot's frame before it;
+//   update_scan(ranges, angles, max_range), when the class has it (uses_scans): inf for no return;
+//   pose() -> (x, y, theta); covariance() -> 3 x 3, when it has it (zero otherwise);
+//   change_frame(tx, ty, theta), when it has it: the estimate re-expressed after a merge.
+class PythonLocalizer final : public localization::Localizer {
+ public:
+  PythonLocalizer(std::string name, py::object instance)
+      : name_(std::move(name)), who_("localizer '" + name_ + "'"), instance_(std::move(instance)),
+        uses_scans_(has_method(instance_, "update_scan")), has_covariance_(has_method(instance_, "covariance")),
+        moves_(has_method(instance_, "change_frame")) {}
+  std::string name() const override { return name_; }
+  bool uses_scans() const override { return uses_scans_; }
+  bool ignores_own_map() const override { return true; }
+
+  void predict(const localization::Odometry& u) override {
+    const core::Pose2 step = localization::integrate_motion(core::Pose2(), u);
+    py::gil_scoped_acquire gil;
+    call_plugin(who_, instance_, "predict", step.x, step.y, step.theta);
+  }
+  void update_scan(const localization::RangeScan& scan, const mapping::OccupancyGrid& /*own_map*/) override {
+    if (!uses_scans_) return;
+    py::gil_scoped_acquire gil;
+    py::array_t<double> ranges(py::ssize_t(scan.ranges.size()));
+    for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
+      ranges.mutable_at(py::ssize_t(b)) = scan.ranges[b].value_or(std::numeric_limits<double>::infinity());
+    }
+    call_plugin(who_, instance_, "update_scan", ranges,
+                py::array_t<double>(py::ssize_t(scan.angles.size()), scan.angles.data()), scan.max_range);
+  }
+  core::Pose2 pose() const override {
+    py::gil_scoped_acquire gil;
+    const auto p = finite_numbers(call_plugin(who_, instance_, "pose"), 3, who_, "pose", "(x, y, theta)");
+    return {p[0], p[1], p[2]};
+  }
+  Eigen::Matrix3d covariance() const override {
+    if (!has_covariance_) return Eigen::Matrix3d::Zero();
+    py::gil_scoped_acquire gil;
+    const py::object answer = call_plugin(who_, instance_, "covariance");
+    const auto flat = finite_numbers(py::module_::import("numpy").attr("ravel")(answer), 9, who_, "covariance",
+                                     "a 3 x 3 matrix of finite numbers");
+    Eigen::Matrix3d c;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) c(i, j) = flat[std::size_t(3 * i + j)];
+    return c;
+  }
+  void change_frame(const core::Transform2& t) override {
+    if (!moves_) {
+      throw Error(who_ + " has no change_frame(tx, ty, theta): its robot cannot take a teammate's map frame");
+    }
+    py::gil_scoped_acquire gil;
+    call_plugin(who_, instance_, "change_frame", t.translation().x(), t.translation().y(), t.rotation());
+  }
+
+ private:
+  std::string name_, who_;
+  PluginObject instance_;
+  bool uses_scans_, has_covariance_, moves_;
+};
+
+void register_python_localizer(const std::string& name, const py::object& cls, const std::string& help,
+                               const std::vector<PythonParam>& params) {
+  for (const char* method : {"predict", "pose"}) {
+    if (!py::hasattr(cls, method)) {
+      throw InputError(fmt::format("register_localizer '{}': the class has no {} method", name, method));
+    }
+  }
+  PyObject* held = hold_forever(cls);
+  localization::register_localizer(
+      name, help.empty() ? "written in Python" : help,
+      [name, held](const localization::LocalizerContext& context) -> std::unique_ptr<localization::Localizer> {
+        py::gil_scoped_acquire gil;
+        py::object instance = make_plugin("localizer '" + name + "'", held, pose_tuple(context.initial_pose),
+                                          params_dict(context.params), context.seed);
+        return std::make_unique<PythonLocalizer>(name, std::move(instance));
+      },
+      param_specs(params));
 }
 
 }  // namespace
@@ -687,6 +987,12 @@ PYBIND11_MODULE(_fleetmap, m) {
 
   m.def("_register_strategy", &register_python_strategy, py::arg("name"), py::arg("cls"), py::arg("help"),
         py::arg("joint"), py::arg("with_context"), py::arg("params"));
+  m.def("_register_planner", &register_python_planner, py::arg("name"), py::arg("cls"), py::arg("help"),
+        py::arg("complete"), py::arg("params"));
+  m.def("_register_map_aligner", &register_python_map_aligner, py::arg("name"), py::arg("cls"), py::arg("help"),
+        py::arg("params"));
+  m.def("_register_localizer", &register_python_localizer, py::arg("name"), py::arg("cls"), py::arg("help"),
+        py::arg("params"));
 
   py::class_<AssignmentContext>(m, "AssignmentContext",
                                 "What a Python strategy's assign gets as its optional fifth argument; valid only "

@@ -3,8 +3,8 @@
 Runs explorations from a scenario (a dict, a YAML file, or keyword arguments) and returns their
 metrics and per-step arrays; loads and saves maps as numpy arrays (map_server's 0 occupied,
 254 free, 205 unknown); merges two maps; plans paths; runs benchmark sweeps; and registers
-coordination strategies written in Python, which scenarios and sweeps then use by name like the
-built-in ones.
+coordination strategies, path planners, map aligners and localizers written in Python, which
+scenarios, sweeps and plan_path then use by name like the built-in ones.
 
     import fleetmap
     run = fleetmap.explore(map="office", robots=2, steps=50, seed=1)
@@ -63,6 +63,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
 __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
     "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
+    "register_planner", "register_map_aligner", "register_localizer",
     "map_names", "strategies", "localizers", "map_aligners", "planners", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
 ]
 
@@ -292,15 +293,16 @@ def _takes_context(name: str, cls: Any) -> bool:
     return len(positional) >= 5
 
 
-def _param_declarations(name: str, params) -> list:
-    """register_strategy's `params` as the tuples the C++ side declares them from."""
+def _param_declarations(name: str, params, what: str = "register_strategy") -> list:
+    """The `params` of register_strategy (or of `what`, another register_ function) as the tuples the
+    C++ side declares them from."""
     out = []
     for key, spec in (params or {}).items():
         if not isinstance(spec, Mapping):
             spec = {"default": spec}
         unknown = set(spec) - {"default", "unit", "min", "max", "choices", "doc"}
         if unknown or "default" not in spec:
-            raise InputError(f"register_strategy '{name}': parameter '{key}' needs a default and takes only "
+            raise InputError(f"{what} '{name}': parameter '{key}' needs a default and takes only "
                              f"default, unit, min, max, choices, doc (got {sorted(spec)})")
         default = spec["default"]
         if isinstance(default, bool):
@@ -310,7 +312,7 @@ def _param_declarations(name: str, params) -> list:
         elif isinstance(default, str):
             kind, text = "text", default
         else:
-            raise InputError(f"register_strategy '{name}': parameter '{key}': the default must be a number, "
+            raise InputError(f"{what} '{name}': parameter '{key}': the default must be a number, "
                              f"True/False or a word, not {type(default).__name__}")
         lo = float(spec.get("min", -math.inf))
         hi = float(spec.get("max", math.inf))
@@ -346,3 +348,140 @@ def register_strategy(name: str, cls: type, help: str = "", joint: bool = True, 
         raise InputError(f"register_strategy '{name}': the class has no assign method")
     _fleetmap._register_strategy(name, cls, help, bool(joint), _takes_context(name, cls),
                                  _param_declarations(name, params))
+
+
+def _check_method(what: str, name: str, cls: Any, method: str, arguments: Sequence[str],
+                  optional: bool = False) -> bool:
+    """Whether cls has `method` taking `arguments` besides self; raises InputError naming the plug-in
+    when it lacks a required one or takes other arguments."""
+    if getattr(cls, method, None) is None:
+        if optional:
+            return False
+        raise InputError(f"{what} '{name}': the class has no {method} method")
+    function = getattr(cls, method)
+    try:
+        parameters = list(inspect.signature(function).parameters.values())
+    except (TypeError, ValueError):  # no signature to read: trusted
+        return True
+    if any(p.kind == p.VAR_POSITIONAL for p in parameters):
+        return True
+    positional = [p for p in parameters if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    if inspect.isfunction(function) and not isinstance(inspect.getattr_static(cls, method), staticmethod):
+        positional = positional[1:]  # a plain method read from the class still lists self
+    required = [p for p in positional if p.default is p.empty]
+    if len(required) > len(arguments) or len(positional) < len(arguments):
+        raise InputError(f"{what} '{name}': {method} must take ({', '.join(arguments)}); it takes "
+                         f"{len(positional)} arguments besides self")
+    return True
+
+
+def _check_made_as(what: str, name: str, cls: Any, arguments: Sequence[str]) -> None:
+    """Raises InputError naming the plug-in when cls cannot be called with `arguments`."""
+    try:
+        signature = inspect.signature(cls)
+    except (TypeError, ValueError):  # no signature to read: trusted
+        return
+    try:
+        signature.bind(*arguments)
+    except TypeError:
+        raise InputError(f"{what} '{name}': the class is made as cls({', '.join(arguments)}), which its "
+                         f"signature {signature} does not take") from None
+
+
+def register_planner(name: str, cls: type, help: str = "", params: Mapping | None = None,
+                     complete: bool = False) -> None:
+    """Registers a path planner written in Python under `name`.
+
+    `cls` is a class (or any callable) called without arguments to make one planner object per
+    plan_path call (and per run of a scenario with exploration: {path_planner: NAME}). Its method
+        search(free, resolution, origin, start, goal, params) -> list of (x, y), or None
+    gets `free`, a bool (height, width) array of the map's cells, top row first as Map.image,
+    True where the robot's centre may be (a known free cell farther than the robot radius from
+    every obstacle and unknown cell); `resolution`, metres per cell; `origin`, the pose
+    (x, y, theta) of the map's lower-left corner, so that with theta 0 the centre of free[row, col]
+    is (origin x + (col + 0.5) * resolution, origin y + (height - row - 0.5) * resolution); `start`
+    and `goal`, (x, y) in metres, both valid and connected (plan_path answers the other cases
+    itself); and `params`, a dict of the declared parameters' values. It returns the waypoints in
+    metres from the start to the goal, or None when it finds no path (status 'no path within
+    budget'). The path is checked as every planner's must be: its ends must lie within half a
+    cell's diagonal of the start and the goal (the centres of their cells do; the ends are then
+    replaced by them) and every straight segment must stay in the free space; a path that does not
+    raises fleetmap.Error naming the planner and the segment. An exception raised in search becomes
+    a fleetmap.Error naming the planner. plan_path's time_budget does not stop a Python search: it
+    runs until it returns.
+
+    `help` is the one line planners() shows. `params` declares the planner's own settings as
+    register_strategy's do, by name: a default (a number, True/False or a word), or a dict
+    {default, unit, min, max, choices, doc}; plan_path(..., params={KEY: VALUE}) and a scenario's
+    exploration: {path_planner: {name: NAME, KEY: VALUE}} set them, checked against the
+    declaration. `complete`: whether it finds a path whenever one
+    exists (the test harnesses hold complete planners to it).
+    """
+    _check_made_as("register_planner", name, cls, [])
+    _check_method("register_planner", name, cls, "search", ["free", "resolution", "origin", "start", "goal", "params"])
+    _fleetmap._register_planner(name, cls, help, bool(complete), _param_declarations(name, params, "register_planner"))
+
+
+def register_map_aligner(name: str, cls: type, help: str = "", params: Mapping | None = None) -> None:
+    """Registers a map aligner written in Python under `name`: a way two robots in different map
+    frames find the transform between them, so that one takes the other's map (scenario
+    merging: NAME, or merging: {mode: NAME, KEY: VALUE}).
+
+    `cls` is a class (or any callable) called without arguments to make one aligner object per
+    run. Its method
+        align(receiver_map, sender_map, receiver_pose, sender_pose, params)
+            -> None or (tx, ty, theta, confidence)
+    gets the two robots' maps as fleetmap.Map copies (`.image` the uint8 array, 254 free, 0
+    occupied, 205 unknown, top row first; `.resolution`; `.origin`), each in its robot's own map
+    frame; the robots' estimated poses (x, y, theta) in those frames; and `params`, a dict of the
+    declared parameters' values. It returns None when it found no alignment (recorded as a refused
+    merge), or the transform that takes a point of the sender's frame into the receiver's,
+    p_receiver = R(theta) p_sender + (tx, ty), in metres and radians, with a confidence in [0, 1]:
+    the sender's robots then take the receiver's frame. merge_maps(receiver_map, sender_map) gives
+    such a transform (in degrees). The sender's map counts as sent with every attempt, and attempts
+    of one pair are spaced by the scenario's merging.attempt_every steps. An exception raised in
+    align becomes a fleetmap.Error naming the aligner.
+
+    `help` is the one line map_aligners() shows. `params` declares its settings as
+    register_strategy's do; a scenario sets them with merging: {mode: NAME, KEY: VALUE} (what
+    --set merging.KEY=VALUE does on the command line), each checked against its declaration.
+    """
+    _check_made_as("register_map_aligner", name, cls, [])
+    _check_method("register_map_aligner", name, cls, "align",
+                  ["receiver_map", "sender_map", "receiver_pose", "sender_pose", "params"])
+    _fleetmap._register_map_aligner(name, cls, help, _param_declarations(name, params, "register_map_aligner"))
+
+
+def register_localizer(name: str, cls: type, help: str = "", params: Mapping | None = None) -> None:
+    """Registers a localizer written in Python under `name` (scenario localization: NAME, or
+    localization: {name: NAME, KEY: VALUE}).
+
+    `cls` is called as cls(initial_pose, params, seed) to make one localizer per robot:
+    `initial_pose` (x, y, theta) is where the robot starts in its map frame (metres, radians),
+    `params` a dict of the declared parameters' values, `seed` an int for the robot's own random
+    numbers. Each step the simulator calls
+        predict(dx, dy, dtheta): the step's odometry as a motion in the robot's frame before it
+            (dx forward, dy to the left, metres; dtheta counter-clockwise, radians), which differs
+            from the true motion by the scenario's noise;
+        update_scan(ranges, angles, max_range), only when the class has it: the range scan as two
+            float arrays of one value per beam (metres, inf where no return came within
+            max_range; radians in the robot's frame);
+        pose() -> (x, y, theta): the estimate in the robot's map frame;
+        covariance() -> 3 x 3 array, only when the class has it: the estimate's covariance in x, y,
+            theta (taken as zero without it);
+        change_frame(tx, ty, theta), only when the class has it: after a merge, the estimate
+            re-expressed in the new frame, x_new = R(theta) x_old + (tx, ty), heading + theta; a
+            robot whose localizer lacks it cannot take a teammate's map frame (an error).
+    An exception raised in any of them becomes a fleetmap.Error naming the localizer.
+
+    `help` is the one line localizers() shows. `params` declares its settings as
+    register_strategy's do; a scenario sets them with localization: {name: NAME, KEY: VALUE} (what
+    --set localization.KEY=VALUE does on the command line), each checked against its declaration.
+    """
+    _check_made_as("register_localizer", name, cls, ["initial_pose", "params", "seed"])
+    _check_method("register_localizer", name, cls, "predict", ["dx", "dy", "dtheta"])
+    _check_method("register_localizer", name, cls, "pose", [])
+    _check_method("register_localizer", name, cls, "update_scan", ["ranges", "angles", "max_range"], optional=True)
+    _check_method("register_localizer", name, cls, "covariance", [], optional=True)
+    _check_method("register_localizer", name, cls, "change_frame", ["tx", "ty", "theta"], optional=True)
+    _fleetmap._register_localizer(name, cls, help, _param_declarations(name, params, "register_localizer"))
