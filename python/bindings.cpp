@@ -844,6 +844,10 @@ PYBIND11_MODULE(_fleetmap, m) {
       "(plan_path's `planner` and `params`, fleetmap plan --set planner.KEY=VALUE).");
   m.def("planner_names", &planning::planner_names, "Every path planner's name (plan_path's `planner`).");
   m.def("merge_method_names", &merging::merge_method_names, "Every merge method's name (merge_maps's `method`).");
+  m.def(
+      "merge_methods", [] { return registry_members(merging::merge_method_registry()); },
+      "Every merge method, built-in and registered: a list of {name, help, params} as strategies() gives them "
+      "(merge_maps's `method` and `params`, fleetmap merge --set METHOD.KEY=VALUE).");
 
   py::class_<Run>(m, "Run")
       .def_property_readonly("label", [](const Run& r) { return r.label; })
@@ -942,17 +946,19 @@ PYBIND11_MODULE(_fleetmap, m) {
   m.def(
       "_merge_maps",
       [](const py::object& a, const py::object& b, const std::string& method, double min_confidence,
-         std::uint64_t seed) {
+         std::uint64_t seed, const merging::MergeMethodSettings& method_settings) {
         const auto& ga = a.cast<const mapping::OccupancyGrid&>();
         const auto& gb = b.cast<const mapping::OccupancyGrid&>();
         if (ga.resolution() != gb.resolution()) check_resampled_size(gb, ga.resolution(), "merge_maps: b seen through a's cells");
         merging::MergeOptions options;
         options.method = method;
+        options.method_settings = method_settings;
         options.min_confidence = min_confidence;
         options.seed = seed;
+        merging::check_merge_method(method, method_settings);  // a bad parameter is refused before any work
         return PairMerge(a, b, options);
       },
-      py::arg("a"), py::arg("b"), py::arg("method"), py::arg("min_confidence"), py::arg("seed"));
+      py::arg("a"), py::arg("b"), py::arg("method"), py::arg("min_confidence"), py::arg("seed"), py::arg("method_settings"));
 
   py::class_<planning::PlanResult>(m, "PlanResult", "A planned path.")
       .def_property_readonly("success", &planning::PlanResult::success, "Whether there is a path.")

@@ -56,6 +56,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
     localizers,
     map_aligners,
     planners,
+    merge_methods,
     strategy_names,
     keep_freed_memory,
 )
@@ -64,7 +65,7 @@ __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
     "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
     "register_planner", "register_map_aligner", "register_localizer",
-    "map_names", "strategies", "localizers", "map_aligners", "planners", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
+    "map_names", "strategies", "localizers", "map_aligners", "planners", "merge_methods", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
 ]
 
 # The built-in maps ship beside the installed package (share/fleetmap/maps); the C++ side looks
@@ -236,7 +237,8 @@ def save_map(map: Map, path: PathLike) -> None:
     map.save(str(path))
 
 
-def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1) -> MergeResult:
+def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5, seed: int = 1,
+               params: Mapping[str, Mapping[str, Any]] | None = None) -> MergeResult:
     """Aligns map b to map a as `fleetmap merge a b` does (maps of two resolutions too).
 
     The result's `transform` (tx, ty, theta) takes b's map frame into a's, in metres and degrees: a
@@ -249,12 +251,25 @@ def merge_maps(a: Map, b: Map, method: str = "auto", min_confidence: float = 0.5
     (m, m, deg) and `uncertain_direction` the largest and smallest (m) where the maps overlap with
     the largest's direction (deg). `map` is the fused map (in a's frame and
     resolution, what `fleetmap merge a b --out merged.yaml` writes), for plan_path; None when not
-    merged."""
+    merged. `params` gives merge methods their own parameters by method name (merge_methods()
+    lists them), e.g. {"features": {"ratio": 0.7}}: for `method` itself, or under "auto" for any
+    method it runs; checked as `fleetmap merge --set features.ratio=0.7` checks them."""
     for name, value in (("a", a), ("b", b)):
         if not isinstance(value, Map):
             raise InputError(f"merge_maps: {name} must be a fleetmap.Map (load_map, Map.from_image), "
                              f"got {type(value).__name__}")
-    return _fleetmap._merge_maps(a, b, method, min_confidence, seed)
+    settings = []
+    for merge_method, values in (params or {}).items():
+        if not isinstance(values, Mapping):
+            raise InputError(f"merge_maps: params['{merge_method}'] must be a dict of that method's parameters, "
+                             f"got {type(values).__name__}")
+        settings.append((str(merge_method), [(str(k), _setting_text(v)) for k, v in values.items()]))
+    return _fleetmap._merge_maps(a, b, method, min_confidence, seed, settings)
+
+
+def _setting_text(value: Any) -> str:
+    """A parameter's value as a scenario file writes it."""
+    return ("true" if value else "false") if isinstance(value, bool) else str(value)
 
 
 def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: str = "astar",
@@ -268,7 +283,7 @@ def plan_path(map: Map, start: Sequence[float], goal: Sequence[float], planner: 
     if not isinstance(map, Map):
         got = "None (a merge_maps result that did not merge has no map)" if map is None else type(map).__name__
         raise InputError(f"plan_path: map must be a fleetmap.Map, got {got}")
-    settings = [(str(k), ("true" if v else "false") if isinstance(v, bool) else str(v)) for k, v in (params or {}).items()]
+    settings = [(str(k), _setting_text(v)) for k, v in (params or {}).items()]
     return _fleetmap._plan_path(map, (float(start[0]), float(start[1])), (float(goal[0]), float(goal[1])),
                                 planner, float(robot_radius), float(time_budget), int(seed), settings)
 

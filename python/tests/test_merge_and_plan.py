@@ -41,6 +41,24 @@ class MergeTest(unittest.TestCase):
         self.assertAlmostEqual(ptheta, 0.0, delta=0.5)
         self.assertEqual(result.scale, 1.0)
 
+    def test_a_merge_methods_own_parameters_are_listed_set_and_checked(self):
+        methods = {m["name"]: m for m in fleetmap.merge_methods()}
+        self.assertEqual(list(methods)[:3], ["auto", "grid", "features"])
+        ratio = next(p for p in methods["features"]["params"] if p["name"] == "ratio")
+        self.assertEqual(ratio["default"], "0.8")
+        a, b = office_windows()
+        # More inliers than any ORB model here: features proposes nothing; under auto grid still merges.
+        none = fleetmap.merge_maps(a, b, method="features", params={"features": {"min_inliers": 10000}})
+        self.assertFalse(none.merged)
+        self.assertIn("no candidate transform", none.reason)
+        self.assertTrue(fleetmap.merge_maps(a, b, params={"features": {"min_inliers": 10000}}).merged)
+        with self.assertRaisesRegex(fleetmap.InputError, "did you mean 'ratio'"):
+            fleetmap.merge_maps(a, b, params={"features": {"ratoi": 0.5}})
+        with self.assertRaisesRegex(fleetmap.InputError, "does not run 'features'"):
+            fleetmap.merge_maps(a, b, method="grid", params={"features": {"ratio": 0.5}})
+        with self.assertRaisesRegex(fleetmap.InputError, ">= 0.25"):
+            fleetmap.merge_maps(a, b, params={"grid": {"sweep_step_deg": 0}})
+
     def test_a_merge_reports_its_covariance_in_metres_and_radians(self):
         a, b = office_windows()
         result = fleetmap.merge_maps(a, b)
