@@ -49,11 +49,16 @@ class OverlapAligner final : public MapAligner {
   explicit OverlapAligner(const core::Params& p) : method_(p.text("method")), min_confidence_(p.number("min_confidence")) {
     check_merge_method(method_);
   }
+  void set_merge_methods(const MergeMethodSettings& settings) override {
+    check_merge_method(method_, settings);
+    merge_methods_ = settings;
+  }
   bool costly() const override { return true; }
   bool sends_map() const override { return true; }
   FrameAlignment align(const AlignmentRequest& q) const override {
     MergeOptions o;
     o.method = method_;
+    o.method_settings = merge_methods_;
     o.min_confidence = min_confidence_;
     o.seed = q.seed;
     const MergeResult m = align_maps(*q.receiver_map, *q.sender_map, o);
@@ -70,6 +75,7 @@ class OverlapAligner final : public MapAligner {
  private:
   std::string method_;
   double min_confidence_;
+  MergeMethodSettings merge_methods_;
 };
 
 // The map-alignment paper, §III.A: the two landmark maps associated by RANSAC (eq. (2)-(6)), the
@@ -174,8 +180,19 @@ core::Params map_aligner_options(const std::string& name, const core::Settings& 
   return map_aligner_registry().configure(name, settings);
 }
 
-std::unique_ptr<MapAligner> make_map_aligner(const std::string& name, const core::Settings& settings) {
-  return map_aligner_registry().get(name).make(map_aligner_options(name, settings));
+void MapAligner::set_merge_methods(const MergeMethodSettings& settings) {
+  for (const auto& [method, given] : settings) {
+    if (!given.empty()) {
+      throw InputError("parameters of merge method '" + method + "' given, but this merging runs no merge method (overlap does)");
+    }
+  }
+}
+
+std::unique_ptr<MapAligner> make_map_aligner(const std::string& name, const core::Settings& settings,
+                                             const MergeMethodSettings& merge_methods) {
+  auto aligner = map_aligner_registry().get(name).make(map_aligner_options(name, settings));
+  aligner->set_merge_methods(merge_methods);
+  return aligner;
 }
 
 }  // namespace fleetmap::merging

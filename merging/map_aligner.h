@@ -24,6 +24,7 @@
 #include "core/transform2.h"
 #include "localization/localizer.h"
 #include "mapping/occupancy_grid.h"
+#include "merging/merge.h"
 #include "merging/rendezvous.h"
 
 namespace fleetmap::merging {
@@ -64,6 +65,9 @@ class MapAligner {
   // *_landmarks), so that the robots' localizer must estimate some.
   virtual bool needs_landmark_estimates() const { return false; }
   virtual FrameAlignment align(const AlignmentRequest& request) const = 0;
+  // The merge methods' own parameters (MergeOptions::method_settings), for an aligner that runs
+  // merge methods. Throws InputError for settings it cannot use: by default any, since it runs none.
+  virtual void set_merge_methods(const MergeMethodSettings& settings);
 };
 
 // Makes an aligner from its declared parameters' values.
@@ -78,7 +82,9 @@ void register_map_aligner(std::string name, std::string help, MapAlignerFactory 
 // The aligner's declared parameters with `settings` applied; throws InputError for an unknown name
 // (naming the valid ones), a setting it does not declare or a value it refuses.
 core::Params map_aligner_options(const std::string& name, const core::Settings& settings = {});
-// Throws as map_aligner_options, and InputError for a merge method the overlap aligner does not know.
-std::unique_ptr<MapAligner> make_map_aligner(const std::string& name, const core::Settings& settings = {});
+// Throws as map_aligner_options, and InputError for a merge method the overlap aligner does not know
+// or merge-method settings it does not run (MapAligner::set_merge_methods).
+std::unique_ptr<MapAligner> make_map_aligner(const std::string& name, const core::Settings& settings = {},
+                                             const MergeMethodSettings& merge_methods = {});
 
 }  // namespace fleetmap::merging

@@ -345,6 +345,7 @@ void check_merge_method(const std::string& name, const MergeMethodSettings& sett
   registry.get(name);  // InputError naming the valid ones
   for (const auto& [method, given] : settings) {
     registry.get(method);
+    if (given.empty()) continue;
     if (method != name && name != "auto") {
       throw InputError("merge method '" + name + "' does not run '" + method + "', so its parameters do not apply (only auto runs every method)");
     }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <mutex>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -260,6 +261,14 @@ void read_exploration(io::YamlMap& top, Scenario& s) {
   ex.finish();
 }
 
+// The settings of merge method `method` in `s`, added empty when it has none.
+core::Settings& merge_method_settings_of(Scenario& s, const std::string& method) {
+  for (auto& [name, settings] : s.merge_method_settings) {
+    if (name == method) return settings;
+  }
+  return s.merge_method_settings.emplace_back(method, core::Settings{}).second;
+}
+
 // `merging`: an aligner's name, or a mapping of its name (`mode`, or `name`), the attempts' pace
 // shared by every aligner, and the parameters the aligner declares.
 void read_merging(io::YamlMap& top, Scenario& s) {
@@ -276,6 +285,18 @@ void read_merging(io::YamlMap& top, Scenario& s) {
   s.merge_attempt_every = int(merge.number("attempt_every", s.merge_attempt_every, limits::kCount));
   core::Params params = merging::map_aligner_options(name, s.merging_settings);
   io::read_declared(merge, params, s.merging_settings);
+  // The merge methods' parameters, a block per method (`features: {ratio: 0.7}`).
+  for (const auto& method : merging::merge_method_names()) {
+    if (!merge.has(method)) continue;
+    auto block = merge.map(method);
+    core::Params declared = merging::merge_method_registry().params(method);
+    for (const auto& key : block.keys()) {
+      const auto node = *block.node(key);
+      if (!node.IsScalar()) throw InputError(block.where(key) + ": expected a value, got " + io::describe_node(node));
+      io::set_declared(declared, merge_method_settings_of(s, method), key, node.Scalar(), block.where(key));
+    }
+    block.finish();
+  }
   // Files written before the aligners declared their parameters hold `method: auto` and
   // `min_confidence: 0.5` whatever the mode: those defaults are read as before, ignored by the
   // aligners that have no such parameter; another value there is a setting the aligner lacks.
@@ -302,12 +323,17 @@ std::string yaml_scalar(const std::string& value) {
   return plain ? value : io::yaml_quoted(value);
 }
 
+// "KEY: VALUE, KEY: VALUE": settings inside a YAML flow mapping.
+std::string settings_yaml(const core::Settings& settings) {
+  std::string out;
+  for (const auto& [key, value] : settings) out += (out.empty() ? "" : ", ") + key + ": " + yaml_scalar(value);
+  return out;
+}
+
 // A member as a scenario writes it: its name alone, or {name: NAME, KEY: VALUE, ...}.
 std::string member_yaml(const std::string& name, const core::Settings& settings) {
   if (settings.empty()) return name;
-  std::string out = "{name: " + name;
-  for (const auto& [key, value] : settings) out += ", " + key + ": " + yaml_scalar(value);
-  return out + "}";
+  return "{name: " + name + ", " + settings_yaml(settings) + "}";
 }
 
 }  // namespace
@@ -352,8 +378,9 @@ Scenario load_scenario(const std::filesystem::path& path) {
   return parse_scenario(io::read_file(path, 16 << 20), path.string(), path.parent_path());
 }
 
-const std::vector<ParameterFamily>& parameter_families() {
-  static const std::vector<ParameterFamily> kFamilies = {
+const std::deque<ParameterFamily>& parameter_families() {
+  static std::mutex mutex;
+  static std::deque<ParameterFamily> families = {
       {"strategy", "exploration.strategy", [](const Scenario& s) { return s.exploration.strategy; },
        [](Scenario& s) -> core::Settings& { return s.exploration.strategy_settings; },
        [](const std::string& m) { return exploration::strategy_registry().params(m); },
@@ -370,7 +397,23 @@ const std::vector<ParameterFamily>& parameter_families() {
        [](const std::string& m) { return merging::map_aligner_registry().params(m); },
        [] { return merging::map_aligner_registry().parameter_names(); }},
   };
-  return kFamilies;
+  static std::size_t fixed = families.size();
+  // One family per merge method, its only member: its parameters nest under `merging`.
+  const std::lock_guard<std::mutex> lock(mutex);
+  for (const auto& method : merging::merge_method_names()) {
+    const std::string name = "merging." + method;
+    if (std::any_of(families.begin() + std::ptrdiff_t(fixed), families.end(), [&](const auto& f) { return f.name == name; })) continue;
+    families.push_back({name, name, [method](const Scenario&) { return method; },
+                        [method](Scenario& s) -> core::Settings& { return merge_method_settings_of(s, method); },
+                        [](const std::string& m) { return merging::merge_method_registry().params(m); },
+                        [method] {
+                          const core::Params params = merging::merge_method_registry().params(method);
+                          std::vector<std::string> out;
+                          for (const auto& spec : params.specs()) out.push_back(spec.name);
+                          return out;
+                        }});
+  }
+  return families;
 }
 
 const ParameterFamily* parameter_family(const std::string& name) {
@@ -381,17 +424,27 @@ const ParameterFamily* parameter_family(const std::string& name) {
 }
 
 void set_parameter(Scenario& s, const std::string& assignment, const std::string& what) {
+  // The longest family name before the key: merging.features.ratio is the ratio of merging.features.
   const auto a = core::parse_param_assignment(assignment, what);
-  const ParameterFamily* family = parameter_family(a.family);
+  const std::string dotted = a.family + "." + a.key;
+  const ParameterFamily* family = nullptr;
+  for (const auto& f : parameter_families()) {
+    if (dotted.rfind(f.name + ".", 0) == 0 && dotted.find('.', f.name.size() + 1) == std::string::npos &&
+        (!family || f.name.size() > family->name.size())) {
+      family = &f;
+    }
+  }
+  if (!family && parameter_family(a.family)) family = parameter_family(a.family);
   if (!family) {
     std::vector<std::string> names;
     for (const auto& f : parameter_families()) names.push_back(f.name);
     throw InputError(what + ": unknown family '" + a.family + "'" + core::did_you_mean(a.family, names) + " (--set takes " +
                      core::join(names, ".KEY=VALUE, ") + ".KEY=VALUE)");
   }
+  const std::string key = dotted.substr(family->name.size() + 1);
   auto& settings = family->settings(s);
-  std::erase_if(settings, [&](const auto& kv) { return kv.first == a.key; });
-  settings.emplace_back(a.key, a.value);
+  std::erase_if(settings, [&](const auto& kv) { return kv.first == key; });
+  settings.emplace_back(key, a.value);
 }
 
 void validate_scenario(const Scenario& s) {
@@ -470,7 +523,7 @@ void validate_scenario(const Scenario& s) {
   check_name("merging", s.merging, merging_names());
   std::unique_ptr<merging::MapAligner> aligner;
   try {
-    aligner = merging::make_map_aligner(s.merging, s.merging_settings);
+    aligner = merging::make_map_aligner(s.merging, s.merging_settings, s.merge_method_settings);
   } catch (const InputError& err) {
     throw InputError(std::string("merging: ") + err.what());
   }
@@ -579,6 +632,9 @@ std::string scenario_to_yaml(const Scenario& s, const std::filesystem::path& fil
     << "\n  planner_iterations: " << s.planner_iterations << "\n";
   y << "merging:\n  mode: " << s.merging << "\n  attempt_every: " << s.merge_attempt_every << "\n";
   for (const auto& [key, value] : s.merging_settings) y << "  " << key << ": " << yaml_scalar(value) << "\n";
+  for (const auto& [method, settings] : s.merge_method_settings) {
+    if (!settings.empty()) y << "  " << method << ": {" << settings_yaml(settings) << "}\n";
+  }
   y << "lookahead: " << fmt(s.lookahead_m) << "\n";
   y << "outputs:\n  html: " << (s.html_replay ? "true" : "false") << "\n";
   return y.str();

@@ -3,6 +3,7 @@
 // file, line and key), written back to YAML, and overridden by command-line flags.
 #include <Eigen/Core>
 #include <cstdint>
+#include <deque>
 #include <filesystem>
 #include <functional>
 #include <limits>
@@ -99,6 +100,10 @@ struct Scenario {
   // merging.min_confidence=0.7`; overlap: method, min_confidence; landmarks: min_confidence,
   // support_distance); checked against its declaration by validate_scenario.
   core::Settings merging_settings;
+  // The merge methods' own parameters, for an aligner that runs them (overlap's `method`), by
+  // method: `merging: {mode: overlap, method: auto, features: {ratio: 0.7}}`, `--set
+  // merging.features.ratio=0.7`.
+  merging::MergeMethodSettings merge_method_settings;
   int merge_attempt_every = 20;              // overlap, landmarks: steps between attempts of the same pair
   double lookahead_m = 0.5;                  // path following
   // How robots get a path to their target: "wave" (the wave's steepest descent) or a planner of
@@ -139,8 +144,8 @@ std::string scenario_to_yaml(const Scenario& scenario, const std::filesystem::pa
 void validate_scenario(const Scenario& scenario);
 
 // A family whose members declare parameters that a scenario sets: its name in `--set` and `--vary`
-// (strategy, localization, planner, merging), the member the scenario chose and the settings
-// given to it.
+// (strategy, localization, planner, merging, and merging.METHOD for each merge method the overlap
+// aligner may run), the member the scenario chose and the settings given to it.
 struct ParameterFamily {
   std::string name;
   std::string group;  // the scenario key whose mapping holds the member's name and parameters, dotted
@@ -151,7 +156,9 @@ struct ParameterFamily {
   // Every parameter some member declares, for "did you mean" and to accept a sweep axis.
   std::function<std::vector<std::string>()> parameter_names;
 };
-const std::vector<ParameterFamily>& parameter_families();
+// Every family, the merge methods registered so far included; references stay valid as more are
+// registered.
+const std::deque<ParameterFamily>& parameter_families();
 // The family named `name`, or null.
 const ParameterFamily* parameter_family(const std::string& name);
 

@@ -101,7 +101,7 @@ Simulation::Simulation(const Scenario& scenario, mapping::OccupancyGrid truth, S
   explored_ = std::any_of(robots_.begin(), robots_.end(), [](const Robot& r) { return !r.driver; });
 
   // Map frames: one shared world frame, or one per robot, its origin at the robot's start.
-  aligner_ = merging::make_map_aligner(scenario_.merging, scenario_.merging_settings);
+  aligner_ = merging::make_map_aligner(scenario_.merging, scenario_.merging_settings, scenario_.merge_method_settings);
   if (aligner_->shared_frame()) {
     frame_origin_ = {core::Transform2::identity()};
     frame_geometry_ = {world_.geometry()};

@@ -2,6 +2,9 @@
 // `fleetmap plugins`, `--set FAMILY.KEY=VALUE` on explore and bench, `bench --vary FAMILY.KEY=...`,
 // and the messages for a mistyped key, a value out of range, and a member without that parameter.
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <set>
 
 #include "tests/cli/bench_test_support.h"
 
@@ -154,6 +157,49 @@ TEST(PluginsCommand, TheAlignersParametersAreSetAndCheckedLikeTheOthers) {
   dir.write("wrong.yaml", "map: hall.yaml\nsteps: 5\nmerging: {mode: rendezvous, min_confidence: 0.9}\n");
   EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --scenario wrong.yaml --out wrong", dir),
                         "merging 'rendezvous' has no parameter 'min_confidence'");
+}
+
+// The merge methods the overlap aligner runs have their own parameters, nested under merging.
+TEST(PluginsCommand, TheMergeMethodsParametersAreSetUnderMerging) {
+  TempDir dir;
+  const std::string run = "explore --map office --robots 2 --starts random --min-separation 4 --steps 150 --merging overlap "
+                          "--set merging.method=features ";
+  // More inliers than any ORB model can have: no candidate; a loose ratio test and few inliers: some.
+  const auto strict = run_fleetmap(run + "--set merging.features.min_inliers=10000 --out strict", dir);
+  ASSERT_EQ(strict.exit_code, 0) << strict.err;
+  const auto loose = run_fleetmap(run + "--set merging.features.ratio=1 --set merging.features.min_inliers=3 --out loose", dir);
+  ASSERT_EQ(loose.exit_code, 0) << loose.err;
+  const std::string scenario = slurp(dir / "loose" / "scenario.yaml");
+  EXPECT_NE(scenario.find("  method: features\n  features: {ratio: 1, min_inliers: 3}\n"), std::string::npos) << scenario;
+  const auto reasons = [&](const char* out) {
+    const auto metrics = nlohmann::json::parse(slurp(dir / out / "metrics.json"));
+    std::set<std::string> r;
+    for (const auto& m : metrics["merges"]) r.insert(m.value("reason", ""));
+    return r;
+  };
+  EXPECT_EQ(reasons("strict"), std::set<std::string>{"no reliable overlap: no candidate transform"});
+  EXPECT_FALSE(reasons("loose").contains("no reliable overlap: no candidate transform"));
+  const auto again = run_fleetmap("explore --scenario loose/scenario.yaml --out again", dir);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(slurp(dir / "again" / "scenario.yaml"), scenario);
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--set merging.features.ratoi=1 --out bad", dir), "did you mean 'ratio'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--set merging.features.ratio=2 --out bad", dir), "<= 1");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap(run + "--set merging.method=grid --set merging.features.ratio=0.5 --out bad", dir),
+                        "merge method 'grid' does not run 'features'");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("explore --map office --robots 2 --steps 5 --merging rendezvous "
+                                     "--set merging.features.ratio=0.5 --out bad", dir),
+                        "runs no merge method");
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad"));
+  // A sweep axis like any other parameter.
+  const auto b = run_fleetmap("bench --maps office --strategies coordinated --robots 2 --seeds 1 --steps 20 --merging overlap "
+                              "--vary merging.features.ratio=0.7,0.9 --out b", dir);
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  const CsvTable results = read_csv(dir / "b" / "results.csv");
+  ASSERT_EQ(results.rows.size(), 2u);
+  EXPECT_EQ(results.rows[0].at("variant"), "merging.features.ratio=0.7");
+  EXPECT_ONE_LINE_ERROR(run_fleetmap("bench --maps office --strategies coordinated --robots 2 --seeds 1 --steps 20 "
+                                     "--merging overlap --vary merging.features.ratoi=0.7 --out b2", dir),
+                        "did you mean 'ratio'");
 }
 
 // The planners' parameters: plan --set, and a path planner's in explore's scenario.
