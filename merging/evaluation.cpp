@@ -82,9 +82,10 @@ mapping::OccupancyGrid resample_grid(const mapping::OccupancyGrid& grid, const c
   return out;
 }
 
-mapping::OccupancyGrid crop_grid(const mapping::OccupancyGrid& grid, int x0, int y0, int width, int height) {
+mapping::OccupancyGrid crop_grid(const mapping::OccupancyGrid& grid, int x0, int y0, int width, int height,
+                                 const core::Pose2& origin) {
   // resample_grid without the turn: a copy of the rows (a resampled cell costs a rounding call).
-  mapping::OccupancyGrid out(core::GridGeometry(grid.resolution(), width, height), grid.options());
+  mapping::OccupancyGrid out(core::GridGeometry(grid.resolution(), width, height, origin), grid.options());
   const std::vector<float>& from = grid.log_odds_data();
   const int xs = std::max(0, -x0), xe = std::min(width, grid.width() - x0);
   for (int y = std::max(0, -y0); y < std::min(height, grid.height() - y0); ++y) {

@@ -100,8 +100,10 @@ class SyntheticWorld {
 // Crop pair options for views of a SyntheticWorld; as make_crop_pair, with the world's own view.
 CropPair make_world_pair(const SyntheticWorld& world, const CropPairOptions& options, core::Random& random);
 
-// The window [x0, x0 + width) x [y0, y0 + height) of a grid as a grid of its own (outside: unknown).
-mapping::OccupancyGrid crop_grid(const mapping::OccupancyGrid& grid, int x0, int y0, int width, int height);
+// The window [x0, x0 + width) x [y0, y0 + height) of a grid as a grid of its own (outside: unknown),
+// its lower-left corner at `origin`.
+mapping::OccupancyGrid crop_grid(const mapping::OccupancyGrid& grid, int x0, int y0, int width, int height,
+                                 const core::Pose2& origin = {});
 
 // `grid` seen from a frame turned and shifted by `frame_to_grid`: a width x height grid whose cell q
 // holds grid's nearest cell to frame_to_grid(q) (unknown outside grid).

@@ -756,7 +756,9 @@ KnownPart::KnownPart(const mapping::OccupancyGrid& grid, int margin) : full_(&gr
   // Copying costs more than it saves unless the cut is clearly smaller.
   if (double(x1 - x0 + 1) * double(y1 - y0 + 1) > 0.8 * double(grid.width()) * double(grid.height())) return;
   origin_ = Eigen::Vector2i(x0, y0);
-  cut_ = crop_grid(grid, x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+  // Where its cells lie in the map's frame: a registered method may read the cut in metres.
+  const core::Pose2 corner = grid.geometry().origin().compose(core::Pose2(x0 * grid.resolution(), y0 * grid.resolution(), 0.0));
+  cut_ = crop_grid(grid, x0, y0, x1 - x0 + 1, y1 - y0 + 1, corner);
 }
 
 MergeResult uncut(MergeResult result, const KnownPart& a, const KnownPart& b) {

@@ -281,7 +281,8 @@ std::string merge_method_help();
 void check_merge_method(const std::string& name, const MergeMethodSettings& settings = {});
 
 // A map cut to the box of its known cells (with a margin), so that the search does not pay for
-// the unknown around what a robot saw (a robot's map is often allocated far larger).
+// the unknown around what a robot saw (a robot's map is often allocated far larger). The cut's
+// cells lie where they lay in the map's frame (its geometry's origin is moved with the box).
 class KnownPart {
  public:
   explicit KnownPart(const mapping::OccupancyGrid& grid, int margin = 2);

@@ -1,7 +1,8 @@
 // The C++ half of the Python package `fleetmap` (pybind11): maps as numpy arrays, exploration runs,
-// map merging, path planning, sweeps, and coordination strategies, planners, map aligners and
-// localizers written in Python. The Python half (fleetmap/__init__.py) turns scenario dicts and files
-// into the YAML text read here and wraps the results; fleetmap/__init__.pyi documents both.
+// map merging, path planning, sweeps, and coordination strategies, planners, map aligners,
+// localizers and merge methods written in Python. The Python half (fleetmap/__init__.py) turns
+// scenario dicts and files into the YAML text read here and wraps the results;
+// fleetmap/__init__.pyi documents both.
 #include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -29,6 +30,7 @@
 #include "merging/map_aligner.h"
 #include "merging/merge.h"
 #include "merging/multi_merge.h"
+#include "merging/rendezvous.h"
 #include "planning/free_space.h"
 #include "planning/planner.h"
 #include "sim/run_metrics.h"
@@ -710,6 +712,57 @@ void register_python_localizer(const std::string& name, const py::object& cls, c
       param_specs(params));
 }
 
+// One pass of a merge method written in Python: the object's propose(a, b) with the two maps as the
+// merge sees them (Map copies, perhaps cut to their known cells, their origins where those cells lie),
+// answering candidates (tx, ty, theta[, score]) that take b's frame into a's (metres, radians, as
+// merge_maps' transform). They enter the common pipeline at full resolution (Hypothesis::level 0);
+// without scores, the list's order ranks them.
+std::vector<merging::Hypothesis> propose_in_python(const std::string& name, const PluginObject& instance,
+                                                   const merging::PreparedGrid& a, const merging::PreparedGrid& b) {
+  const std::string who = "merge method '" + name + "'";
+  const char* expected = "a list of (tx, ty, theta) or (tx, ty, theta, score)";
+  py::gil_scoped_acquire gil;
+  const py::object answer = call_plugin(who, instance, "propose", py::cast(a.grid()), py::cast(b.grid()));
+  if (!py::isinstance<py::sequence>(answer) || py::isinstance<py::str>(answer)) {
+    throw Error(fmt::format("{}: propose must return {}, got {}", who, expected, std::string(py::repr(answer))));
+  }
+  const auto items = py::reinterpret_borrow<py::sequence>(answer);
+  const std::size_t count = items.size();
+  std::vector<merging::Hypothesis> out;
+  for (std::size_t i = 0; i < count; ++i) {
+    const py::object item = items[i];
+    const bool scored = py::isinstance<py::sequence>(item) && !py::isinstance<py::str>(item) && py::len(item) == 4;
+    const auto t = finite_numbers(item, scored ? 4 : 3, who, "propose", expected);
+    const core::Transform2 cells =
+        merging::cells_from_world(a.grid().geometry(), b.grid().geometry(), core::Transform2(t[0], t[1], t[2]));
+    out.push_back({cells, scored ? t[3] : double(count - i), 0, name});
+  }
+  return out;
+}
+
+void register_python_merge_method(const std::string& name, const py::object& cls, const std::string& help,
+                                  const std::vector<PythonParam>& params) {
+  if (!py::hasattr(cls, "propose")) {
+    throw InputError("register_merge_method '" + name + "': the class has no propose method");
+  }
+  PyObject* held = hold_forever(cls);
+  merging::register_merge_method(
+      name, help.empty() ? "written in Python" : help,
+      [name, held](const core::Params& values) {
+        std::shared_ptr<const PluginObject> instance;
+        {
+          py::gil_scoped_acquire gil;
+          instance = std::make_shared<const PluginObject>(
+              make_plugin("merge method '" + name + "'", held, params_dict(values)));
+        }
+        return merging::MergePasses{[name, instance](const merging::PreparedGrid& a, const merging::PreparedGrid& b,
+                                                     const merging::MergeOptions&, core::Random&) {
+          return propose_in_python(name, *instance, a, b);
+        }};
+      },
+      param_specs(params));
+}
+
 }  // namespace
 
 // A family's members as Python lists them: {name, help, params}, each parameter {name, kind,
@@ -998,6 +1051,8 @@ PYBIND11_MODULE(_fleetmap, m) {
   m.def("_register_map_aligner", &register_python_map_aligner, py::arg("name"), py::arg("cls"), py::arg("help"),
         py::arg("params"));
   m.def("_register_localizer", &register_python_localizer, py::arg("name"), py::arg("cls"), py::arg("help"),
+        py::arg("params"));
+  m.def("_register_merge_method", &register_python_merge_method, py::arg("name"), py::arg("cls"), py::arg("help"),
         py::arg("params"));
 
   py::class_<AssignmentContext>(m, "AssignmentContext",

@@ -3,8 +3,8 @@
 Runs explorations from a scenario (a dict, a YAML file, or keyword arguments) and returns their
 metrics and per-step arrays; loads and saves maps as numpy arrays (map_server's 0 occupied,
 254 free, 205 unknown); merges two maps; plans paths; runs benchmark sweeps; and registers
-coordination strategies, path planners, map aligners and localizers written in Python, which
-scenarios, sweeps and plan_path then use by name like the built-in ones.
+coordination strategies, path planners, map aligners, localizers and merge methods written in
+Python, which scenarios, sweeps, plan_path and merge_maps then use by name like the built-in ones.
 
     import fleetmap
     run = fleetmap.explore(map="office", robots=2, steps=50, seed=1)
@@ -64,7 +64,7 @@ from ._fleetmap import (  # noqa: F401  (re-exported)
 __all__ = [
     "AssignmentContext", "Error", "InputError", "Map", "MergeResult", "PlanResult", "ExplorationResult",
     "explore", "sweep", "save_results", "load_map", "save_map", "merge_maps", "plan_path", "register_strategy",
-    "register_planner", "register_map_aligner", "register_localizer",
+    "register_planner", "register_map_aligner", "register_localizer", "register_merge_method",
     "map_names", "strategies", "localizers", "map_aligners", "planners", "merge_methods", "strategy_names", "planner_names", "merge_method_names", "keep_freed_memory",
 ]
 
@@ -500,3 +500,35 @@ def register_localizer(name: str, cls: type, help: str = "", params: Mapping | N
     _check_method("register_localizer", name, cls, "covariance", [], optional=True)
     _check_method("register_localizer", name, cls, "change_frame", ["tx", "ty", "theta"], optional=True)
     _fleetmap._register_localizer(name, cls, help, _param_declarations(name, params, "register_localizer"))
+
+
+def register_merge_method(name: str, cls: type, help: str = "", params: Mapping | None = None) -> None:
+    """Registers a merge method written in Python under `name`: merge_maps(a, b, method=NAME) and
+    `auto` (which runs every method) use it, and so do robots that merge by overlap search
+    (scenario merging: {mode: overlap, method: NAME}).
+
+    `cls` is called as cls(params) when a merge starts, `params` a dict of the declared
+    parameters' values. Its method
+        propose(a, b) -> list of (tx, ty, theta) or (tx, ty, theta, score)
+    gets the two maps as the merge sees them, fleetmap.Map copies (`.image` uint8, top row first,
+    254 free, 0 occupied, 205 unknown; `.resolution`, the same for both; `.origin`), perhaps cut to
+    the box of their known cells: each map's `origin` is then where that box's lower-left corner
+    lies in the frame of the map given to merge_maps, so that the centre of image[row, col] lies at
+    origin (x, y) + R(origin theta) ((col + 0.5) * resolution, (height - row - 0.5) * resolution).
+    Each candidate is a transform in METRES and RADIANS between those frames, as merge_maps'
+    `transform` (there in degrees): a point p of b lies at R(theta) p + (tx, ty) in a. `score`
+    ranks the method's own candidates (higher is better); without it the list's order does, first
+    best. The common pipeline then treats them as a built-in method's: it refines each against
+    the maps' walls at full resolution (that corrects a candidate a few cells off, not more),
+    scores it and decides: `confidence`, refusal, `method` NAME when one of them wins. An empty
+    list proposes nothing. An exception raised in propose, or an answer of another shape, becomes
+    a fleetmap.Error naming the method. Merges may run on other threads (sweeps with jobs > 1);
+    each call takes the interpreter's lock.
+
+    `help` is the one line merge_methods() shows. `params` declares its settings as
+    register_strategy's do; merge_maps(..., params={NAME: {KEY: VALUE}}) sets them, each checked
+    against its declaration (robots merging by overlap search use the declared defaults).
+    """
+    _check_made_as("register_merge_method", name, cls, ["params"])
+    _check_method("register_merge_method", name, cls, "propose", ["a", "b"])
+    _fleetmap._register_merge_method(name, cls, help, _param_declarations(name, params, "register_merge_method"))

@@ -1,6 +1,6 @@
-"""Planners, map aligners and localizers written in Python: registered with declared parameters,
-listed, run through the public API by name, their parameters checked, their failures reported with
-their names."""
+"""Planners, map aligners, localizers and merge methods written in Python: registered with declared
+parameters, listed, run through the public API by name, their parameters checked, their failures
+reported with their names."""
 import math
 import unittest
 from collections import deque
@@ -8,6 +8,7 @@ from collections import deque
 import numpy as np
 
 import fleetmap
+from test_merge_and_plan import office_windows
 
 
 class BreadthFirst:
@@ -131,6 +132,82 @@ class RaisingLocalizer(BiasedDeadReckoning):
         raise RuntimeError("wheel fell off")
 
 
+# `auto` runs every registered merge method, in this process's other tests too: the classes below
+# propose nothing (and raise nothing) unless a test turns them on here.
+MERGE_METHODS_ON = set()
+
+
+# office_windows(): b's frame is a's moved 3.5 m along x (70 columns of 0.05 m cells).
+WINDOWS_SHIFT = (3.5, 0.0, 0.0)
+CELL = 0.05
+
+
+class ShiftOracle:
+    """Proposes office_windows()'s true transform moved by `offset` metres along x."""
+
+    made = []
+
+    def __init__(self, params):
+        self.offset = params["offset"]
+        self.seen = []
+        ShiftOracle.made.append(self)
+
+    def propose(self, a, b):
+        if type(self) not in MERGE_METHODS_ON:
+            return []
+        self.seen.append((a, b))
+        tx, ty, theta = WINDOWS_SHIFT
+        return [(tx + self.offset, ty, theta)]
+
+
+class FixedAnswer:
+    """Proposes `answer` with a score; no parameters."""
+
+    answer = None
+    seen = []
+
+    def __init__(self, params):
+        FixedAnswer.seen.append(params)
+
+    def propose(self, a, b):
+        if type(self) not in MERGE_METHODS_ON:
+            return []
+        FixedAnswer.seen.append((a, b))
+        return [FixedAnswer.answer + (1.0,)]
+
+
+class GridFromPython:
+    """Answers merge_maps' own transform of the two maps it gets (grid search), in radians."""
+
+    calls = 0
+
+    def __init__(self, params):
+        pass
+
+    def propose(self, a, b):
+        if type(self) not in MERGE_METHODS_ON:
+            return []
+        GridFromPython.calls += 1
+        result = fleetmap.merge_maps(a, b, method="grid", min_confidence=0.0)
+        tx, ty, theta_deg = result.transform
+        return [(tx, ty, math.radians(theta_deg), result.confidence)]
+
+
+class RaisingMergeMethod:
+    def __init__(self, params):
+        pass
+
+    def propose(self, a, b):
+        if type(self) not in MERGE_METHODS_ON:
+            return []
+        raise ValueError(f"no idea where {b.width} x {b.height} goes")
+
+
+class WrongShape(RaisingMergeMethod):
+    def propose(self, a, b):
+        return [(1.0, 2.0)] if type(self) in MERGE_METHODS_ON else []
+
+
 fleetmap.register_planner("py-bfs", BreadthFirst, help="breadth-first search over cells (a Python test's own)",
                           complete=True,
                           params={"max_cells": {"default": 1000000, "min": 1, "doc": "cells expanded before giving up"}})
@@ -146,6 +223,13 @@ fleetmap.register_localizer("py-biased", BiasedDeadReckoning, help="dead reckoni
                                              "doc": "added to the estimate's x"}})
 fleetmap.register_localizer("py-raising-localizer", RaisingLocalizer, params={"bias": 0.0})
 fleetmap.register_localizer("py-stays-in-its-frame", StaysInItsFrame, params={"bias": 0.0})
+fleetmap.register_merge_method("py-oracle", ShiftOracle, help="the true shift moved along x (a Python test's own)",
+                               params={"offset": {"default": 0.0, "min": -5, "max": 5, "unit": "m",
+                                                  "doc": "added to the true tx"}})
+fleetmap.register_merge_method("py-fixed", FixedAnswer)
+fleetmap.register_merge_method("py-grid", GridFromPython, help="merge_maps' grid search called from Python")
+fleetmap.register_merge_method("py-raising-merge", RaisingMergeMethod)
+fleetmap.register_merge_method("py-wrong-shape", WrongShape)
 
 START, GOAL = (1.0, 1.0), (15.0, 15.0)  # far apart in the office, walls between them
 
@@ -339,6 +423,162 @@ class PythonLocalizerTest(unittest.TestCase):
 
         with self.assertRaisesRegex(ValueError, "py-no-arguments.*made as cls\\(initial_pose, params, seed\\)"):
             fleetmap.register_localizer("py-no-arguments", MadeWithoutArguments)
+
+
+class PythonMergeMethodTest(unittest.TestCase):
+    def turn_on(self, *classes):
+        MERGE_METHODS_ON.update(classes)
+        self.addCleanup(MERGE_METHODS_ON.clear)
+
+    def test_it_is_listed_with_its_parameters(self):
+        self.assertIn("py-oracle", fleetmap.merge_method_names())
+        listed = {m["name"]: m for m in fleetmap.merge_methods()}
+        self.assertEqual(listed["py-oracle"]["help"], "the true shift moved along x (a Python test's own)")
+        self.assertEqual([(p["name"], p["kind"], p["default"], p["unit"], p["accepts"])
+                          for p in listed["py-oracle"]["params"]],
+                         [("offset", "number", "0.0", "m", "a number >= -5 and <= 5 (m)")])
+        self.assertEqual(listed["py-fixed"]["help"], "written in Python")
+        self.assertEqual(listed["py-fixed"]["params"], [])
+
+    def test_merge_maps_refines_and_decides_on_its_candidates(self):
+        self.turn_on(ShiftOracle)
+        a, b = office_windows()
+        for offset in (0.0, 0.15):
+            result = fleetmap.merge_maps(a, b, method="py-oracle", params={"py-oracle": {"offset": offset}})
+            self.assertEqual(ShiftOracle.made[-1].offset, offset)
+            self.assertTrue(result.merged, result.reason)
+            self.assertEqual(result.method, "py-oracle")
+            self.assertGreater(result.confidence, 0.9)
+            # Three cells off (0.15 m), the refinement brings the candidate to the truth within half a cell.
+            tx, ty, theta = result.transform
+            self.assertAlmostEqual(tx, 3.5, delta=CELL / 2)
+            self.assertAlmostEqual(ty, 0.0, delta=CELL / 2)
+            self.assertAlmostEqual(theta, 0.0, delta=0.5)
+            px, py, _ = result.pixel_transform
+            self.assertAlmostEqual(px, 70.0, delta=0.5)
+            self.assertAlmostEqual(py, 0.0, delta=0.5)
+        # Two metres off is beyond the refinement's reach: the walls cross and the merge is refused,
+        # the reported transform where the method put it.
+        far = fleetmap.merge_maps(a, b, method="py-oracle", params={"py-oracle": {"offset": 2.0}})
+        self.assertFalse(far.merged)
+        self.assertIn("no reliable overlap", far.reason)
+        self.assertGreater(far.transform[0] - 3.5, 1.5)
+        # Once per merge: made with the merge's parameters, asked with the two maps.
+        oracle = ShiftOracle.made[-1]
+        self.assertEqual(oracle.offset, 2.0)
+        self.assertEqual(len(oracle.seen), 1)
+        seen_a, seen_b = oracle.seen[0]
+        np.testing.assert_array_equal(seen_a.image, a.image)
+        np.testing.assert_array_equal(seen_b.image, b.image)
+
+    def test_its_candidates_are_metres_between_the_frames_of_the_maps_given(self):
+        self.turn_on(FixedAnswer)
+        a, b = office_windows()
+        # b inside unknown space: 40 rows above, 10 below, 20 columns left, 30 right. The merge cuts it
+        # to its known cells (with a two-cell margin); the cut's origin says where that lies in b's frame.
+        padded = np.full((b.height + 50, b.width + 50), 205, np.uint8)
+        padded[40:40 + b.height, 20:20 + b.width] = b.image
+        b_padded = fleetmap.Map.from_image(padded)
+        # b's lower-left corner is now 20 columns left of and 10 rows below the window's.
+        truth = (3.5 - 20 * CELL, -10 * CELL, 0.0)
+        for answer, merged in ((truth, True), ((truth[0], -truth[1], 0.0), False)):
+            FixedAnswer.answer = answer
+            FixedAnswer.seen.clear()
+            result = fleetmap.merge_maps(a, b_padded, method="py-fixed")
+            self.assertEqual(result.merged, merged, (answer, result.reason))
+            self.assertEqual(FixedAnswer.seen[0], {})
+            seen_b = FixedAnswer.seen[1][1]
+            self.assertEqual((seen_b.width, seen_b.height), (b.width + 4, b.height + 4))
+            np.testing.assert_allclose(seen_b.origin, (18 * CELL, 8 * CELL, 0.0), atol=1e-12)
+            if merged:
+                np.testing.assert_allclose(result.transform, truth, atol=CELL / 2)
+        # b turned a quarter turn counter-clockwise: b's point p is a's R(-90 deg) p + (3.5 m, b's width).
+        turned = fleetmap.Map.from_image(np.rot90(b.image).copy())
+        for theta, merged in ((-math.pi / 2, True), (math.pi / 2, False)):
+            FixedAnswer.answer = (3.5, b.height * CELL, theta)
+            result = fleetmap.merge_maps(a, turned, method="py-fixed")
+            self.assertEqual(result.merged, merged, (theta, result.reason))
+            if merged:
+                np.testing.assert_allclose(result.transform, (3.5, b.height * CELL, -90.0), atol=CELL / 2)
+        grid = fleetmap.merge_maps(a, turned, method="grid")
+        self.assertTrue(grid.merged, grid.reason)
+        np.testing.assert_allclose(grid.transform, (3.5, b.height * CELL, -90.0), atol=0.05)
+
+    def test_auto_runs_it_with_its_parameters(self):
+        # Windows sharing a metre: grid's first pass is not sure of them, so auto runs every method.
+        office = fleetmap.load_map("office").image
+        a = fleetmap.Map.from_image(office[:, :120].copy())
+        b = fleetmap.Map.from_image(office[:, 100:].copy())
+        self.turn_on(ShiftOracle)
+        ShiftOracle.made.clear()
+        result = fleetmap.merge_maps(a, b, params={"py-oracle": {"offset": 1.5}})
+        self.assertEqual([(o.offset, len(o.seen)) for o in ShiftOracle.made], [(1.5, 1)])
+        self.assertTrue(result.merged, result.reason)
+        self.assertAlmostEqual(result.transform[0], 5.0, delta=CELL / 2)
+
+    def test_explore_merges_with_it_through_the_overlap_aligner(self):
+        self.turn_on(GridFromPython)
+        GridFromPython.calls = 0
+        run = fleetmap.explore(TWO_ROBOTS, steps=30, merging={"mode": "overlap", "method": "py-grid",
+                                                              "attempt_every": 5})
+        self.assertGreater(GridFromPython.calls, 0)
+        merged = [m for m in run.metrics["merges"] if m["merged"]]
+        self.assertTrue(merged)
+        self.assertEqual(merged[0]["method"], "py-grid")
+        self.assertLess(merged[0]["position_error_m"], 2 * CELL)
+        # Sweeps run simulations on several threads, each taking the interpreter to ask it.
+        GridFromPython.calls = 0
+        rows = fleetmap.sweep(maps=["office"], strategies=["coordinated"], robots=2, seeds=2, steps=30, jobs=2,
+                              merging="overlap",
+                              vary={"merging.method": ["py-grid"], "merging.attempt_every": [5]})
+        self.assertEqual(len(rows), 2)
+        self.assertGreater(GridFromPython.calls, 1)
+
+    def test_a_bad_value_is_refused_with_its_range(self):
+        a, b = office_windows()
+        made = len(ShiftOracle.made)
+        with self.assertRaisesRegex(ValueError, "py-oracle.*'offset'.*a number >= -5 and <= 5.*got '10'"):
+            fleetmap.merge_maps(a, b, method="py-oracle", params={"py-oracle": {"offset": 10}})
+        with self.assertRaisesRegex(ValueError, "py-oracle' has no parameter 'ofset'.*did you mean 'offset'"):
+            fleetmap.merge_maps(a, b, method="py-oracle", params={"py-oracle": {"ofset": 1}})
+        self.assertEqual(len(ShiftOracle.made), made)
+
+    def test_an_exception_or_a_wrong_answer_names_the_method(self):
+        a, b = office_windows()
+        self.turn_on(RaisingMergeMethod, WrongShape)
+        with self.assertRaisesRegex(fleetmap.Error, "merge method 'py-raising-merge': propose raised ValueError: "
+                                                    "no idea where 130 x 200 goes"):
+            fleetmap.merge_maps(a, b, method="py-raising-merge")
+        with self.assertRaisesRegex(fleetmap.Error, "merge method 'py-wrong-shape': propose must return a list of "
+                                                    "\\(tx, ty, theta\\) or \\(tx, ty, theta, score\\), got \\(1.0, 2.0\\)"):
+            fleetmap.merge_maps(a, b, method="py-wrong-shape")
+
+        class RefusesToStart(RaisingMergeMethod):
+            def __init__(self, params):
+                if RefusesToStart in MERGE_METHODS_ON:
+                    raise KeyError("not today")
+
+        fleetmap.register_merge_method("py-refuses-to-start", RefusesToStart)
+        self.turn_on(RefusesToStart)
+        with self.assertRaisesRegex(fleetmap.Error, "merge method 'py-refuses-to-start': making it raised KeyError"):
+            fleetmap.merge_maps(a, b, method="py-refuses-to-start")
+
+    def test_it_must_be_made_with_params_and_propose_from_two_maps(self):
+        class MadeWithoutArguments(ShiftOracle):
+            def __init__(self):
+                pass
+
+        with self.assertRaisesRegex(ValueError, "py-no-params.*made as cls\\(params\\)"):
+            fleetmap.register_merge_method("py-no-params", MadeWithoutArguments)
+
+        class ProposesFromOne(ShiftOracle):
+            def propose(self, a):
+                return []
+
+        with self.assertRaisesRegex(ValueError, "py-one-map.*propose must take \\(a, b\\)"):
+            fleetmap.register_merge_method("py-one-map", ProposesFromOne)
+        self.assertNotIn("py-no-params", fleetmap.merge_method_names())
+        self.assertNotIn("py-one-map", fleetmap.merge_method_names())
 
 
 if __name__ == "__main__":

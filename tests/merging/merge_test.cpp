@@ -1136,9 +1136,10 @@ TEST(AlignMaps, OptionsKeepingNoCandidateAreAnInputErrorNamingThem) {
 }
 
 // The search pays for the map's size, so a robot's map allocated far larger than what it saw is cut
-// to its known cells; a map with nothing known, or known nearly everywhere, is kept whole.
+// to its known cells; a map with nothing known, or known nearly everywhere, is kept whole. The cut's
+// cells stay where they were in the map's frame.
 TEST(KnownPart, CutsAMapToTheBoxOfItsKnownCellsWithTheMargin) {
-  mapping::OccupancyGrid grid(core::GridGeometry(0.05, 100, 80));
+  mapping::OccupancyGrid grid(core::GridGeometry(0.05, 100, 80, core::Pose2(-3.0, 4.0, 0.3)));
   const KnownPart nothing(grid);
   EXPECT_EQ(&nothing.grid(), &grid);
   EXPECT_EQ(nothing.origin(), Eigen::Vector2i::Zero());
@@ -1153,6 +1154,7 @@ TEST(KnownPart, CutsAMapToTheBoxOfItsKnownCellsWithTheMargin) {
   EXPECT_EQ(part.grid().state({41 - 28, 25 - 18}), mapping::CellState::Occupied);
   EXPECT_EQ(part.grid().state({35 - 28, 33 - 18}), mapping::CellState::Free);
   EXPECT_EQ(part.grid().count(mapping::CellState::Free) + part.grid().count(mapping::CellState::Occupied), 3);
+  EXPECT_LT((part.grid().geometry().cell_center({41 - 28, 25 - 18}) - grid.geometry().cell_center({41, 25})).norm(), 1e-9);
 
   // The margin stops at the map's edges.
   grid.set_state({0, 79}, mapping::CellState::Free);
