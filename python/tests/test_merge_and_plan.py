@@ -59,6 +59,15 @@ class MergeTest(unittest.TestCase):
         with self.assertRaisesRegex(fleetmap.InputError, ">= 0.25"):
             fleetmap.merge_maps(a, b, params={"grid": {"sweep_step_deg": 0}})
 
+    def test_an_explorations_merge_methods_get_their_parameters_under_merging(self):
+        team = {"map": "office", "robots": {"random": 2, "min_separation": 4}, "seed": 1}
+        run = fleetmap.explore(team, steps=60, merging={"mode": "overlap", "method": "features",
+                                                         "features": {"min_inliers": 10000}})
+        self.assertTrue(run.metrics["merges"])
+        self.assertEqual({m["reason"] for m in run.metrics["merges"]}, {"no reliable overlap: no candidate transform"})
+        with self.assertRaisesRegex(fleetmap.InputError, "merging.features.min_inliers.*from 3 to 10000"):
+            fleetmap.explore(team, steps=5, merging={"mode": "overlap", "features": {"min_inliers": 1}})
+
     def test_a_merge_reports_its_covariance_in_metres_and_radians(self):
         a, b = office_windows()
         result = fleetmap.merge_maps(a, b)
