@@ -429,9 +429,9 @@ Command add_bench_command(CLI::App& root) {
       ->expected(1)
       ->take_all();
   app->add_option("--set", s.set,
-                  "A member's parameter in every run, FAMILY.KEY=VALUE with FAMILY strategy, localization, planner or merging (repeat "
-                  "for more), "
-                  "e.g. --set strategy.beta=0.5 --set localization.particles=50; it applies to the members that declare it "
+                  "A member's parameter in every run, FAMILY.KEY=VALUE with FAMILY strategy, localization, planner, merging "
+                  "or a merge method (merging.grid, merging.features) (repeat for more), e.g. --set strategy.beta=0.5 --set "
+                  "localization.particles=50 --set merging.features.ratio=0.7; it applies to the members that declare it "
                   "(see `fleetmap plugins`)")
       ->expected(1)
       ->take_all();

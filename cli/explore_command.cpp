@@ -440,8 +440,11 @@ Command add_explore_command(CLI::App& root) {
       "\nMerging (--merging): how robots bring each other's maps into their own frame (all but known: each "
       "robot maps in its own frame until it merges)\n" +
       merging::map_aligner_registry().help() +
+      "\nMerge methods (overlap's merging.method), their parameters set as merging.METHOD.KEY:\n" +
+      merging::merge_method_help() +
       "\nPath planners (--path-planner): wave (the wave's steepest descent, the default) or\n" + planning::planner_help() +
-      "\nEvery parameter line above is set by --set FAMILY.KEY=VALUE (strategy, localization, merging, planner).\n");
+      "\nEvery parameter line above is set by --set FAMILY.KEY=VALUE (strategy, localization, merging, planner;\n"
+      "merging.grid, merging.features for the merge methods).\n");
   auto f = std::make_shared<ExploreFlags>();
   app->add_option("--scenario", f->scenario, "Scenario YAML file (see scenarios/); flags below override it")
       ->check(CLI::ExistingFile);
@@ -470,10 +473,10 @@ Command add_explore_command(CLI::App& root) {
   app->add_option("--strategy", f->strategy, "Coordination strategy [default: directional]")
       ->check(one_of(exploration::strategy_names()));
   app->add_option("--set", f->set,
-                  "A parameter of the strategy, the localizer, the path planner or the aligner, FAMILY.KEY=VALUE (repeat for "
-                  "more), e.g. --set "
-                  "strategy.beta=0.5 --set localization.particles=50 --set merging.method=features; each member's parameters and defaults are listed below and by "
-                  "`fleetmap plugins`")
+                  "A parameter of the strategy, the localizer, the path planner, the aligner or a merge method, "
+                  "FAMILY.KEY=VALUE (repeat for more), e.g. --set strategy.beta=0.5 --set localization.particles=50 --set "
+                  "merging.method=features --set merging.features.ratio=0.7; each member's parameters and defaults are "
+                  "listed below and by `fleetmap plugins`")
       ->expected(1)
       ->take_all();
   app->add_option("--localization", f->localization, "How robots know their pose [default: ideal]")
