@@ -255,17 +255,24 @@ PrecomputedGrids::PrecomputedGrids(const SubmapGrid& grid, int depth) : resoluti
   }
   max_value_ = std::max<int>(unknown_, level.empty() ? 0 : *std::max_element(level.begin(), level.end()));
   levels_.push_back(std::move(level));
-  // Level h from level h-1: the largest of four cells half the width apart.
+  // Level h from level h-1: the largest of four cells half the width apart, taken along rows then
+  // along columns (cells past the far edges are unknown).
+  const std::size_t wd = std::size_t(width_);
+  std::vector<std::uint8_t> along(levels_.back().size());
   for (int h = 1; h <= depth; ++h) {
     const int s = 1 << (h - 1);
-    std::vector<std::uint8_t> next(levels_.back().size());
+    const std::vector<std::uint8_t>& prev = levels_.back();
+    for (std::size_t y = 0; y < std::size_t(height_); ++y) {
+      const std::uint8_t* in = prev.data() + y * wd;
+      std::uint8_t* out = along.data() + y * wd;
+      for (int x = 0; x < width_; ++x) out[x] = std::max(in[x], x + s < width_ ? in[x + s] : unknown_);
+    }
+    std::vector<std::uint8_t> next(along.size());
     for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) {
-        const int gx = x + min_x_, gy = y + min_y_;
-        next[std::size_t(y) * std::size_t(width_) + std::size_t(x)] =
-            std::max(std::max(value(h - 1, gx, gy), value(h - 1, gx + s, gy)),
-                     std::max(value(h - 1, gx, gy + s), value(h - 1, gx + s, gy + s)));
-      }
+      const std::uint8_t* a = along.data() + std::size_t(y) * wd;
+      const std::uint8_t* b = y + s < height_ ? along.data() + std::size_t(y + s) * wd : nullptr;
+      std::uint8_t* out = next.data() + std::size_t(y) * wd;
+      for (int x = 0; x < width_; ++x) out[x] = std::max(a[x], b ? b[x] : unknown_);
     }
     levels_.push_back(std::move(next));
   }
