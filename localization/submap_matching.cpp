@@ -294,9 +294,9 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
   for (std::size_t first = 0; first < kStride; ++first) {
     for (std::size_t i = first; i < np; i += kStride) spread.push_back(points[i]);
   }
-  // Each rotated scan's cells, their offsets in the grids' rows (the levels share one layout) and
-  // their bounds, so that a candidate wholly inside the grids reads cells without bounds checks
-  // (the searches' inner loop).
+  // Each rotated scan's cells (counted from the levels' first cell), their offsets in the grids'
+  // rows (the levels share one layout) and their bounds, so that a candidate wholly inside the
+  // grids reads cells without bounds checks (the searches' inner loop).
   const std::ptrdiff_t row = grids.width();
   std::vector<Eigen::Vector2i> cells;
   std::vector<std::ptrdiff_t> offsets;
@@ -306,7 +306,7 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
   for (const double da : angles) {
     Eigen::Vector4i b(INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN);
     for (const auto& p : cells_at(spread, center.theta + da, center.position(), r)) {
-      cells.push_back(p);
+      cells.emplace_back(p.x() - grids.min_x(), p.y() - grids.min_y());
       offsets.push_back(std::ptrdiff_t(p.y()) * row + p.x());
       b = Eigen::Vector4i(std::min(b[0], p.x()), std::min(b[1], p.y()), std::max(b[2], p.x()), std::max(b[3], p.y()));
     }
@@ -334,6 +334,15 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
     return b[0] + low.dx >= grids.min_x() && b[1] + low.dy >= grids.min_y() && b[2] + high.dx < grids.min_x() + grids.width() &&
            b[3] + high.dy < grids.min_y() + grids.height();
   };
+  // A cell's value by its coordinates from the levels' first cell: unknown outside them.
+  const int unknown = grids.value(0, grids.min_x() - 1, grids.min_y() - 1);
+  const unsigned held_x = unsigned(grids.width()), held_y = unsigned(grids.height());
+  const bool none_held = held_x == 0 || held_y == 0;
+  auto checked = [&](const std::uint8_t* data, int x, int y) {
+    const bool in = unsigned(x) < held_x && unsigned(y) < held_y;
+    const int v = data[in ? std::ptrdiff_t(y) * row + x : 0];
+    return in ? v : unknown;
+  };
   // Scoring sets a candidate's score at `level`; or, once the points read so far show that it
   // cannot exceed `bound`, an upper bound of it that does not exceed `bound` either (such a
   // candidate is never explored: the best score only rises). Points are read in blocks between
@@ -343,14 +352,17 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
     const double factor = prior(c, level);
     const std::size_t first = std::size_t(c.scan) * np;
     const bool fast = inside(c, c);
-    const std::uint8_t* data = grids.level_data(level) + std::ptrdiff_t(c.dy - grids.min_y()) * row + (c.dx - grids.min_x());
+    const std::uint8_t* level_data = grids.level_data(level);
+    const std::uint8_t* data = level_data + std::ptrdiff_t(c.dy - grids.min_y()) * row + (c.dx - grids.min_x());
     int sum = 0;
     for (std::size_t i = 0; i < np;) {
       const std::size_t end = std::min(np, i + kBlock);
       if (fast) {
         for (; i < end; ++i) sum += data[offsets[first + i]];
+      } else if (none_held) {
+        sum += unknown * int(end - i), i = end;
       } else {
-        for (; i < end; ++i) sum += grids.value(level, cells[first + i].x() + c.dx, cells[first + i].y() + c.dy);
+        for (; i < end; ++i) sum += checked(level_data, cells[first + i].x() + c.dx, cells[first + i].y() + c.dy);
       }
       if (i < np) {
         const double most = double(sum + top_value * int(np - i)) / n * factor;
@@ -362,20 +374,31 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
     }
     c.score = double(sum) / n * factor;
   };
-  // The four quarters (dx, dy), (dx + s, dy), (dx, dy + s), (dx + s, dy + s) of a candidate, wholly
-  // inside the grids, scored in one pass over their points.
+  // The four quarters (dx, dy), (dx + s, dy), (dx, dy + s), (dx + s, dy + s) of a candidate
+  // scored in one pass over their points.
   auto score_quarters = [&](std::array<Candidate, 4>& q, int level, double bound) {
     std::array<double, 4> factor{};
     for (std::size_t k = 0; k < 4; ++k) factor[k] = prior(q[k], level);
     const std::size_t first = std::size_t(q[0].scan) * np;
-    const std::uint8_t* data = grids.level_data(level) + std::ptrdiff_t(q[0].dy - grids.min_y()) * row + (q[0].dx - grids.min_x());
-    const std::ptrdiff_t sx = q[1].dx - q[0].dx, sy = std::ptrdiff_t(q[2].dy - q[0].dy) * row;
+    const bool fast = inside(q[0], q[3]);
+    const std::uint8_t* level_data = grids.level_data(level);
+    const std::uint8_t* data = level_data + std::ptrdiff_t(q[0].dy - grids.min_y()) * row + (q[0].dx - grids.min_x());
+    const int s = q[1].dx - q[0].dx;
+    const std::ptrdiff_t sx = s, sy = std::ptrdiff_t(s) * row;
     std::array<int, 4> sum{};
     for (std::size_t i = 0; i < np;) {
       const std::size_t end = std::min(np, i + kBlock);
-      for (; i < end; ++i) {
-        const std::uint8_t* p = data + offsets[first + i];
-        sum[0] += p[0], sum[1] += p[sx], sum[2] += p[sy], sum[3] += p[sy + sx];
+      if (fast) {
+        for (; i < end; ++i) {
+          const std::uint8_t* p = data + offsets[first + i];
+          sum[0] += p[0], sum[1] += p[sx], sum[2] += p[sy], sum[3] += p[sy + sx];
+        }
+      } else {
+        for (; i < end; ++i) {
+          const int x = cells[first + i].x() + q[0].dx, y = cells[first + i].y() + q[0].dy;
+          sum[0] += checked(level_data, x, y), sum[1] += checked(level_data, x + s, y);
+          sum[2] += checked(level_data, x, y + s), sum[3] += checked(level_data, x + s, y + s);
+        }
       }
       if (i < np) {
         std::array<double, 4> most{};
@@ -442,7 +465,7 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
           if (child.dx <= w && child.dy <= w && !excluded(child, level - 1)) children[k++] = child;
         }
       }
-      if (k == 4 && inside(children[0], children[3])) {
+      if (k == 4 && !none_held) {
         score_quarters(children, level - 1, best_score);
       } else {
         for (std::size_t j = 0; j < k; ++j) score(children[j], level - 1, best_score);

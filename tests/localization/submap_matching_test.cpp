@@ -155,10 +155,13 @@ double exhaustive_best(const PrecomputedGrids& grids, const PointCloud& points, 
 
 TEST(BranchAndBound, FindsTheBestScoreOfTheExhaustiveSearch) {
   const SubmapGrid grid = two_rooms(false);
-  // The room's scan seen from off its centre and turned, so that its best pose is not the window's centre.
+  // The room's scan seen from off its centre and turned, so that its best pose is not the window's
+  // centre, with returns from beyond its top wall, where the submap knows nothing (off its cells).
   PointCloud scan;
   const core::Pose2 truth(0.3, -0.15, 0.08);
-  for (const auto& p : room({0.0, 0.0}, true)) scan.push_back(truth.inverse().transform(p));
+  PointCloud seen = room({0.0, 0.0}, true);
+  for (double t = -1.0; t <= 1.0 + 1e-9; t += 0.2) seen.push_back({t, 3.0});
+  for (const auto& p : seen) scan.push_back(truth.inverse().transform(p));
   const core::Pose2 center(0.1, 0.1, 0.0);
   for (const int depth : {3, 7}) {
     const PrecomputedGrids grids(grid, depth);
