@@ -137,11 +137,12 @@ LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReade
     throw InputError(fmt::format("the log's map would be {} x {} cells at {} m: give a coarser --resolution", width, height,
                                  o.resolution_m));
   }
-  mapping::OccupancyGrid map(core::GridGeometry(o.resolution_m, width, height, core::Pose2(lo_x - margin, lo_y - margin, 0.0)));
-
   LogSlamResult out;
   auto localizer = localization::make_localizer(o.method, context_for(o));
   const bool own_map = !localizer->ignores_own_map();
+  // A method that keeps a map of its own is handed a grid of one cell, which it does not read.
+  mapping::OccupancyGrid map(core::GridGeometry(o.resolution_m, own_map ? width : 1, own_map ? height : 1,
+                                                core::Pose2(lo_x - margin, lo_y - margin, 0.0)));
   auto log = open_log();
   std::optional<core::Pose2> first_odometry, previous_odometry;
   double previous_time = 0.0, period = 0.0;
@@ -177,6 +178,9 @@ LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReade
   }
   out.log_duration_s = out.times_s.empty() ? 0.0 : out.times_s.back() - out.times_s.front();
   out.counters = localizer->counters();
+  // The method's state is not needed for the final map: its memory and the map's are not held at once.
+  localizer.reset();
+  map = mapping::OccupancyGrid();
   out.map = final_map(open_log, out.trajectory, reach, o.resolution_m);
   return out;
 }

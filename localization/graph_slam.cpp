@@ -113,6 +113,7 @@ struct GraphSlam::State {
     Submap& m = submaps[index];
     m.finished = true;
     m.precomputed = std::make_unique<PrecomputedGrids>(m.grid, o.branch_and_bound_depth);
+    m.grid.release_insertion_state();
     // Earlier nodes may have passed here before (the newer ones are searched as they come).
     for (std::size_t i = 0; i < nodes.size(); ++i) {
       if (!m.has_nodes || i < m.first_node || i > m.last_node) search_loop(i, index);

@@ -53,11 +53,14 @@ struct GraphSlamOptions {
     return r;
   }();
   // Loop closures: searched for a fraction of the (node, finished submap) pairs closer than
-  // max_constraint_distance_m, over the branch-and-bound window, refined with loop_refine.
+  // max_constraint_distance_m, over the branch-and-bound window, refined with loop_refine. A pair's
+  // chance to match falls with its distance (on MIT CSAIL a quarter of the searches within 3 m of
+  // the submap's origin matched, 3 % of those 12-15 m apart, a third of all searches): 10 m, not
+  // Cartographer's 15, keeps most closures for half the searches.
   BranchAndBoundOptions loop_search;
   int branch_and_bound_depth = 7;
   double loop_sampling_ratio = 0.1;
-  double max_constraint_distance_m = 15.0;
+  double max_constraint_distance_m = 10.0;
   // A match is refused when the window holds a rival match farther than loop_rival_radius_m from
   // it that its points prefer by fewer than loop_rival_errors standard errors (score_advantage).
   double loop_rival_radius_m = 1.0;

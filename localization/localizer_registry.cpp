@@ -63,7 +63,7 @@ core::Registry<LocalizerFactory>& localizer_registry() {
                              "a new submap starts every this many inserted scans (each takes twice as many)"),
            ParamSpec::number("insert_min_distance", 0.2, {0, 1e3}, "m",
                              "a scan joins the submaps when the robot moved this far since the last one"),
-           ParamSpec::number("max_constraint_distance", 15, {0, 1e6}, "m",
+           ParamSpec::number("max_constraint_distance", 10, {0, 1e6}, "m",
                              "loop closures are searched between scans and submaps at most this far apart"),
            ParamSpec::number("loop_sampling_ratio", 0.1, {0, 1}, "", "share of (scan, submap) pairs searched for closures"),
            ParamSpec::number("loop_rival_errors", 2, {0, 1e3}, "",

@@ -46,6 +46,8 @@ void SubmapGrid::grow_to(int lo_x, int lo_y, int hi_x, int hi_y) {
   min_x_ = nlo_x, min_y_ = nlo_y, width_ = nw, height_ = nh;
 }
 
+void SubmapGrid::release_insertion_state() { std::vector<std::uint32_t>().swap(stamp_); }
+
 void SubmapGrid::update(int x, int y, double odds_factor) {
   const int ix = x - min_x_, iy = y - min_y_;
   if (ix < 0 || iy < 0 || ix >= width_ || iy >= height_) return;
@@ -62,6 +64,7 @@ void SubmapGrid::update(int x, int y, double odds_factor) {
 
 void SubmapGrid::insert(const Eigen::Vector2d& sensor, const std::vector<Eigen::Vector2d>& hits) {
   if (hits.empty()) return;
+  if (stamp_.size() != cells_.size()) stamp_.assign(cells_.size(), 0);  // scan_ is above 0 from now on
   ++scan_;
   const Eigen::Vector2i s = cell_of(sensor);
   int lo_x = s.x(), lo_y = s.y(), hi_x = s.x(), hi_y = s.y();

@@ -26,6 +26,7 @@ class SubmapGrid {
   explicit SubmapGrid(const SubmapGridOptions& options = {});
 
   double resolution() const { return options_.resolution_m; }
+  const SubmapGridOptions& options() const { return options_; }
   // The cell holding a point (metres) of the grid's frame.
   Eigen::Vector2i cell_of(const Eigen::Vector2d& p) const;
   // Probability of occupancy; unknown cells and cells outside read min_probability.
@@ -40,6 +41,9 @@ class SubmapGrid {
   // One scan taken at `sensor` (grid frame): `hits` are returns (grid frame); each cell between
   // the sensor and a hit gets a miss, each hit cell a hit, every cell at most one update.
   void insert(const Eigen::Vector2d& sensor, const std::vector<Eigen::Vector2d>& hits);
+  // Frees what only insertion needs (a finished submap takes no more scans; one that does gets it
+  // back).
+  void release_insertion_state();
 
   // The bounds of the cells held (inclusive min, exclusive max).
   int min_x() const { return min_x_; }

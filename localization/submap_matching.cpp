@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <climits>
 #include <cstdint>
@@ -189,16 +190,40 @@ MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, 
   const double r = grid.resolution();
   const int w = int(std::ceil(o.linear_window_m / r));
   const double step = angular_search_step(points, r);
-  const double n = double(points.size());
+  const std::size_t np = points.size();
+  const double n = double(np);
+  // A cell reads at most this (the probabilities are clamped, then stored as floats).
+  const double top = double(float(grid.options().max_probability));
+  auto sum_at = [&](const std::vector<Eigen::Vector2i>& cells, int dx, int dy, std::size_t from, std::size_t to, double sum) {
+    for (std::size_t i = from; i < to; ++i) sum += grid.probability(cells[i].x() + dx, cells[i].y() + dy);
+    return sum;
+  };
+  // The prior pose's own score (penalty 0): a candidate that cannot reach it is never the answer,
+  // nor one that cannot beat the best so far; both are told early from a partial sum of the points
+  // (the margin covers the sum's rounding), which leaves the answer as the full search's.
+  const double floor_score = sum_at(cells_at(points, prior.theta + 0.0, prior.position(), r), 0, 0, 0, np, 0.0) / n;
+  constexpr std::size_t kBlock = 32;
+  constexpr double kMargin = 1.0 + 1e-9;
   for (const double da : window_angles(o.angular_window_rad, step)) {
     const auto cells = cells_at(points, prior.theta + da, prior.position(), r);
     for (int dy = -w; dy <= w; ++dy) {
       for (int dx = -w; dx <= w; ++dx) {
-        double sum = 0.0;
-        for (const auto& c : cells) sum += grid.probability(c.x() + dx, c.y() + dy);
         const double d = std::hypot(dx * r, dy * r);
         const double penalty = d * o.translation_weight + std::abs(da) * o.rotation_weight;
-        const double score = sum / n * std::exp(-penalty * penalty);
+        const double factor = std::exp(-penalty * penalty);
+        double sum = 0.0;
+        bool hopeless = false;
+        for (std::size_t i = 0; i < np && !hopeless;) {
+          const std::size_t end = std::min(np, i + kBlock);
+          sum = sum_at(cells, dx, dy, i, end, sum);
+          i = end;
+          if (i < np) {
+            const double most = (sum + top * double(np - i)) / n * factor * kMargin;
+            hopeless = most < floor_score || most <= best.score;
+          }
+        }
+        if (hopeless) continue;
+        const double score = sum / n * factor;
         if (score > best.score) best = {core::Pose2(prior.x + dx * r, prior.y + dy * r, prior.theta + da), score};
       }
     }
@@ -208,9 +233,18 @@ MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, 
 }
 
 PrecomputedGrids::PrecomputedGrids(const SubmapGrid& grid, int depth) : resolution_(grid.resolution()) {
+  // The levels are held over the known cells' bounds, and 2^depth - 1 cells below them (where a
+  // square reaches into them): every other cell of every level is unknown.
+  int lo_x = INT32_MAX, lo_y = INT32_MAX, hi_x = INT32_MIN, hi_y = INT32_MIN;
+  for (int y = grid.min_y(); y < grid.min_y() + grid.height(); ++y) {
+    for (int x = grid.min_x(); x < grid.min_x() + grid.width(); ++x) {
+      if (grid.known(x, y)) lo_x = std::min(lo_x, x), lo_y = std::min(lo_y, y), hi_x = std::max(hi_x, x), hi_y = std::max(hi_y, y);
+    }
+  }
+  if (lo_x > hi_x) lo_x = grid.min_x(), lo_y = grid.min_y(), hi_x = lo_x - 1, hi_y = lo_y - 1;
   const int pad = (1 << depth) - 1;
-  min_x_ = grid.min_x() - pad, min_y_ = grid.min_y() - pad;
-  width_ = grid.width() + pad, height_ = grid.height() + pad;
+  min_x_ = lo_x - pad, min_y_ = lo_y - pad;
+  width_ = hi_x - lo_x + 1 + pad, height_ = hi_y - lo_y + 1 + pad;
   unknown_ = std::uint8_t(std::lround(255.0 * grid.probability(grid.min_x() - 1, grid.min_y() - 1)));
   std::vector<std::uint8_t> level(std::size_t(width_) * std::size_t(height_));
   for (int y = 0; y < height_; ++y) {
@@ -219,18 +253,26 @@ PrecomputedGrids::PrecomputedGrids(const SubmapGrid& grid, int depth) : resoluti
           std::uint8_t(std::lround(255.0 * grid.probability(x + min_x_, y + min_y_)));
     }
   }
+  max_value_ = std::max<int>(unknown_, level.empty() ? 0 : *std::max_element(level.begin(), level.end()));
   levels_.push_back(std::move(level));
-  // Level h from level h-1: the largest of four cells half the width apart.
+  // Level h from level h-1: the largest of four cells half the width apart, taken along rows then
+  // along columns (cells past the far edges are unknown).
+  const std::size_t wd = std::size_t(width_);
+  std::vector<std::uint8_t> along(levels_.back().size());
   for (int h = 1; h <= depth; ++h) {
     const int s = 1 << (h - 1);
-    std::vector<std::uint8_t> next(levels_.back().size());
+    const std::vector<std::uint8_t>& prev = levels_.back();
+    for (std::size_t y = 0; y < std::size_t(height_); ++y) {
+      const std::uint8_t* in = prev.data() + y * wd;
+      std::uint8_t* out = along.data() + y * wd;
+      for (int x = 0; x < width_; ++x) out[x] = std::max(in[x], x + s < width_ ? in[x + s] : unknown_);
+    }
+    std::vector<std::uint8_t> next(along.size());
     for (int y = 0; y < height_; ++y) {
-      for (int x = 0; x < width_; ++x) {
-        const int gx = x + min_x_, gy = y + min_y_;
-        next[std::size_t(y) * std::size_t(width_) + std::size_t(x)] =
-            std::max(std::max(value(h - 1, gx, gy), value(h - 1, gx + s, gy)),
-                     std::max(value(h - 1, gx, gy + s), value(h - 1, gx + s, gy + s)));
-      }
+      const std::uint8_t* a = along.data() + std::size_t(y) * wd;
+      const std::uint8_t* b = y + s < height_ ? along.data() + std::size_t(y + s) * wd : nullptr;
+      std::uint8_t* out = next.data() + std::size_t(y) * wd;
+      for (int x = 0; x < width_; ++x) out[x] = std::max(a[x], b ? b[x] : unknown_);
     }
     levels_.push_back(std::move(next));
   }
@@ -242,15 +284,41 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
   const double r = grids.resolution();
   const int w = int(std::ceil(o.linear_window_m / r));
   const auto angles = window_angles(o.angular_window_rad, angular_search_step(points, r));
-  std::vector<std::vector<Eigen::Vector2i>> scans;
-  scans.reserve(angles.size());
-  for (const double da : angles) scans.push_back(cells_at(points, center.theta + da, center.position(), r));
+  // The points taken in a stride through the scan, so that every prefix is spread over all of it:
+  // a candidate's partial sum tells early that it cannot beat the best, and the sum (of integers)
+  // does not depend on the order.
+  const std::size_t np = points.size();
+  constexpr std::size_t kStride = 16;
+  PointCloud spread;
+  spread.reserve(np);
+  for (std::size_t first = 0; first < kStride; ++first) {
+    for (std::size_t i = first; i < np; i += kStride) spread.push_back(points[i]);
+  }
+  // Each rotated scan's cells (counted from the levels' first cell), their offsets in the grids'
+  // rows (the levels share one layout) and their bounds, so that a candidate wholly inside the
+  // grids reads cells without bounds checks (the searches' inner loop).
+  const std::ptrdiff_t row = grids.width();
+  std::vector<Eigen::Vector2i> cells;
+  std::vector<std::ptrdiff_t> offsets;
+  std::vector<Eigen::Vector4i> bounds;
+  cells.reserve(angles.size() * np);
+  offsets.reserve(angles.size() * np);
+  for (const double da : angles) {
+    Eigen::Vector4i b(INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN);
+    for (const auto& p : cells_at(spread, center.theta + da, center.position(), r)) {
+      cells.emplace_back(p.x() - grids.min_x(), p.y() - grids.min_y());
+      offsets.push_back(std::ptrdiff_t(p.y()) * row + p.x());
+      b = Eigen::Vector4i(std::min(b[0], p.x()), std::min(b[1], p.y()), std::max(b[2], p.x()), std::max(b[3], p.y()));
+    }
+    bounds.push_back(b);
+  }
 
   struct Candidate {
     int scan = 0, dx = 0, dy = 0;
     double score = 0.0;
   };
-  const double n = double(points.size()) * 255.0;
+  const double n = double(np) * 255.0;
+  const int top_value = grids.max_value();
   // The prior's factor at the pose of the candidate's region nearest the centre, so that the
   // region's score still bounds every pose in it.
   auto prior = [&](const Candidate& c, int level) {
@@ -261,39 +329,102 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
     const double penalty = std::hypot(nx * r, ny * r) * o.translation_weight + std::abs(angles[std::size_t(c.scan)]) * o.rotation_weight;
     return std::exp(-penalty * penalty);
   };
-  // Each rotated scan's cell bounds, so that a candidate wholly inside the grids reads cells
-  // without bounds checks (the searches' inner loop).
-  std::vector<Eigen::Vector4i> bounds;
-  for (const auto& cells : scans) {
-    Eigen::Vector4i b(INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN);
-    for (const auto& p : cells) b = Eigen::Vector4i(std::min(b[0], p.x()), std::min(b[1], p.y()), std::max(b[2], p.x()), std::max(b[3], p.y()));
-    bounds.push_back(b);
-  }
-  auto score = [&](Candidate& c, int level) {
+  auto inside = [&](const Candidate& low, const Candidate& high) {
+    const auto& b = bounds[std::size_t(low.scan)];
+    return b[0] + low.dx >= grids.min_x() && b[1] + low.dy >= grids.min_y() && b[2] + high.dx < grids.min_x() + grids.width() &&
+           b[3] + high.dy < grids.min_y() + grids.height();
+  };
+  // A cell's value by its coordinates from the levels' first cell: unknown outside them.
+  const int unknown = grids.value(0, grids.min_x() - 1, grids.min_y() - 1);
+  const unsigned held_x = unsigned(grids.width()), held_y = unsigned(grids.height());
+  const bool none_held = held_x == 0 || held_y == 0;
+  auto checked = [&](const std::uint8_t* data, int x, int y) {
+    const bool in = unsigned(x) < held_x && unsigned(y) < held_y;
+    const int v = data[in ? std::ptrdiff_t(y) * row + x : 0];
+    return in ? v : unknown;
+  };
+  // Scoring sets a candidate's score at `level`; or, once the points read so far show that it
+  // cannot exceed `bound`, an upper bound of it that does not exceed `bound` either (such a
+  // candidate is never explored: the best score only rises). Points are read in blocks between
+  // such checks.
+  constexpr std::size_t kBlock = 32;
+  auto score = [&](Candidate& c, int level, double bound) {
+    const double factor = prior(c, level);
+    const std::size_t first = std::size_t(c.scan) * np;
+    const bool fast = inside(c, c);
+    const std::uint8_t* level_data = grids.level_data(level);
+    const std::uint8_t* data = level_data + std::ptrdiff_t(c.dy - grids.min_y()) * row + (c.dx - grids.min_x());
     int sum = 0;
-    const auto& cells = scans[std::size_t(c.scan)];
-    const auto& b = bounds[std::size_t(c.scan)];
-    if (b[0] + c.dx >= grids.min_x() && b[1] + c.dy >= grids.min_y() && b[2] + c.dx < grids.min_x() + grids.width() &&
-        b[3] + c.dy < grids.min_y() + grids.height()) {
-      const std::uint8_t* data = grids.level_data(level);
-      const std::ptrdiff_t w = grids.width();
-      const std::ptrdiff_t offset = std::ptrdiff_t(c.dy - grids.min_y()) * w + (c.dx - grids.min_x());
-      for (const auto& p : cells) sum += data[offset + std::ptrdiff_t(p.y()) * w + p.x()];
-    } else {
-      for (const auto& p : cells) sum += grids.value(level, p.x() + c.dx, p.y() + c.dy);
+    for (std::size_t i = 0; i < np;) {
+      const std::size_t end = std::min(np, i + kBlock);
+      if (fast) {
+        for (; i < end; ++i) sum += data[offsets[first + i]];
+      } else if (none_held) {
+        sum += unknown * int(end - i), i = end;
+      } else {
+        for (; i < end; ++i) sum += checked(level_data, cells[first + i].x() + c.dx, cells[first + i].y() + c.dy);
+      }
+      if (i < np) {
+        const double most = double(sum + top_value * int(np - i)) / n * factor;
+        if (most <= bound) {
+          c.score = most;
+          return;
+        }
+      }
     }
-    c.score = double(sum) / n * prior(c, level);
+    c.score = double(sum) / n * factor;
+  };
+  // The four quarters (dx, dy), (dx + s, dy), (dx, dy + s), (dx + s, dy + s) of a candidate
+  // scored in one pass over their points.
+  auto score_quarters = [&](std::array<Candidate, 4>& q, int level, double bound) {
+    std::array<double, 4> factor{};
+    for (std::size_t k = 0; k < 4; ++k) factor[k] = prior(q[k], level);
+    const std::size_t first = std::size_t(q[0].scan) * np;
+    const bool fast = inside(q[0], q[3]);
+    const std::uint8_t* level_data = grids.level_data(level);
+    const std::uint8_t* data = level_data + std::ptrdiff_t(q[0].dy - grids.min_y()) * row + (q[0].dx - grids.min_x());
+    const int s = q[1].dx - q[0].dx;
+    const std::ptrdiff_t sx = s, sy = std::ptrdiff_t(s) * row;
+    std::array<int, 4> sum{};
+    for (std::size_t i = 0; i < np;) {
+      const std::size_t end = std::min(np, i + kBlock);
+      if (fast) {
+        for (; i < end; ++i) {
+          const std::uint8_t* p = data + offsets[first + i];
+          sum[0] += p[0], sum[1] += p[sx], sum[2] += p[sy], sum[3] += p[sy + sx];
+        }
+      } else {
+        for (; i < end; ++i) {
+          const int x = cells[first + i].x() + q[0].dx, y = cells[first + i].y() + q[0].dy;
+          sum[0] += checked(level_data, x, y), sum[1] += checked(level_data, x + s, y);
+          sum[2] += checked(level_data, x, y + s), sum[3] += checked(level_data, x + s, y + s);
+        }
+      }
+      if (i < np) {
+        std::array<double, 4> most{};
+        bool all = true;
+        for (std::size_t k = 0; k < 4; ++k) {
+          most[k] = double(sum[k] + top_value * int(np - i)) / n * factor[k];
+          all = all && most[k] <= bound;
+        }
+        if (all) {
+          for (std::size_t k = 0; k < 4; ++k) q[k].score = most[k];
+          return;
+        }
+      }
+    }
+    for (std::size_t k = 0; k < 4; ++k) q[k].score = double(sum[k]) / n * factor[k];
   };
   auto by_score = [](const Candidate& a, const Candidate& b) { return a.score > b.score; };
 
   const int top = grids.depth();
   std::vector<Candidate> start;
   const int top_step = 1 << top;
-  for (int k = 0; k < int(scans.size()); ++k) {
+  for (int k = 0; k < int(angles.size()); ++k) {
     for (int dy = -w; dy <= w; dy += top_step) {
       for (int dx = -w; dx <= w; dx += top_step) {
         Candidate c{k, dx, dy, 0.0};
-        score(c, top);
+        score(c, top, -std::numeric_limits<double>::infinity());
         start.push_back(c);
       }
     }
@@ -302,8 +433,6 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
 
   std::optional<Candidate> best;
   double best_score = o.min_score;
-  // Depth-first: a candidate at level h covers offsets [dx, dx + 2^h) x [dy, dy + 2^h), and its
-  // level-h score bounds every pose it covers.
   // Whether every offset a candidate of `level` covers lies in the excluded disc (its four corners
   // do, and the disc is convex).
   auto excluded = [&](const Candidate& c, int level) {
@@ -316,8 +445,11 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
     }
     return true;
   };
-  auto search = [&](auto&& self, const std::vector<Candidate>& candidates, int level) -> void {
-    for (const auto& c : candidates) {
+  // Depth-first: a candidate at level h covers offsets [dx, dx + 2^h) x [dy, dy + 2^h), and its
+  // level-h score bounds every pose it covers. Candidates best first, equal scores in the order made.
+  auto search = [&](auto&& self, const Candidate* candidates, std::size_t count, int level) -> void {
+    for (std::size_t i = 0; i < count; ++i) {
+      const Candidate& c = candidates[i];
       if (c.score <= best_score) break;
       if (excluded(c, level)) continue;
       if (level == 0) {
@@ -325,20 +457,30 @@ std::optional<MatchResult> branch_and_bound_match(const PrecomputedGrids& grids,
         continue;
       }
       const int half = 1 << (level - 1);
-      std::vector<Candidate> children;
+      std::array<Candidate, 4> children;
+      std::size_t k = 0;
       for (int oy : {0, half}) {
         for (int ox : {0, half}) {
-          Candidate child{c.scan, c.dx + ox, c.dy + oy, 0.0};
-          if (child.dx > w || child.dy > w) continue;
-          score(child, level - 1);
-          children.push_back(child);
+          const Candidate child{c.scan, c.dx + ox, c.dy + oy, 0.0};
+          if (child.dx <= w && child.dy <= w && !excluded(child, level - 1)) children[k++] = child;
         }
       }
-      std::sort(children.begin(), children.end(), by_score);
-      self(self, children, level - 1);
+      if (k == 4 && !none_held) {
+        score_quarters(children, level - 1, best_score);
+      } else {
+        for (std::size_t j = 0; j < k; ++j) score(children[j], level - 1, best_score);
+      }
+      // Insertion sort: stable, as std::sort is for so few.
+      for (std::size_t j = 1; j < k; ++j) {
+        const Candidate v = children[j];
+        std::size_t m = j;
+        for (; m > 0 && v.score > children[m - 1].score; --m) children[m] = children[m - 1];
+        children[m] = v;
+      }
+      self(self, children.data(), k, level - 1);
     }
   };
-  search(search, start, top);
+  search(search, start.data(), start.size(), top);
   if (!best) return std::nullopt;
   return MatchResult{core::Pose2(center.x + best->dx * r, center.y + best->dy * r,
                                  core::normalize_angle(center.theta + angles[std::size_t(best->scan)])),

@@ -57,6 +57,8 @@ class PrecomputedGrids {
   int min_y() const { return min_y_; }
   int width() const { return width_; }
   int height() const { return height_; }
+  // The largest value of every level (and outside).
+  int max_value() const { return max_value_; }
   std::uint8_t value(int level, int x, int y) const {
     const int ix = x - min_x_, iy = y - min_y_;
     if (ix < 0 || iy < 0 || ix >= width_ || iy >= height_) return unknown_;
@@ -67,6 +69,7 @@ class PrecomputedGrids {
   double resolution_ = 0.05;
   int min_x_ = 0, min_y_ = 0, width_ = 0, height_ = 0;
   std::uint8_t unknown_ = 0;
+  int max_value_ = 0;
   std::vector<std::vector<std::uint8_t>> levels_;
 };
 

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace fleetmap::localization {
@@ -121,6 +123,86 @@ TEST(RefineMatch, TheScanFixesTheCorridorsWidthAndThePredictionItsLength) {
   const core::Pose2 refined = refine_match(grid, corridor_scan(), prediction, prediction, o);
   EXPECT_NEAR(refined.y, 0.0, 0.015) << refined;  // the walls decide across (a third of a cell)
   EXPECT_NEAR(refined.x, 0.3, 0.02) << refined;   // nothing along: the prediction holds
+}
+
+// Every pose of the window around `center` (the search's angles and offsets), scored as the search
+// scores a pose: the best score there is the one the search must return.
+double exhaustive_best(const PrecomputedGrids& grids, const PointCloud& points, const core::Pose2& center,
+                       const BranchAndBoundOptions& o) {
+  const double r = grids.resolution();
+  const int w = int(std::ceil(o.linear_window_m / r));
+  const double step = angular_search_step(points, r);
+  const int na = int(std::ceil(o.angular_window_rad / step));
+  double best = -1.0;
+  for (int k = -na; k <= na; ++k) {
+    const double da = k * step;
+    const double c = std::cos(center.theta + da), s = std::sin(center.theta + da);
+    std::vector<Eigen::Vector2i> cells;
+    for (const auto& p : points) {
+      cells.emplace_back(int(std::floor((c * p.x() - s * p.y() + center.x) / r)), int(std::floor((s * p.x() + c * p.y() + center.y) / r)));
+    }
+    for (int dy = -w; dy <= w; ++dy) {
+      for (int dx = -w; dx <= w; ++dx) {
+        int sum = 0;
+        for (const auto& cell : cells) sum += grids.value(0, cell.x() + dx, cell.y() + dy);
+        const double penalty = std::hypot(dx * r, dy * r) * o.translation_weight + std::abs(da) * o.rotation_weight;
+        best = std::max(best, double(sum) / (double(points.size()) * 255.0) * std::exp(-penalty * penalty));
+      }
+    }
+  }
+  return best;
+}
+
+TEST(BranchAndBound, FindsTheBestScoreOfTheExhaustiveSearch) {
+  const SubmapGrid grid = two_rooms(false);
+  // The room's scan seen from off its centre and turned, so that its best pose is not the window's
+  // centre, with returns from beyond its top wall, where the submap knows nothing (off its cells).
+  PointCloud scan;
+  const core::Pose2 truth(0.3, -0.15, 0.08);
+  PointCloud seen = room({0.0, 0.0}, true);
+  for (double t = -1.0; t <= 1.0 + 1e-9; t += 0.2) seen.push_back({t, 3.0});
+  for (const auto& p : seen) scan.push_back(truth.inverse().transform(p));
+  const core::Pose2 center(0.1, 0.1, 0.0);
+  for (const int depth : {3, 7}) {
+    const PrecomputedGrids grids(grid, depth);
+    for (const double weight : {0.0, 1.0}) {
+      BranchAndBoundOptions o;
+      o.linear_window_m = 1.0;
+      o.angular_window_rad = 0.2;
+      o.min_score = 0.0;
+      o.translation_weight = weight;
+      o.rotation_weight = weight;
+      const auto match = branch_and_bound_match(grids, scan, center, o);
+      ASSERT_TRUE(match);
+      EXPECT_DOUBLE_EQ(match->score, exhaustive_best(grids, scan, center, o)) << "depth " << depth << ", weight " << weight;
+      EXPECT_NEAR(match->pose.x, truth.x, 0.1) << match->pose;
+      EXPECT_NEAR(match->pose.y, truth.y, 0.1) << match->pose;
+    }
+  }
+}
+
+TEST(SubmapGrid, AGridThatReleasedItsInsertionStateTakesScansAsBefore) {
+  SubmapGrid kept, released;
+  for (int k = 0; k < 3; ++k) {
+    kept.insert({0.0, 0.0}, room({0.0, 0.0}, true));
+    released.insert({0.0, 0.0}, room({0.0, 0.0}, true));
+  }
+  released.release_insertion_state();
+  // More scans, one of them beyond the grid's bounds (the grid grows).
+  for (int k = 0; k < 3; ++k) {
+    for (SubmapGrid* g : {&kept, &released}) {
+      g->insert({0.2, 0.1}, room({0.0, 0.0}, true));
+      g->insert({6.0, 0.0}, room({6.0, 0.0}, true));
+    }
+  }
+  ASSERT_EQ(released.min_x(), kept.min_x());
+  ASSERT_EQ(released.min_y(), kept.min_y());
+  ASSERT_EQ(released.width(), kept.width());
+  ASSERT_EQ(released.height(), kept.height());
+  EXPECT_EQ(released.known_cells(), kept.known_cells());
+  for (int y = kept.min_y(); y < kept.min_y() + kept.height(); ++y) {
+    for (int x = kept.min_x(); x < kept.min_x() + kept.width(); ++x) ASSERT_EQ(released.probability(x, y), kept.probability(x, y)) << x << " " << y;
+  }
 }
 
 }  // namespace
