@@ -54,13 +54,35 @@ void mark_robots(const mapping::OccupancyGrid& map, const std::vector<ExplorerRo
                  std::vector<std::uint8_t>& passable) {
   const double reach = (2.0 * options.robot_radius_m + options.safety_margin_m) / map.resolution();
   const int r = int(std::ceil(reach));
-  for (std::size_t j = 0; j < robots.size(); ++j) {
-    if (int(j) == self || (self >= 0 && !links[std::size_t(self)][j])) continue;
-    const Cell c = robot_cell(robots[j]);
+  const auto mark = [&](const Cell& c) {
     for (int dy = -r; dy <= r; ++dy) {
       for (int dx = -r; dx <= r; ++dx) {
         const Cell n{c.x + dx, c.y + dy};
         if (double(dx * dx + dy * dy) <= reach * reach && map.contains(n)) passable[std::size_t(map.geometry().index(n))] = 0;
+      }
+    }
+  };
+  for (std::size_t j = 0; j < robots.size(); ++j) {
+    if (int(j) == self || (self >= 0 && !links[std::size_t(self)][j])) continue;
+    mark(robot_cell(robots[j]));
+  }
+}
+
+// The robots `robot` just bumped into: the cells closer to where they stand than two radii (where
+// its centre cannot be), so that a path keeps its disc clear of theirs; its own cell, touching
+// them, stays open.
+void mark_bumped_robots(const mapping::OccupancyGrid& map, const ExplorerRobot& robot,
+                        const TraversabilityOptions& options, std::vector<std::uint8_t>& passable) {
+  const double res = map.resolution();
+  const double reach = 2.0 * options.robot_radius_m - 0.5 * res;
+  const int r = int(std::ceil(reach / res));
+  for (const Eigen::Vector2d& p : robot.bumped_robots) {
+    const auto c = map.geometry().world_to_cell(p);
+    if (!c) continue;
+    for (int dy = -r; dy <= r; ++dy) {
+      for (int dx = -r; dx <= r; ++dx) {
+        const Cell n{c->x + dx, c->y + dy};
+        if (map.contains(n) && (map.geometry().cell_center(n) - p).norm() < reach) passable[std::size_t(map.geometry().index(n))] = 0;
       }
     }
   }
@@ -150,11 +172,13 @@ bool TeamExplorer::blocked(const RobotState& r, const Cell& frontier, const Cell
 }
 
 std::vector<std::uint8_t> TeamExplorer::wave_from(const mapping::OccupancyGrid& map, const Cell& from, WaveField& out,
-                                                  const std::function<void(std::vector<std::uint8_t>&)>& block) {
+                                                  const std::function<void(std::vector<std::uint8_t>&)>& block,
+                                                  const std::function<void(std::vector<std::uint8_t>&)>& block_after_open) {
   std::vector<std::uint8_t> passable, factor;
   passage_grid(passage_cells(map, options_.traversability), passable, factor);
   if (block) block(passable);
   open_around(map, from, options_.traversability, passable);
+  if (block_after_open) block_after_open(passable);
   std::vector<float> occupancy;
   compute_wave(wave_grid(map, passable, factor, occupancy, options_.wave), std::span<const Cell>(&from, 1), options_.wave,
                out);
@@ -236,12 +260,21 @@ bool TeamExplorer::check_task(int i, const std::vector<ExplorerRobot>& robots,
   }
   // Stuck, most likely behind or facing another robot: plan a way around the robots it knows of.
   if (r.steps_since_progress > 0 && r.steps_since_progress % options_.detour_after_steps == 0) {
-    wave_from(map, robot_cell(robot), wave_, [&](std::vector<std::uint8_t>& passable) {
-      mark_robots(map, robots, i, links, options_.traversability, passable);
-    });
+    wave_from(
+        map, robot_cell(robot), wave_,
+        [&](std::vector<std::uint8_t>& passable) { mark_robots(map, robots, i, links, options_.traversability, passable); },
+        [&](std::vector<std::uint8_t>& passable) { mark_bumped_robots(map, robot, options_.traversability, passable); });
     if (wave_.reached(r.goal)) {
       ++stats_.detours;
       set_path(r, wave_.path_to(r.goal), map);
+    } else if (!robot.bumped_robots.empty()) {
+      // A robot it just bumped into bars every way to the goal: another target, rather than
+      // pushing against it until the stall limit.
+      ++stats_.given_up_stalled;
+      ++stats_.targets_given_up;
+      given_up_[std::size_t(i)].push_back({map.geometry().cell_center(r.goal), "stalled: a robot bars the way"});
+      fail_approach(i, Failure::Stalled, map.observed_count());
+      return false;
     }
   }
   if (r.steps_since_progress > options_.stall_steps) {

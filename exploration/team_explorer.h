@@ -50,6 +50,9 @@ struct ExplorationOptions {
 struct ExplorerRobot {
   const mapping::OccupancyGrid* map = nullptr;  // the robot's own map
   core::Pose2 pose;                             // its estimated pose in that map's frame
+  // Where robots it has just bumped into stand, in that map's frame (a bumper's contact, whether
+  // or not it can talk to them): a detour plans around them as around the robots it knows of.
+  std::vector<Eigen::Vector2d> bumped_robots;
 };
 
 // Plans a path on a robot's map from `from` to `to` (metres), or returns nothing. The simulator
@@ -190,7 +193,8 @@ class TeamExplorer {
   // `block` closed what it wants closed, e.g. the cells around other robots). Returns the grid's
   // passable cells.
   std::vector<std::uint8_t> wave_from(const mapping::OccupancyGrid& map, const Cell& from, WaveField& out,
-                                      const std::function<void(std::vector<std::uint8_t>&)>& block = {});
+                                      const std::function<void(std::vector<std::uint8_t>&)>& block = {},
+                                      const std::function<void(std::vector<std::uint8_t>&)>& block_after_open = {});
   void set_path(RobotState& r, std::vector<Cell> path, const mapping::OccupancyGrid& map) const;
   // The provider's path to the goal as cells, or the wave's when the provider has none.
   std::vector<Cell> plan(const mapping::OccupancyGrid& map, const ExplorerRobot& robot, const Cell& goal,

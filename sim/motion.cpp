@@ -115,14 +115,17 @@ Command follow_path(const core::Pose2& estimate, const std::vector<Eigen::Vector
   return clear_on_map(c, estimate, own_map, robot, period_s);
 }
 
-Command escape_command(const core::Pose2& estimate, const mapping::OccupancyGrid& own_map, double period_s) {
+Command escape_command(const core::Pose2& estimate, const mapping::OccupancyGrid& own_map, double period_s,
+                       const std::vector<Eigen::Vector2d>& bumped, double radius_m) {
   constexpr double kStep = 0.15;
   constexpr int kDirections = 16;
   const Eigen::Vector2d p = estimate.position();
   double best = -1.0, best_angle = estimate.theta;
   for (int k = 0; k < kDirections; ++k) {
     const double a = estimate.theta + 2.0 * std::numbers::pi * k / kDirections;
-    const double c = occupied_clearance(own_map, p + kStep * Eigen::Vector2d(std::cos(a), std::sin(a)), 1.0);
+    const Eigen::Vector2d q = p + kStep * Eigen::Vector2d(std::cos(a), std::sin(a));
+    double c = occupied_clearance(own_map, q, 1.0);
+    for (const auto& b : bumped) c = std::min(c, (q - b).norm() - 2.0 * radius_m);
     if (c > best + 1e-9) best = c, best_angle = a;
   }
   const double e = core::normalize_angle(best_angle - estimate.theta);
@@ -183,7 +186,13 @@ MoveResult move_robot(const World& world, int self, const std::vector<core::Pose
       const double f = double(k) / substeps;
       const Eigen::Vector2d q = localization::integrate_motion(start, {v * f, w * f, period_s}).position();
       if (valid(q)) continue;
-      if (!world.disc_free(q, robot.radius_m)) out.contact = world.nearest_blocked_point(q, robot.radius_m);
+      if (!world.disc_free(q, robot.radius_m)) {
+        out.contact = world.nearest_blocked_point(q, robot.radius_m);
+      } else {
+        for (std::size_t j = 0; j < truths.size() && !out.robot; ++j) {
+          if (int(j) != self && (truths[j].position() - q).norm() < 2.0 * robot.radius_m) out.robot = int(j);
+        }
+      }
       break;
     }
   }

@@ -59,8 +59,10 @@ Command follow_path(const core::Pose2& estimate, const std::vector<Eigen::Vector
                     const mapping::OccupancyGrid& own_map, const RobotOptions& robot, double period_s, double lookahead_m);
 
 // Recovery after blocked moves: drive 0.15 m straight (forwards or backwards, whichever heads more
-// away) toward the direction of most clearance from the occupied cells of the robot's own map.
-Command escape_command(const core::Pose2& estimate, const mapping::OccupancyGrid& own_map, double period_s);
+// away) toward the direction of most clearance from the occupied cells of the robot's own map and
+// from the discs (of `radius_m`) of the robots it bumped into (`bumped`, in its map's frame).
+Command escape_command(const core::Pose2& estimate, const mapping::OccupancyGrid& own_map, double period_s,
+                       const std::vector<Eigen::Vector2d>& bumped = {}, double radius_m = 0.0);
 
 struct MoveResult {
   core::Pose2 pose;              // the new true pose
@@ -71,6 +73,8 @@ struct MoveResult {
   // world frame): the point of the blocked cell nearest to the disc where the full move first
   // failed. Empty when nothing was hit, or only another robot.
   std::optional<Eigen::Vector2d> contact;
+  // The robot whose disc stopped the move, when another robot did (a bumper touching it).
+  std::optional<int> robot;
 };
 
 // Executes `command` for one period along the exact arc, checked in small sub-steps against walls

@@ -346,7 +346,11 @@ void Simulation::decide() {
     return;
   }
   std::vector<exploration::ExplorerRobot> views;
-  for (const Robot& r : robots_) views.push_back({&r.map, r.localizer->pose()});
+  for (const Robot& r : robots_) {
+    exploration::ExplorerRobot view{&r.map, r.localizer->pose(), {}};
+    for (const auto& b : r.bumped) view.bumped_robots.push_back(b.second);
+    views.push_back(std::move(view));
+  }
   // Robots coordinate only when they can talk and share a map frame.
   auto links = links_;
   for (std::size_t i = 0; i < links.size(); ++i)
@@ -399,7 +403,10 @@ void Simulation::step() {
     if (robot.driver) {
       cmd = robot.command.value_or(Command{});
     } else {
-      cmd = streak >= 2 ? clear_on_map(escape_command(loc.pose(), robot.map, scenario_.period_s), loc.pose(), robot.map,
+      std::vector<Eigen::Vector2d> bumped;
+      for (const auto& b : robot.bumped) bumped.push_back(b.second);
+      cmd = streak >= 2 ? clear_on_map(escape_command(loc.pose(), robot.map, scenario_.period_s, bumped, scenario_.robot.radius_m),
+                                       loc.pose(), robot.map,
                                        scenario_.robot, scenario_.period_s)
                         : follow_path(loc.pose(), explorer_.path(i), robot.map, scenario_.robot, scenario_.period_s,
                                       scenario_.lookahead_m);
@@ -425,6 +432,15 @@ void Simulation::step() {
     loc.predict(mv.odometry);
     t.localization_s += seconds_since(t_predict);
     if (mv.contact) mark_contact(robot, *mv.contact);
+    if (mv.robot) {
+      // Where the bumper puts the other robot: its offset from this one, seen from the estimate.
+      const core::Pose2 est = loc.pose();
+      const Eigen::Vector2d offset = truths[std::size_t(*mv.robot)].position() - mv.pose.position();
+      const double turn = est.theta - mv.pose.theta, c = std::cos(turn), sn = std::sin(turn);
+      robot.bumped.emplace_back(step_, est.position() + Eigen::Vector2d(c * offset.x() - sn * offset.y(), sn * offset.x() + c * offset.y()));
+    }
+    const int keep = scenario_.exploration.detour_after_steps;
+    std::erase_if(robot.bumped, [&](const auto& b) { return b.first <= step_ - keep; });
   }
   timing_.motion += seconds_since(t0);
   sense_and_map();

@@ -235,6 +235,8 @@ class Simulation {
     RobotTrack track;
     bool was_finished = false;
     int blocked_streak = 0;  // consecutive blocked moves
+    // Robots it bumped into: the step, and where the other stood in this robot's map frame.
+    std::vector<std::pair<int, Eigen::Vector2d>> bumped;
   };
   // What stopped robot's move at `contact` (world frame) becomes a wall on its own map.
   void mark_contact(Robot& robot, const Eigen::Vector2d& contact);
