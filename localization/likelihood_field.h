@@ -6,6 +6,7 @@
 // log p per cell of that window; points outside the window count as far from every wall.
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <vector>
@@ -59,6 +60,20 @@ class LikelihoodField {
     const int x = int(std::floor(grid_point.x())) - window_.x0, y = int(std::floor(grid_point.y())) - window_.y0;
     if (x < 0 || y < 0 || x >= window_.width() || y >= window_.height()) return far_;
     return table_[std::size_t(y) * std::size_t(window_.width()) + std::size_t(x)];
+  }
+  // Adds log_likelihood_nearest of the cells (x + i, y), i in [0, n), to out[i]: a row of the
+  // correlative search's window, for one end point.
+  void add_nearest_row(int x, int y, int n, double* out) const {
+    x -= window_.x0;
+    y -= window_.y0;
+    const bool row_inside = y >= 0 && y < window_.height();
+    const int begin = row_inside ? std::clamp(-x, 0, n) : n, end = row_inside ? std::clamp(window_.width() - x, begin, n) : n;
+    for (int i = 0; i < begin; ++i) out[i] += far_;
+    if (begin < end) {
+      const float* row = &table_[std::size_t(y) * std::size_t(window_.width()) + std::size_t(x)];
+      for (int i = begin; i < end; ++i) out[i] += row[i];
+    }
+    for (int i = end; i < n; ++i) out[i] += far_;
   }
   // From the exact distance of the point to the nearest occupied cell (of the cell holding it): to
   // its mean hit point, or to its box.

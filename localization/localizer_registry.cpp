@@ -48,7 +48,13 @@ core::Registry<LocalizerFactory>& localizer_registry() {
           {particles(30, 1e4, "particles per robot, each with its own grid"),
            ParamSpec::flag("sample_motion", true,
                            "each particle's search starts from its odometry step drawn with the process noise (false: "
-                           "from the step itself, so one particle is the scan matcher)")});
+                           "from the step itself, so one particle is the scan matcher)"),
+           // GMapping's linearUpdate / angularUpdate; defaults chosen on the training logs.
+           ParamSpec::number("linear_update", 0.3, {0, 1e3}, "m",
+                             "a scan is matched and mapped once the odometry moved this far since the last one (0 "
+                             "here or in angular_update: every scan)"),
+           ParamSpec::number("angular_update", 0.1, {0, 1e3}, "rad",
+                             "... or turned this much since the last one")});
     r.add("fastslam-grid",
           "grid-based FastSLAM: particles drawn from the raw motion model, each weighted by its scan on its own grid, "
           "no scan-matching proposal (León et al., sec. II.B)",

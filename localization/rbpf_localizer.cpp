@@ -28,6 +28,8 @@ RbpfLocalizer::RbpfLocalizer(const LocalizerContext& c, Proposal proposal)
     : options_(c.options), proposal_(proposal), rng_(c.seed) {
   const core::Params params = params_of(c, proposal);
   sample_motion_ = params.declares("sample_motion") ? params.flag("sample_motion") : true;
+  if (params.declares("linear_update")) linear_update_ = params.number("linear_update");
+  if (params.declares("angular_update")) angular_update_ = params.number("angular_update");
   // The robot knows where it starts: every particle starts there, with equal weights.
   particles_.resize(std::size_t(params.number("particles")));  // declared >= 1
   for (auto& p : particles_) p.pose = p.odometry_pose = c.initial_pose;
@@ -36,22 +38,44 @@ RbpfLocalizer::RbpfLocalizer(const LocalizerContext& c, Proposal proposal)
 
 void RbpfLocalizer::predict(const Odometry& u) {
   ++steps_;
+  ++pending_steps_;
+  moved_ += std::abs(u.v * u.dt);
+  turned_ += std::abs(u.omega * u.dt);
+  due_ = !(linear_update_ > 0.0 && angular_update_ > 0.0) || moved_ >= linear_update_ || turned_ >= angular_update_;
+  // The noise of the pending steps is drawn once, when their scan is due: until then the particles
+  // follow the odometry, so that the poses reported in between are the last corrected ones moved by it.
+  const double spread = std::sqrt(double(pending_steps_));
+  if (due_) {
+    draw_spread_ = spread;
+    pending_steps_ = 0;
+  }
   for (auto& p : particles_) {
     p.odometry_pose = integrate_motion(p.pose, u);
     p.pose = p.odometry_pose;
-    if (!sample_motion_ && proposal_ == Proposal::ScanMatching) continue;
-    p.pose = {p.pose.x + rng_.normal(0.0, options_.process_noise_xy), p.pose.y + rng_.normal(0.0, options_.process_noise_xy),
-              core::normalize_angle(p.pose.theta + rng_.normal(0.0, options_.process_noise_theta))};
+    if (!due_ || (!sample_motion_ && proposal_ == Proposal::ScanMatching)) continue;
+    p.pose = {p.pose.x + rng_.normal(0.0, spread * options_.process_noise_xy),
+              p.pose.y + rng_.normal(0.0, spread * options_.process_noise_xy),
+              core::normalize_angle(p.pose.theta + rng_.normal(0.0, spread * options_.process_noise_theta))};
   }
 }
 
 void RbpfLocalizer::update_scan(const RangeScan& scan, const mapping::OccupancyGrid& own_map) {
-  if (!maps_ready_ || !(particles_.front().map.geometry() == own_map.geometry())) {
+  const bool restart = !maps_ready_ || !(particles_.front().map.geometry() == own_map.geometry());
+  if (!due_ && !restart) {
+    ++skipped_;
+    return;
+  }
+  if (restart) {
     const CowGrid start = CowGrid::from_occupancy_grid(own_map);
     for (auto& p : particles_) p.map = start;  // one set of tiles, shared by all
     maps_ready_ = true;
   }
   ScanMatcherOptions m = scan_matcher_options(options_, scan.max_range, own_map.resolution());
+  // The motion prior spans the steps whose noise was drawn as one.
+  m.prior_xy_m *= draw_spread_;
+  m.prior_theta_rad *= draw_spread_;
+  moved_ = turned_ = 0.0;
+  due_ = !(linear_update_ > 0.0 && angular_update_ > 0.0);
   if (proposal_ == Proposal::Motion) {
     // The likelihood at the drawn pose alone: no search, no refinement, no prior.
     m.search_xy_m = m.search_theta_rad = 0.0;
@@ -137,6 +161,7 @@ std::vector<std::pair<std::string, double>> RbpfLocalizer::counters() const {
           {"resamplings", double(resamplings_)},
           {"effective_sample_size", n_eff_},
           {"scan_matches", double(matched_)},
+          {"scans_skipped", double(skipped_)},
           {"map_bytes_shared", double(m.shared_bytes)},
           {"map_bytes_unshared", double(m.unshared_bytes)}};
 }

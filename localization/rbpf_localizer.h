@@ -12,6 +12,11 @@
 //     beams (ScanMatcherOptions::independent_beams), as GMapping's likelihood gain smooths weights;
 //  4. the scan is integrated into the particle's map at its pose;
 //  5. selective resampling: low-variance resampling when N_eff = 1 / sum(w^2) < N / 2.
+// Steps 1-5 run only once the odometry has moved linear_update metres or turned angular_update
+// radians since the last processed scan (GMapping's linearUpdate / angularUpdate): scans closer
+// together add little to the map and cost a scan match per particle. Until then every particle
+// follows its odometry undrawn, and the step's noise is drawn once for the whole motion (sqrt(k)
+// times a step's for k steps), the matcher's prior widened alike.
 // Maps are CowGrids: resampled copies share every tile until one of them writes to it.
 // The reported pose and map are the particle with the largest weight.
 //
@@ -72,6 +77,12 @@ class RbpfLocalizer final : public Localizer {
   LocalizerOptions options_;
   Proposal proposal_;
   bool sample_motion_ = true;  // `rbpf`'s sample_motion parameter (fastslam-grid always samples)
+  double linear_update_ = 0.0, angular_update_ = 0.0;  // 0 (fastslam-grid): every scan
+  double moved_ = 0.0, turned_ = 0.0;  // odometry since the last processed scan
+  int pending_steps_ = 0;              // odometry steps whose noise is not drawn yet
+  double draw_spread_ = 1.0;           // sqrt of the steps the last draw stood for
+  bool due_ = true;                    // the next scan is processed
+  int skipped_ = 0;
   core::Random rng_;
   std::vector<Particle> particles_;
   int best_ = 0;

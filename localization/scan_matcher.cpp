@@ -133,10 +133,9 @@ ScanMatch match_scan(const LikelihoodField& field, const std::vector<Eigen::Vect
     for (std::size_t k = 0; k < points.size(); ++k) grid_points[k] = g.world_to_grid(turned.transform(points[k]));
     std::fill(sums.begin(), sums.end(), 0.0);
     for (const auto& gp : grid_points) {
-      for (int iy = -nxy; iy <= nxy; ++iy) {
-        double* row = &sums[std::size_t((iy + nxy) * side)];
-        for (int ix = -nxy; ix <= nxy; ++ix) row[ix + nxy] += field.log_likelihood_nearest({gp.x() + ix, gp.y() + iy});
-      }
+      // The offsets are whole cells: the cell of gp + (ix, iy) is gp's cell + (ix, iy).
+      const int cx = int(std::floor(gp.x())), cy = int(std::floor(gp.y()));
+      for (int iy = -nxy; iy <= nxy; ++iy) field.add_nearest_row(cx - nxy, cy + iy, side, &sums[std::size_t((iy + nxy) * side)]);
     }
     for (int iy = -nxy; iy <= nxy; ++iy) {
       for (int ix = -nxy; ix <= nxy; ++ix) {
@@ -183,8 +182,27 @@ ScanMatch match_scan(const LikelihoodField& field, const std::vector<Eigen::Vect
 ScanMatch match_scan_to_grid(const CowGrid& map, const RangeScan& scan, const core::Pose2& guess,
                              const ScanMatcherOptions& o, const std::optional<core::Pose2>& prior_mean) {
   const auto points = scan_end_points(scan, o.beam_stride);
-  const CellWindow window =
-      window_around(map.geometry(), guess.position(), scan.max_range + o.search_xy_m + o.field.max_distance_m);
+  // The field is needed only where an end point can land during the search: around the end points
+  // at the guess, by how far the search's turn and shift move the farthest one, and the field's
+  // reach beyond (nearer walls than max_distance_m are all inside). Smaller than the scan's range
+  // all round, which a room or a corridor seldom fills.
+  const auto& g = map.geometry();
+  double max_r = 0.0;
+  Eigen::Vector2d lo = g.world_to_grid(guess.position()), hi = lo;  // grid coordinates (cells)
+  for (const auto& p : points) {
+    max_r = std::max(max_r, p.norm());
+    const Eigen::Vector2d c = g.world_to_grid(guess.transform(p));
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
+  }
+  const double turn = std::min(o.search_theta_rad, M_PI);
+  const double margin = (max_r * 2.0 * std::sin(0.5 * turn) + o.search_xy_m + o.field.max_distance_m) / g.resolution() + 2.0;
+  const CellWindow reach = window_around(g, guess.position(), scan.max_range + o.search_xy_m + o.field.max_distance_m);
+  CellWindow window;
+  window.x0 = std::clamp(int(std::floor(lo.x() - margin)), reach.x0, reach.x1);
+  window.y0 = std::clamp(int(std::floor(lo.y() - margin)), reach.y0, reach.y1);
+  window.x1 = std::clamp(int(std::ceil(hi.x() + margin)) + 1, window.x0, reach.x1);
+  window.y1 = std::clamp(int(std::ceil(hi.y() + margin)) + 1, window.y0, reach.y1);
   const LikelihoodField field(
       map.geometry(), window, [&](int x, int y) { return map.occupied(x, y); }, o.field,
       [&](int x, int y) { return map.hit_mean(x, y); });

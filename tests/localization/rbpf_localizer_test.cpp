@@ -66,7 +66,8 @@ TEST(RbpfLocalizer, WithOneParticleAndNoNoiseEqualsTheScanMatcher) {
   c.options.process_noise_theta = 0.005;
   c.options.range_noise = 0.01;
   auto sm = make_localizer("scan-matching", c);
-  c.params = localizer_options("rbpf", {{"particles", "1"}, {"sample_motion", "false"}});
+  // Every scan matched, as the scan matcher does.
+  c.params = localizer_options("rbpf", {{"particles", "1"}, {"sample_motion", "false"}, {"linear_update", "0"}});
   auto pf = make_localizer("rbpf", c);
   mapping::OccupancyGrid own(room.geometry());
   core::Pose2 truth = c.initial_pose;
@@ -110,7 +111,7 @@ TEST(RbpfLocalizer, ParticleMapsShareMemoryCopyOnWrite) {
   c.initial_pose = {2.0, 2.0, 0.0};
   c.options.process_noise_xy = 0.01;
   c.options.process_noise_theta = 0.005;
-  c.params = localizer_options("rbpf", {{"particles", "30"}});
+  c.params = localizer_options("rbpf", {{"particles", "30"}, {"linear_update", "0"}});  // 12 scans, all processed
   c.seed = 9;
   RbpfLocalizer pf(c);
   core::Pose2 truth = c.initial_pose;
@@ -174,6 +175,58 @@ TEST(RbpfLocalizer, CorrectsBiasedOdometry) {
   }
   EXPECT_GT((odometry.position() - truth.position()).norm(), 0.12);
   EXPECT_LT((pf->pose().position() - truth.position()).norm(), 0.04);
+}
+
+// GMapping's linearUpdate: a scan is matched and mapped only once the odometry has moved
+// linear_update since the last one. In between, the reported pose is the last one moved by the
+// odometry, undrawn, and no particle's map changes.
+TEST(RbpfLocalizer, MatchesAndMapsAScanOnlyOnceTheRobotMovedEnough) {
+  const auto room = asymmetric_room();
+  core::Random rng(6);
+  LocalizerContext c;
+  c.initial_pose = {1.5, 1.5, 0.0};
+  c.options.process_noise_xy = 0.01;
+  c.options.process_noise_theta = 0.005;
+  c.options.range_noise = 0.01;
+  c.params = localizer_options("rbpf", {{"particles", "5"}, {"linear_update", "0.5"}, {"angular_update", "0.25"}});
+  c.seed = 8;
+  RbpfLocalizer pf(c);
+  mapping::OccupancyGrid own(room.geometry());
+  core::Pose2 truth = c.initial_pose;
+  int processed = 0;
+  for (int k = 0; k < 21; ++k) {
+    const core::Pose2 before = pf.pose();
+    const Odometry reported{0.14, 0.004, 1.0};
+    if (k > 0) {
+      truth = integrate_motion(truth, {0.15, 0.0, 1.0});
+      pf.predict(reported);
+    }
+    const auto map_before = pf.map_estimate();
+    const auto scan = scan_at(room, truth, 0.01, rng);
+    // 0.14 m a step: the fourth step since the last processed scan passes 0.5 m (turns stay small).
+    const bool due = k % 4 == 0;
+    if (!due) {
+      const core::Pose2 odometry = integrate_motion(before, reported);
+      EXPECT_NEAR(pf.pose().x, odometry.x, 1e-12) << "step " << k;
+      EXPECT_NEAR(pf.pose().y, odometry.y, 1e-12) << "step " << k;
+      EXPECT_NEAR(pf.pose().theta, odometry.theta, 1e-12) << "step " << k;
+    }
+    pf.update_scan(scan, own);
+    if (!due) {
+      ASSERT_TRUE(map_before);
+      EXPECT_EQ(pf.map_estimate()->log_odds_data(), map_before->log_odds_data()) << "step " << k;
+    } else {
+      ++processed;
+      if (map_before) EXPECT_NE(pf.map_estimate()->log_odds_data(), map_before->log_odds_data()) << "step " << k;
+    }
+    mapping::insert_scan(own, pf.pose(), scan);
+  }
+  double skipped = -1;
+  for (const auto& [name, value] : pf.counters())
+    if (name == "scans_skipped") skipped = value;
+  EXPECT_EQ(processed, 6);
+  EXPECT_EQ(skipped, 15);
+  EXPECT_LT((pf.pose().position() - truth.position()).norm(), 0.05);  // the processed scans corrected the drift
 }
 
 // Grid FastSLAM has no scan-matching proposal: one particle with no process noise is dead

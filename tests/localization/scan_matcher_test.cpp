@@ -3,6 +3,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <vector>
 
 #include "core/angle.h"
 #include "mapping/range_scan.h"
@@ -29,6 +30,32 @@ TEST(LikelihoodField, IsHighestOnWallsAndFallsWithDistance) {
   EXPECT_GT(on_wall, near);
   EXPECT_GT(near, far);
   EXPECT_FLOAT_EQ(far, field.far_log_likelihood());
+}
+
+// The correlative search reads the field a row at a time: the same values as cell by cell, the
+// window's outside (rows and columns on either side) counting as far from every wall. The table's
+// far cells are filled without computing their distance: they must hold what it would give.
+TEST(LikelihoodField, RowsReadTheSameCellsAsOneByOne) {
+  const auto room = asymmetric_room();
+  const auto& g = room.geometry();
+  const CellWindow window = window_around(g, {3.0, 2.0}, 1.5);
+  const auto field = LikelihoodField::of_grid(room, window);
+  int near_wall = 0, far = 0;
+  for (int y = window.y0 - 3; y < window.y1 + 3; ++y) {
+    std::vector<double> row(std::size_t(window.width() + 10), 1.0);
+    field.add_nearest_row(window.x0 - 5, y, int(row.size()), row.data());
+    for (int i = 0; i < int(row.size()); ++i) {
+      const Eigen::Vector2d centre(window.x0 - 5 + i + 0.5, y + 0.5);
+      const double nearest = field.log_likelihood_nearest(centre);
+      ASSERT_EQ(row[std::size_t(i)], 1.0 + nearest) << i << " " << y;
+      const bool inside = centre.x() > window.x0 && centre.x() < window.x1 && centre.y() > window.y0 && centre.y() < window.y1;
+      if (!inside) continue;
+      EXPECT_EQ(float(nearest), float(field.log_likelihood(centre))) << i << " " << y;
+      (nearest > field.far_log_likelihood() ? near_wall : far)++;
+    }
+  }
+  EXPECT_GT(near_wall, 100);  // both kinds of cells were compared
+  EXPECT_GT(far, 100);
 }
 
 // The matcher must find a known offset from the guess on a map built the way a robot builds its
