@@ -118,7 +118,8 @@ class PythonStrategyTest(unittest.TestCase):
     def test_a_localizers_parameters_are_listed_and_set_like_a_strategys(self):
         listed = {s["name"]: s for s in fleetmap.localizers()}
         self.assertEqual([(p["name"], p["default"]) for p in listed["rbpf"]["params"]],
-                         [("particles", "30"), ("sample_motion", "true")])
+                         [("particles", "30"), ("sample_motion", "true"), ("linear_update", "0.3"),
+                          ("angular_update", "0.1")])
         self.assertEqual(listed["ekf"]["params"], [])
         run = fleetmap.explore(map="empty", robots=1, steps=5, localization={"name": "rbpf", "particles": 2})
         self.assertEqual(run.steps, 5)
