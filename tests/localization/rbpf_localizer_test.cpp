@@ -146,18 +146,24 @@ TEST(RbpfLocalizer, ParticleMapsShareMemoryCopyOnWrite) {
   RecordProperty("shared_bytes", std::to_string(m.shared_bytes));
 }
 
-// On biased odometry (5% short, a small turn bias), the filter keeps its best particle near the
-// truth like the scan matcher does, while dead reckoning drifts.
-TEST(RbpfLocalizer, CorrectsBiasedOdometry) {
-  const auto room = asymmetric_room();
-  core::Random rng(4);
+// An rbpf in the asymmetric room at (1.5, 1.5), with small process and range noise.
+LocalizerContext room_context(const core::Settings& params, std::uint64_t seed) {
   LocalizerContext c;
   c.initial_pose = {1.5, 1.5, 0.0};
   c.options.process_noise_xy = 0.01;
   c.options.process_noise_theta = 0.005;
   c.options.range_noise = 0.01;
-  c.params = localizer_options("rbpf", {{"particles", "10"}});
-  c.seed = 3;
+  c.params = localizer_options("rbpf", params);
+  c.seed = seed;
+  return c;
+}
+
+// On biased odometry (5% short, a small turn bias), the filter keeps its best particle near the
+// truth like the scan matcher does, while dead reckoning drifts.
+TEST(RbpfLocalizer, CorrectsBiasedOdometry) {
+  const auto room = asymmetric_room();
+  core::Random rng(4);
+  const LocalizerContext c = room_context({{"particles", "10"}}, 3);
   auto pf = make_localizer("rbpf", c);
   mapping::OccupancyGrid own(room.geometry());
   core::Pose2 truth = c.initial_pose, odometry = c.initial_pose;
@@ -183,13 +189,7 @@ TEST(RbpfLocalizer, CorrectsBiasedOdometry) {
 TEST(RbpfLocalizer, MatchesAndMapsAScanOnlyOnceTheRobotMovedEnough) {
   const auto room = asymmetric_room();
   core::Random rng(6);
-  LocalizerContext c;
-  c.initial_pose = {1.5, 1.5, 0.0};
-  c.options.process_noise_xy = 0.01;
-  c.options.process_noise_theta = 0.005;
-  c.options.range_noise = 0.01;
-  c.params = localizer_options("rbpf", {{"particles", "5"}, {"linear_update", "0.5"}, {"angular_update", "0.25"}});
-  c.seed = 8;
+  const LocalizerContext c = room_context({{"particles", "5"}, {"linear_update", "0.5"}, {"angular_update", "0.25"}}, 8);
   RbpfLocalizer pf(c);
   mapping::OccupancyGrid own(room.geometry());
   core::Pose2 truth = c.initial_pose;
