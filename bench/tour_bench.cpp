@@ -50,7 +50,12 @@ const Snapshot& snapshot(const std::string& map, int robots, int steps) {
 void decide_benchmark(benchmark::State& state, const std::string& map, int robots, int steps, const std::string& strategy) {
   const Snapshot& shot = snapshot(map, robots, steps);
   std::vector<ExplorerRobot> team;
-  for (int i = 0; i < robots; ++i) team.push_back({&shot.maps[std::size_t(i)], shot.poses[std::size_t(i)]});
+  for (int i = 0; i < robots; ++i) {
+    ExplorerRobot r;
+    r.map = &shot.maps[std::size_t(i)];
+    r.pose = shot.poses[std::size_t(i)];
+    team.push_back(r);
+  }
   const std::vector<std::vector<char>> links(std::size_t(robots), std::vector<char>(std::size_t(robots), 1));
   // The options the simulator gives the default scenario's explorer (sensor range 4 m, radius 0.2 m):
   // the defaults, with goals up to the range less two planning cells.

@@ -217,7 +217,9 @@ TEST(RbpfLocalizer, MatchesAndMapsAScanOnlyOnceTheRobotMovedEnough) {
       EXPECT_EQ(pf.map_estimate()->log_odds_data(), map_before->log_odds_data()) << "step " << k;
     } else {
       ++processed;
-      if (map_before) EXPECT_NE(pf.map_estimate()->log_odds_data(), map_before->log_odds_data()) << "step " << k;
+      if (map_before) {
+        EXPECT_NE(pf.map_estimate()->log_odds_data(), map_before->log_odds_data()) << "step " << k;
+      }
     }
     mapping::insert_scan(own, pf.pose(), scan);
   }
