@@ -1,7 +1,8 @@
 // Merging's accept/refuse decision as a calibrated model: pairs of windows of real laser maps of
-// one split of buildings (bench/real_maps/README.md, "Merging's decision model"), fleetmap's
-// answer and the features its decision saw (merging::DecisionFeatures and the quality of the
-// answer), and the ORB peer on the same pairs. Prints markdown for bench/README.md: success at each
+// one or more splits of buildings, and of HouseExpo floor plans (bench/real_maps/README.md,
+// "Merging's decision model"), fleetmap's answer and the features of it (merging::DecisionFeatures
+// with the rival search run on every answer, MergeOptions::complete_features, and the quality of
+// the answer), and the ORB peer on the same pairs. Prints markdown for bench/README.md: success at each
 // overlap for fleetmap's decision, for a logistic model of P(answer right | features), and for the
 // peer; false merges on unrelated pairs; the model's reliability table (answers at probability p,
 // share right). With --fit the model is fitted on these pairs (the training split) and its
@@ -13,7 +14,8 @@
 // (merging::OverlapMeasure::Known), as bench/merging_real_bench.cpp cuts them. Unrelated pairs: a
 // window of one building's map and one of another building's in the same split. An answer is
 // right when b's known cells lie within 2 cells of where the truth puts them on average; for an
-// unrelated pair no answer is right. Times are the thread's CPU time per pair (alignment only).
+// unrelated pair no answer is right. Times are the thread's CPU time per pair (alignment only, the
+// complete rival search included; bench/merging_real_bench.cpp times what `fleetmap merge` runs).
 #include <fmt/format.h>
 #include <opencv2/core/utility.hpp>
 
@@ -60,7 +62,9 @@ std::string building(const std::string& map) {
 
 struct Args {
   fs::path maps = "/work/realmaps/maps";
-  std::string split = "training";
+  fs::path plans = "/work/shared/datasets/houseexpo";
+  std::vector<std::string> splits = {"training"};
+  int plan_window = 150;  // HouseExpo plans are 7-38 m across: 7.5 m windows at 0.05 m
   int pairs = 10;       // per map and overlap
   int unrelated = 100;  // pairs of windows of two buildings
   int window = 300;
@@ -72,9 +76,10 @@ struct Args {
 };
 
 [[noreturn]] void usage(const std::string& why) {
-  std::cerr << why << "\nusage: fleetmap_bench_merging_model [--maps DIR] [--split training|validation|test] [--pairs N]\n"
-                      "       [--unrelated N] [--window CELLS] [--overlaps 0.5,0.3,0.2] [--seed N] [--csv FILE]\n"
-                      "       [--fit | --model W0,W1,...]\n";
+  std::cerr << why << "\nusage: fleetmap_bench_merging_model [--maps DIR] [--plans DIR] [--split S[,S...]] [--pairs N]\n"
+                      "       [--unrelated N] [--window CELLS] [--plan-window CELLS] [--overlaps 0.5,0.3,0.2] [--seed N]\n"
+                      "       [--csv FILE] [--fit | --model W0,W1,...]\n"
+                      "  S: training, validation, test (real maps in --maps), plans-even, plans-odd (HouseExpo plans in --plans)\n";
   std::exit(2);
 }
 
@@ -118,9 +123,17 @@ Args parse(int argc, char** argv) {
     const std::string v = argv[++i];
     if (k == "--maps") a.maps = v;
     else if (k == "--split") {
-      if (!kSplits.count(v)) usage("--split: '" + v + "' is not training, validation or test");
-      a.split = v;
-    } else if (k == "--pairs") a.pairs = int(numbers(k, v).at(0));
+      a.splits.clear();
+      for (std::size_t start = 0; start <= v.size();) {
+        const std::size_t comma = std::min(v.find(',', start), v.size());
+        const std::string one = v.substr(start, comma - start);
+        if (!kSplits.count(one) && one != "plans-even" && one != "plans-odd")
+          usage("--split: '" + one + "' is not training, validation, test, plans-even or plans-odd");
+        a.splits.push_back(one);
+        start = comma + 1;
+      }
+    } else if (k == "--plans") a.plans = v;
+    else if (k == "--plan-window") a.plan_window = int(numbers(k, v).at(0)); else if (k == "--pairs") a.pairs = int(numbers(k, v).at(0));
     else if (k == "--unrelated") a.unrelated = int(numbers(k, v).at(0));
     else if (k == "--window") a.window = int(numbers(k, v).at(0));
     else if (k == "--overlaps") a.overlaps = numbers(k, v);
@@ -134,19 +147,21 @@ Args parse(int argc, char** argv) {
 
 // --- features -----------------------------------------------------------------------------------
 
-// What the model reads of an answer, each meaningful on any map (cells, shares, counts):
-// agreement of the walls both maps know, contradiction (walls in the other's open space), the
-// cells' agreement, the evidence, distinctiveness against the best rival (before the shape rules
-// zero it), and how well the fit pins the weakest direction (the covariance's largest standard
-// deviation at the overlap).
+// What the model reads of an answer, each meaningful on any map (cells, shares, counts): the
+// walls' agreement where both maps know the cells, the walls in the other map's open space, the
+// cells' agreement, distinctiveness against the best rival of the complete search, how well the fit
+// pins its weakest direction (the covariance's largest standard deviation at the overlap), how
+// tightly the walls fit, the matched structure beyond two straight walls (what tells a place from
+// any corner of any building), and the best turned rival's share of the evidence (a symmetric room).
 const std::vector<std::string> kFeatureNames = {
     "log((matched + 1) / (contradicted + 1))",
     "log(1 + open_space_walls)",
     "logit(acceptance)",
-    "log(1 + evidence)",
-    "distinctiveness",
+    "distinctiveness (complete rival search)",
     "log(largest std at the overlap, cells)",
     "log(residual rms, cells)",
+    "log(1 + matched structure off the two strongest lines)",
+    "turned rival's share of the evidence",
 };
 
 std::vector<double> features_of(const merging::MergeResult& r) {
@@ -158,10 +173,11 @@ std::vector<double> features_of(const merging::MergeResult& r) {
       std::log((q.matched + 1.0) / (q.contradicted + 1.0)),
       std::log1p(double(q.open_space_walls)),
       std::log((omega + 1e-3) / (1.0 - omega + 1e-3)),
-      std::log1p(r.evidence),
-      r.features.distinctiveness,
+      std::clamp(r.features.distinctiveness, 0.0, 1.0),
       std::log(largest_std + 0.01),
       std::log(q.residual_rms + 0.05),
+      std::log1p(double(q.beyond_corner + q.wall_ends + q.common_openings)),
+      std::clamp(r.features.turned, 0.0, 2.0),
   };
 }
 
@@ -226,6 +242,8 @@ struct Row {
   std::vector<double> x;
   double p = 0.0;
   double largest_std = 0.0;  // the covariance's largest standard deviation at the overlap, cells
+  int refusal = 0;           // merging::Refusal, as a number
+  double confidence = 0.0;
 };
 
 constexpr double kSuccessCells = 2.0;
@@ -236,11 +254,15 @@ Row run(const std::string& map, double overlap, const mapping::OccupancyGrid& a,
   row.map = map;
   row.overlap = overlap;
   const double c0 = bench::thread_seconds();
-  // As `fleetmap merge` aligns them: the features are what decide() saw (its probes run only on
-  // answers that could be merged, so others' distinctiveness is an upper bound).
-  const merging::MergeResult r = merging::align_across_resolutions(a, b, {});
+  // As `fleetmap merge` aligns them, with the rival search run on every answer (the features are
+  // then complete; the decision is decide()'s own).
+  merging::MergeOptions options;
+  options.complete_features = true;
+  const merging::MergeResult r = merging::align_across_resolutions(a, b, options);
   row.ms = 1e3 * (bench::thread_seconds() - c0);
   row.merged = r.merged;
+  row.refusal = int(r.refusal);
+  row.confidence = r.confidence;
   if (truth && r.candidates > 0) {
     row.error = merging::mean_displacement(r.transform, *truth, b);
     row.right = row.error < kSuccessCells;
@@ -272,54 +294,72 @@ std::string percent(int k, int n) { return n > 0 ? fmt::format("{:.0f}% ({}/{})"
 int main(int argc, char** argv) {
   const Args args = parse(argc, argv);
   cv::setNumThreads(1);
-  std::vector<std::pair<std::string, mapping::OccupancyGrid>> maps;
-  for (const auto& name : kSplits.at(args.split)) {
-    const fs::path yaml = args.maps / (name + ".yaml");
-    try {
-      maps.emplace_back(name, io::load_map(yaml));
-    } catch (const Error& e) {
-      std::cerr << yaml.string() << ": " << e.what() << "\n";
-      return 2;
-    }
-  }
   core::Random random(args.seed);
-  merging::CropPairOptions window;
-  window.width = window.height = args.window;
-  window.measure = merging::OverlapMeasure::Known;
-  window.min_known = 0.25;
-  window.max_tries = 60;
   std::vector<Row> rows;
-  for (const auto& [name, map] : maps) {
-    for (const double f : args.overlaps) {
-      window.overlap = f;
-      for (int k = 0; k < args.pairs; ++k) {
-        try {
-          const merging::CropPair c = merging::make_crop_pair(map, window, random);
-          rows.push_back(run(name, f, c.a, c.b, c.b_to_a));
-        } catch (const Error&) {
-          std::cerr << fmt::format("{}: no {} x {} windows at {:.0f}% overlap\n", name, args.window, args.window, 100 * f);
-          break;
-        }
+  std::size_t map_count = 0;
+  for (const std::string& split : args.splits) {
+    // HouseExpo's plans (ideal walls, many bare rooms: generic corners and rooms are common there)
+    // split by their sorted order, every other plan.
+    const bool plans = split.rfind("plans-", 0) == 0;
+    std::vector<fs::path> files;
+    if (plans) {
+      std::vector<fs::path> all;
+      for (const auto& e : fs::directory_iterator(args.plans))
+        if (e.path().extension() == ".yaml") all.push_back(e.path());
+      std::sort(all.begin(), all.end());
+      for (std::size_t i = split == "plans-even" ? 0 : 1; i < all.size(); i += 2) files.push_back(all[i]);
+    } else {
+      for (const auto& name : kSplits.at(split)) files.push_back(args.maps / (name + ".yaml"));
+    }
+    std::vector<std::pair<std::string, mapping::OccupancyGrid>> maps;
+    for (const auto& yaml : files) {
+      try {
+        maps.emplace_back(yaml.stem().string(), io::load_map(yaml));
+      } catch (const Error& e) {
+        std::cerr << yaml.string() << ": " << e.what() << "\n";
+        return 2;
       }
     }
-    std::cerr << name << ": " << rows.size() << " pairs so far\n";
-  }
-  merging::CropPairOptions one = window;
-  one.overlap = 0.9;
-  for (int k = 0; k < args.unrelated && maps.size() >= 2; ++k) {
-    const std::size_t i = std::size_t(random.uniform_int(0, int(maps.size()) - 1));
-    const std::size_t j = std::size_t(random.uniform_int(0, int(maps.size()) - 1));
-    if (building(maps[i].first) == building(maps[j].first)) {
-      --k;
-      continue;
+    map_count += maps.size();
+    merging::CropPairOptions window;
+    window.width = window.height = plans ? args.plan_window : args.window;
+    window.measure = merging::OverlapMeasure::Known;
+    window.min_known = 0.25;
+    window.max_tries = 60;
+    for (const auto& [name, map] : maps) {
+      for (const double f : args.overlaps) {
+        window.overlap = f;
+        for (int k = 0; k < args.pairs; ++k) {
+          try {
+            const merging::CropPair c = merging::make_crop_pair(map, window, random);
+            rows.push_back(run(name, f, c.a, c.b, c.b_to_a));
+          } catch (const Error&) {
+            std::cerr << fmt::format("{}: no {} x {} windows at {:.0f}% overlap\n", name, window.width, window.height, 100 * f);
+            break;
+          }
+        }
+      }
+      std::cerr << name << ": " << rows.size() << " pairs so far\n";
     }
-    try {
-      const merging::CropPair ci = merging::make_crop_pair(maps[i].second, one, random);
-      const merging::CropPair cj = merging::make_crop_pair(maps[j].second, one, random);
-      rows.push_back(run(maps[i].first + "/" + maps[j].first, 0.0, ci.a, cj.b, std::nullopt));
-    } catch (const Error&) {
+    merging::CropPairOptions one = window;
+    one.overlap = 0.9;
+    for (int k = 0, tries = 0; k < args.unrelated && maps.size() >= 2 && tries < 20 * args.unrelated; ++k, ++tries) {
+      const std::size_t i = std::size_t(random.uniform_int(0, int(maps.size()) - 1));
+      const std::size_t j = std::size_t(random.uniform_int(0, int(maps.size()) - 1));
+      if (building(maps[i].first) == building(maps[j].first)) {
+        --k;
+        continue;
+      }
+      try {
+        const merging::CropPair ci = merging::make_crop_pair(maps[i].second, one, random);
+        const merging::CropPair cj = merging::make_crop_pair(maps[j].second, one, random);
+        rows.push_back(run(maps[i].first + "/" + maps[j].first, 0.0, ci.a, cj.b, std::nullopt));
+      } catch (const Error&) {
+      }
     }
   }
+  std::string split_names;
+  for (const auto& sp : args.splits) split_names += (split_names.empty() ? "" : "+") + sp;
 
   std::vector<double> model = args.model;
   if (args.fit) {
@@ -327,11 +367,19 @@ int main(int argc, char** argv) {
     std::vector<int> y;
     for (const auto& r : rows) x.push_back(r.x), y.push_back(r.right ? 1 : 0);
     model = fit_logistic(x, y);
-    fmt::print("Fitted on {} pairs of the {} split (seed {}). Coefficients (--model):\n\n```\n", rows.size(), args.split,
+    fmt::print("Fitted on {} pairs of the {} split (seed {}). Coefficients (--model):\n\n```\n", rows.size(), split_names,
                args.seed);
     for (std::size_t i = 0; i < model.size(); ++i) fmt::print("{}{:.6g}", i ? "," : "", model[i]);
     fmt::print("\n```\n\n| feature | weight |\n|---|---|\n| intercept | {:.4g} |\n", model[0]);
     for (std::size_t i = 0; i < kFeatureNames.size(); ++i) fmt::print("| {} | {:.4g} |\n", kFeatureNames[i], model[i + 1]);
+    fmt::print("\nThe right answers' medians of the features:\n\n```\n");
+    for (std::size_t i = 0; i < kFeatureNames.size(); ++i) {
+      std::vector<double> v;
+      for (const auto& r : rows)
+        if (r.right) v.push_back(r.x[i]);
+      fmt::print("{}{:.6g}", i ? ", " : "", median(v));
+    }
+    fmt::print("\n```\n");
     fmt::print("\n");
   }
   if (!model.empty() && model.size() != kFeatureNames.size() + 1)
@@ -339,7 +387,7 @@ int main(int argc, char** argv) {
                       kFeatureNames.size() + 1));
   for (auto& r : rows) r.p = model.empty() ? 0.0 : probability(model, r.x);
 
-  fmt::print("Split `{}`: {} maps, {} x {} windows, {} pairs per map and overlap, seed {}{}.\n\n", args.split, maps.size(),
+  fmt::print("Split `{}`: {} maps, {} x {} windows, {} pairs per map and overlap, seed {}{}.\n\n", split_names, map_count,
              args.window, args.window, args.pairs, args.seed, args.fit ? " (the model's own training pairs)" : "");
   fmt::print("| overlap | pairs | fleetmap (decide) | model p >= 0.5 | ORB peer | answer right (merged or not) |\n|---|---|---|---|---|---|\n");
   for (const double f : args.overlaps) {
@@ -401,12 +449,13 @@ int main(int argc, char** argv) {
   }
   if (!args.csv.empty()) {
     std::ofstream out(args.csv);
-    out << "map,overlap,right,merged,error,ms,peer_merged,peer_right,peer_error,peer_ms,p";
+    out << "map,overlap,right,merged,error,ms,peer_merged,peer_right,peer_error,peer_ms,p,refusal,confidence";
     for (std::size_t i = 0; i < kFeatureNames.size(); ++i) out << ",f" << i;
     out << "\n";
     for (const auto& r : rows) {
       out << fmt::format("{},{},{},{},{:.4f},{:.1f},{},{},{:.4f},{:.1f},{:.4f}", r.map, r.overlap, int(r.right), int(r.merged),
-                         r.error, r.ms, int(r.peer_merged), int(r.peer_right), r.peer_error, r.peer_ms, r.p);
+                         r.error, r.ms, int(r.peer_merged), int(r.peer_right), r.peer_error, r.peer_ms, r.p)
+          << fmt::format(",{},{:.4f}", r.refusal, r.confidence);
       for (const double v : r.x) out << fmt::format(",{:.6g}", v);
       out << "\n";
     }

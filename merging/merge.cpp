@@ -575,8 +575,14 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
                       best_q.wall_ends == 0 && best_q.common_openings == 0;
   const double beyond = best_q.beyond_corner + best_q.wall_ends +
                         (best_q.junction_arms >= 3 && !lone_t ? co.full_beyond_corner : 0.0);
-  if (options.probe_symmetries && beyond > 0 &&
-      agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence) {
+  // The probes count for the decision only on answers that could be merged; with
+  // complete_features they run on every answer with evidence, for DecisionFeatures alone.
+  const bool counts = options.probe_symmetries && beyond > 0 &&
+                      agree_factor * acceptance_factor * support(result.evidence) >= options.min_confidence;
+  const double turned_unprobed = turned;
+  const double distinct_unprobed = result.distinctiveness;
+  const auto alternative_unprobed = result.alternative;
+  if (counts || (options.complete_features && options.probe_symmetries && result.evidence > 0.0)) {
     result.features.probed = true;
     std::tie(result.distinctiveness, result.alternative) =
         distinctiveness(b, other_placements(a, b, result.transform, options, others), best_q, result.transform);
@@ -600,6 +606,12 @@ MergeResult decide(const PreparedGrid& a, const PreparedGrid& b, const std::vect
     }
   }
   result.features.distinctiveness = result.distinctiveness;
+  result.features.turned = turned;
+  if (!counts) {
+    turned = turned_unprobed;
+    result.distinctiveness = distinct_unprobed;
+    result.alternative = alternative_unprobed;
+  }
   if (result.covariance) {
     // Where b's points land at the overlap centre: dt + dtheta perp(centre - t).
     const Eigen::Vector2d lever = best_q.overlap_centre - result.transform.translation();

@@ -193,6 +193,10 @@ struct MergeOptions {
   // translations) so that symmetric or repeated places lower the distinctiveness whatever method
   // proposed the answer.
   bool probe_symmetries = true;
+  // Run those probes on every answer with evidence, not only on answers that could be merged, so
+  // that MergeResult::features are complete for every answer (the decision model's benchmark). The
+  // decision is the same; a refused answer costs the probes' time.
+  bool complete_features = false;
   std::uint64_t seed = 1;        // RANSAC sampling
   OverlapSearchOptions overlap;
   FeatureMatchingOptions features;
@@ -222,11 +226,14 @@ enum class Refusal {
 // (bench/merging_model_bench.cpp).
 struct DecisionFeatures {
   double distinctiveness = 0.0;  // 1 - S2 / S1 against the best plausible rival the search and probes found
-  bool probed = false;           // the symmetry probes ran (the answer could be merged before them)
+  bool probed = false;           // the symmetry probes ran (the answer could be merged before them, or complete_features)
   // From MergeResult::covariance: the largest standard deviation of where b's points land at the
   // overlap centre (cells), and theta's (degrees).
   double largest_std_cells = 0.0;
   double theta_std_deg = 0.0;
+  // The largest share of the answer's evidence that a plausible placement turned a quarter turn or
+  // more from it reaches (a symmetric room fits itself turned).
+  double turned = 0.0;
 };
 
 struct MergeResult {

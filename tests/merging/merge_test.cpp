@@ -571,6 +571,25 @@ TEST(AlignMaps, WallsEndingWhereTheViewEndsDoNotLiftOneCorner) {
   EXPECT_EQ(r.refusal, Refusal::OneCorner);
 }
 
+// complete_features runs the rival search on an answer the decision refuses before it (one corner):
+// the features then hold what the search found, and the decision is the same.
+TEST(AlignMaps, CompleteFeaturesLeaveTheDecisionAsItIs) {
+  const auto a = load_houseexpo_map("bare_hall_step265_robot_1.png", 0.05);
+  const auto b = load_houseexpo_map("bare_hall_step265_robot_3.png", 0.05);
+  const MergeResult plain = align_maps(a, b);
+  MergeOptions options;
+  options.complete_features = true;
+  const MergeResult complete = align_maps(a, b, options);
+  ASSERT_GT(plain.evidence, 0.0);
+  EXPECT_FALSE(plain.features.probed);
+  EXPECT_TRUE(complete.features.probed);
+  EXPECT_EQ(complete.merged, plain.merged);
+  EXPECT_EQ(complete.confidence, plain.confidence);
+  EXPECT_EQ(complete.refusal, plain.refusal);
+  EXPECT_EQ(complete.reason, plain.reason);
+  EXPECT_LE(complete.features.distinctiveness, plain.features.distinctiveness);
+}
+
 // Two fifths in common, but the search's best answer is a rough fit of similar rooms elsewhere,
 // 120 cells off (walls 0.75 cells apart on average, against ~0.3 for the right one), and the
 // common walls fit turned a half turn as well. No wrong merge: refused, or right. (Judging the
