@@ -111,7 +111,8 @@ class GraphSlam {
   // Matches above the loop search's min_score refused for a rival elsewhere in the window.
   std::size_t rejected_loop_closures() const;
   std::size_t optimizations() const;
-  // Scans whose odometry was an outlier, found by a wider search.
+  // Scans whose odometry was an outlier: placed by a wider search around the steady motion, whose
+  // match the scan preferred to the odometry's.
   std::size_t relocalized() const;
   const std::vector<GraphConstraint>& constraints() const;
   // change_frame: x_new = new_from_old * x_old for every pose held.

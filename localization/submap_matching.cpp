@@ -499,6 +499,7 @@ core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const
                                int(points.size())),
                            nullptr, pose);
   Eigen::Matrix2d translation_weights = o.translation_weight * Eigen::Matrix2d::Identity();
+  Eigen::Vector2d anchor = target.position();
   if (o.fixed_translation_weight >= 0.0) {
     // The curvature is the whole scan's: points evenly spread through it estimate it for less.
     constexpr std::size_t kCurvaturePoints = 100;
@@ -508,17 +509,22 @@ core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(score_curvature(grid, spread, initial, 0.5 * grid.resolution()));
     const double largest = eigen.eigenvalues()[1];
     Eigen::Vector2d w = Eigen::Vector2d::Constant(o.translation_weight);
+    Eigen::Vector2d fixed = Eigen::Vector2d::Zero();
     if (largest > 0.0) {
       // A residual's weight is the square root of its information, and the curvature is one.
       for (int i = 0; i < 2; ++i) {
-        const double fixed = std::sqrt(std::max(0.0, eigen.eigenvalues()[i]) / largest);
-        w[i] = fixed * o.fixed_translation_weight + (1.0 - fixed) * o.translation_weight;
+        fixed[i] = std::sqrt(std::max(0.0, eigen.eigenvalues()[i]) / largest);
+        w[i] = fixed[i] * o.fixed_translation_weight + (1.0 - fixed[i]) * o.translation_weight;
       }
     }
     translation_weights = eigen.eigenvectors() * w.asDiagonal() * eigen.eigenvectors().transpose();
+    // The pull's anchor moves from target's translation to initial's by the same share: initial is
+    // a search's answer that already weighed the prediction, and pulling it back toward the
+    // prediction where the scan fixes the pose counts the prediction twice.
+    anchor += eigen.eigenvectors() * fixed.asDiagonal() * eigen.eigenvectors().transpose() * (initial.position() - target.position());
   }
   problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PriorCost, 3, 3>(
-                               new PriorCost(core::Pose2(target.x, target.y, initial.theta), translation_weights, o.rotation_weight)),
+                               new PriorCost(core::Pose2(anchor.x(), anchor.y(), initial.theta), translation_weights, o.rotation_weight)),
                            nullptr, pose);
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;

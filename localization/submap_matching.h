@@ -102,8 +102,10 @@ struct RefineOptions {
   // When >= 0, the translation's pull is this in the direction the points fix best and
   // translation_weight in a direction they leave free, blended along each eigenvector of the
   // score's curvature at `initial` (score_curvature) by the square root of its eigenvalue over the
-  // largest: the scan decides where it can, the prediction holds a corridor's length. Below 0:
-  // translation_weight everywhere.
+  // largest: the scan decides where it can, the prediction holds a corridor's length. The pull's
+  // anchor is blended alike, `initial`'s translation where the points fix the pose, `target`'s
+  // where they leave it free (refine_match). Below 0: translation_weight everywhere, toward
+  // `target`.
   double fixed_translation_weight = -1.0;
 };
 
@@ -118,7 +120,9 @@ Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points
 // Least-squares refinement (Ceres, bicubic interpolation of the grid) from `initial`, its
 // translation pulled toward `target`'s and its rotation toward `initial`'s (as Cartographer: the
 // odometry's prediction anchors the translation, so that a corridor whose walls do not fix the
-// position along it keeps the odometry's).
+// position along it keeps the odometry's). With fixed_translation_weight >= 0 the translation is
+// pulled toward `initial`'s in the directions the points fix: `initial` is then a search's answer
+// that already weighed the prediction.
 core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& initial,
                          const core::Pose2& target, const RefineOptions& options = {});
 

@@ -91,13 +91,13 @@ TEST(BranchAndBound, ExcludedPosesAreNeverTheAnswer) {
 }
 
 // A corridor 2 m wide along x, 20 m long (its walls through the middle of a row of cells), seen from
-// its middle with its ends out of sight.
-SubmapGrid corridor() {
+// its middle with its ends out of sight, each stretch by `scans` scans.
+SubmapGrid corridor(int scans = 5) {
   SubmapGrid grid;
   for (double x0 = -8.0; x0 <= 8.0; x0 += 1.0) {
     PointCloud walls;
     for (double t = -3.0; t <= 3.0 + 1e-9; t += 0.05) walls.push_back({x0 + t, 1.025}), walls.push_back({x0 + t, -1.025});
-    for (int k = 0; k < 5; ++k) grid.insert({x0, 0.0}, walls);
+    for (int k = 0; k < scans; ++k) grid.insert({x0, 0.0}, walls);
   }
   return grid;
 }
@@ -123,6 +123,25 @@ TEST(RefineMatch, TheScanFixesTheCorridorsWidthAndThePredictionItsLength) {
   const core::Pose2 refined = refine_match(grid, corridor_scan(), prediction, prediction, o);
   EXPECT_NEAR(refined.y, 0.0, 0.015) << refined;  // the walls decide across (a third of a cell)
   EXPECT_NEAR(refined.x, 0.3, 0.02) << refined;   // nothing along: the prediction holds
+}
+
+TEST(RefineMatch, TheSearchsAnswerHoldsAlongADeadEndCorridor) {
+  // A corridor 2 m wide closed 2 m ahead, seen once (walls 0.55 against 0.49 for free cells): its
+  // end wall fixes the position along it, less surely than the side walls across.
+  PointCloud scan;
+  for (double t = -3.0; t <= 2.0 + 1e-9; t += 0.05) scan.push_back({t, 1.025}), scan.push_back({t, -1.025});
+  for (double t = -1.0; t <= 1.0 + 1e-9; t += 0.05) scan.push_back({2.025, t});
+  SubmapGrid grid;
+  grid.insert({0.0, 0.0}, scan);
+  // The search found the truth (the origin); the prediction is 10 cm short of the end wall.
+  const core::Pose2 found(0.0, 0.0, 0.0), prediction(-0.1, 0.0, 0.0);
+  RefineOptions o;
+  o.fixed_translation_weight = 1.0;
+  const core::Pose2 refined = refine_match(grid, scan, found, prediction, o);
+  // The end wall moves the answer off the prediction by more than half a cell (the pull toward the
+  // prediction alone leaves it within a few millimetres of it), the side walls hold it across.
+  EXPECT_GT(refined.x, prediction.x + 0.5 * grid.resolution()) << refined;
+  EXPECT_NEAR(refined.y, 0.0, 0.25 * grid.resolution()) << refined;
 }
 
 // Every pose of the window around `center` (the search's angles and offsets), scored as the search
