@@ -26,6 +26,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -242,6 +243,7 @@ struct Row {
   std::vector<double> x;
   double p = 0.0;
   double largest_std = 0.0;  // the covariance's largest standard deviation at the overlap, cells
+  double mahalanobis2 = -1.0;  // the transform's error (tx, ty, theta) squared in the covariance's metric
   int refusal = 0;           // merging::Refusal, as a number
   double confidence = 0.0;
 };
@@ -266,6 +268,12 @@ Row run(const std::string& map, double overlap, const mapping::OccupancyGrid& a,
   if (truth && r.candidates > 0) {
     row.error = merging::mean_displacement(r.transform, *truth, b);
     row.right = row.error < kSuccessCells;
+    if (r.covariance) {
+      Eigen::Vector3d e(r.transform.translation().x() - truth->translation().x(),
+                        r.transform.translation().y() - truth->translation().y(),
+                        std::remainder(r.transform.rotation() - truth->rotation(), 2.0 * std::numbers::pi));
+      row.mahalanobis2 = e.dot(r.covariance->ldlt().solve(e));
+    }
   }
   row.x = features_of(r);
   row.largest_std = r.features.largest_std_cells;
@@ -436,6 +444,15 @@ int main(int argc, char** argv) {
   if (!ratio.empty())
     fmt::print("Right merges' error / the covariance's largest std at the overlap: median {:.2f}, 90th percentile {:.2f}.\n",
                median(ratio), ratio[std::size_t(0.9 * double(ratio.size() - 1))]);
+  // An honest covariance makes the squared Mahalanobis distance of the error chi-square with 3
+  // degrees of freedom: median 2.366, 95% below 7.815.
+  std::vector<double> d2;
+  for (const auto& r : rows)
+    if (r.merged && r.right && r.mahalanobis2 >= 0.0) d2.push_back(r.mahalanobis2);
+  if (!d2.empty())
+    fmt::print("Right merges' error in the covariance's metric (squared Mahalanobis distance, chi-square 3 if honest: "
+               "median 2.37, 95% under 7.81): median {:.2f}, {:.0f}% under 7.81.\n",
+               median(d2), 100.0 * double(std::count_if(d2.begin(), d2.end(), [](double v) { return v < 7.815; })) / double(d2.size()));
   fmt::print("\n");
   if (!model.empty()) {
     fmt::print("Reliability of the model (all pairs: answers at probability p, share right):\n\n| p | answers | right |\n|---|---|---|\n");

@@ -47,11 +47,11 @@ LevelFit refine_alignment(const PreparedGrid& a, const PreparedGrid& b, const co
 // within inlier_distance, Huber-weighted), Sigma = s^2 H^-1 with H = sum w J^T J and
 // s^2 = sum w d^2 / (n - 3) the residuals' own noise, at least 1/12 cell^2 (a grid places a wall
 // only to within a cell: uniform, variance 1/12). Every matched wall gives one residual from each
-// map, so H counts each wall twice: Sigma is doubled. Residuals are taken as independent, which
-// walls drawn several cells thick are not: the covariance is a lower bound, and its shape (which
-// direction the walls leave free) is what it tells best: a long straight wall alone constrains
-// nothing along itself, and the variance along it is then large. nullopt with fewer than 4
-// residuals. Directions the walls do not constrain at all get a variance of 1e12 (cells^2 or rad^2).
+// map, so H counts each wall twice: Sigma is doubled. Residuals are taken as independent; on real
+// laser maps the errors of right merges fall within Sigma as a Gaussian's should, on ideal
+// rasterised plans it is too small (bench/README.md, "Merging's decision model"). A long straight
+// wall alone constrains nothing along itself, and the variance along it is then large. nullopt
+// with fewer than 4 residuals. Directions the walls do not constrain at all get a variance of 1e12 (cells^2 or rad^2).
 std::optional<Eigen::Matrix3d> fit_covariance(const PreparedGrid& a, const PreparedGrid& b, const core::Transform2& b_to_a,
                                               const RefineOptions& options = {});
 
