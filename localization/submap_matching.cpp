@@ -183,8 +183,12 @@ double score_advantage(const SubmapGrid& grid, const PointCloud& points, const c
   return mean / error;
 }
 
-MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
-                              const CorrelativeOptions& o) {
+namespace {
+
+// correlative_match over a cell reader `value(x, y)` whose values never exceed `top`.
+template <typename Value>
+MatchResult correlative_search(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
+                               const CorrelativeOptions& o, const Value& value, double top) {
   MatchResult best{prior, -1.0};
   if (points.empty()) return {prior, 0.0};
   const double r = grid.resolution();
@@ -192,10 +196,8 @@ MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, 
   const double step = angular_search_step(points, r);
   const std::size_t np = points.size();
   const double n = double(np);
-  // A cell reads at most this (the probabilities are clamped, then stored as floats).
-  const double top = double(float(grid.options().max_probability));
   auto sum_at = [&](const std::vector<Eigen::Vector2i>& cells, int dx, int dy, std::size_t from, std::size_t to, double sum) {
-    for (std::size_t i = from; i < to; ++i) sum += grid.probability(cells[i].x() + dx, cells[i].y() + dy);
+    for (std::size_t i = from; i < to; ++i) sum += value(cells[i].x() + dx, cells[i].y() + dy);
     return sum;
   };
   // The prior pose's own score (penalty 0): a candidate that cannot reach it is never the answer,
@@ -230,6 +232,18 @@ MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, 
   }
   best.pose.theta = core::normalize_angle(best.pose.theta);
   return best;
+}
+
+}  // namespace
+
+MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
+                              const CorrelativeOptions& o) {
+  if (o.hit_field) {
+    return correlative_search(grid, points, prior, o, [&](int x, int y) { return grid.hit_field(x, y); }, 1.0);
+  }
+  // A cell reads at most this (the probabilities are clamped, then stored as floats).
+  const double top = double(float(grid.options().max_probability));
+  return correlative_search(grid, points, prior, o, [&](int x, int y) { return grid.probability(x, y); }, top);
 }
 
 PrecomputedGrids::PrecomputedGrids(const SubmapGrid& grid, int depth) : resolution_(grid.resolution()) {

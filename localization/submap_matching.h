@@ -36,10 +36,13 @@ struct CorrelativeOptions {
   // for its distance d (m) and turn a (rad) from the prior, so that ties go to the prior.
   double translation_weight = 0.1;
   double rotation_weight = 0.1;
+  // Score by the grid's hit field (SubmapGrid::hit_field, the mean over the points) instead of
+  // its probabilities; the grid must keep one.
+  bool hit_field = false;
 };
 
 // Real-time correlative scan matching (Olson 2009): every pose of the window around `prior` at
-// the grid's resolution and the angular step.
+// the grid's resolution and the angular step. The result's score is the one the options chose.
 MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
                               const CorrelativeOptions& options = {});
 
