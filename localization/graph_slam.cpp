@@ -161,7 +161,7 @@ struct GraphSlam::State {
 GraphSlam::GraphSlam(const GraphSlamOptions& options, const core::Pose2& initial_pose) : s_(std::make_unique<State>()) {
   s_->o = options;
   s_->initial = initial_pose;
-  if (options.local_search.hit_field && s_->o.grid.hit_field_sigma_m <= 0.0) {
+  if ((options.local_search.hit_field || options.local_refine.hit_field) && s_->o.grid.hit_field_sigma_m <= 0.0) {
     const double r = options.grid.resolution_m;
     s_->o.grid.hit_field_sigma_m = std::sqrt(options.range_noise_m * options.range_noise_m + 2.0 * r * r / 12.0);
   }

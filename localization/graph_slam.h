@@ -37,7 +37,8 @@ struct GraphSlamOptions {
   // The local correlative search scores a scan by the submap's surface field (SubmapGrid), whose
   // sigma is the spread of a return's distance to the centre of the cell that holds its wall:
   // the laser's range noise and two cells' quantization (the point's and the wall's, a cell width
-  // over sqrt(12) each). Loop closures and the refinement read the probabilities.
+  // over sqrt(12) each). The local refinement fits the same field (local_refine.hit_field); loop
+  // closures, the relocalizing search and the comparisons of two matches read the probabilities.
   CorrelativeOptions local_search = [] {
     CorrelativeOptions c;
     c.hit_field = true;
@@ -64,6 +65,7 @@ struct GraphSlamOptions {
   RefineOptions local_refine = [] {
     RefineOptions r;
     r.fixed_translation_weight = 1.0;
+    r.hit_field = true;
     return r;
   }();
   // Loop closures: searched for a fraction of the (node, finished submap) pairs closer than

@@ -110,6 +110,9 @@ struct RefineOptions {
   // where they leave it free (refine_match). Below 0: translation_weight everywhere, toward
   // `target`.
   double fixed_translation_weight = -1.0;
+  // Fit the grid's surface field (SubmapGrid::hit_field) instead of its probabilities, the
+  // curvature too; the grid must keep one.
+  bool hit_field = false;
 };
 
 // How well a placement fixes the scan's position in each direction: the curvature of the mean
@@ -118,7 +121,9 @@ struct RefineOptions {
 // scan moves by +-`step_m` (best below a cell) along eight directions u (per m^2; eigenvalues
 // clamped at 0). Olson 2009 (sec. IV-D) reads a match's covariance off the same score surface: along a
 // corridor whose ends are out of range the score hardly drops, across it it drops fast.
-Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m);
+// hit_field: of the grid's surface field instead.
+Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m,
+                                bool hit_field = false);
 
 // Least-squares refinement (Ceres, bicubic interpolation of the grid) from `initial`, its
 // translation pulled toward `target`'s and its rotation toward `initial`'s (as Cartographer: the

