@@ -161,6 +161,10 @@ struct GraphSlam::State {
 GraphSlam::GraphSlam(const GraphSlamOptions& options, const core::Pose2& initial_pose) : s_(std::make_unique<State>()) {
   s_->o = options;
   s_->initial = initial_pose;
+  if ((options.local_search.hit_field || options.local_refine.hit_field) && s_->o.grid.hit_field_sigma_m <= 0.0) {
+    const double r = options.grid.resolution_m;
+    s_->o.grid.hit_field_sigma_m = std::sqrt(options.range_noise_m * options.range_noise_m + 2.0 * r * r / 12.0);
+  }
 }
 GraphSlam::~GraphSlam() = default;
 GraphSlam::GraphSlam(GraphSlam&&) noexcept = default;
@@ -171,10 +175,25 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
   const GraphSlamOptions& o = s.o;
   PointCloud points;
   points.reserve(scan.ranges.size());
+  // joined[i]: points i - 1 and i are one surface (surface_min_incidence_rad).
+  std::vector<bool> joined;
+  joined.reserve(scan.ranges.size());
+  std::optional<std::size_t> last_beam;
   for (std::size_t b = 0; b < scan.ranges.size(); ++b) {
     const auto& r = scan.ranges[b];
     if (!r || *r < o.min_range_m || *r > o.max_range_m || !std::isfinite(*r)) continue;
     points.emplace_back(*r * std::cos(scan.angles[b]), *r * std::sin(scan.angles[b]));
+    bool join = false;
+    if (last_beam) {
+      const double dphi = std::abs(core::normalize_angle(scan.angles[b] - scan.angles[*last_beam]));
+      if (dphi < o.surface_min_incidence_rad) {
+        const double previous = *scan.ranges[*last_beam];
+        const double gap = previous * std::sin(dphi) / std::sin(o.surface_min_incidence_rad - dphi) + 3.0 * o.range_noise_m;
+        join = (points.back() - points[points.size() - 2]).norm() <= gap;
+      }
+    }
+    joined.push_back(join);
+    last_beam = b;
   }
   const PointCloud match_points = voxel_filter(points, o.match_voxel_m);
   PointCloud loop_points = voxel_filter(points, o.loop_voxel_m);
@@ -292,6 +311,7 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
       in_grid.reserve(hits.size());
       for (const auto& h : hits) in_grid.push_back(to_grid.transform(h));
       m.grid.insert(to_grid.transform(local.position()), in_grid);
+      for (std::size_t i = 0; i < in_grid.size(); ++i) m.grid.add_surface(joined[i] ? in_grid[i - 1] : in_grid[i], in_grid[i]);
       ++m.inserted;
       if (std::find(linked.begin(), linked.end(), a) == linked.end()) linked.push_back(a);
     }

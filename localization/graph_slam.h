@@ -34,7 +34,22 @@ struct GraphSlamOptions {
   // (matched, it becomes a node either way): a robot standing still does not swamp the grid.
   double insert_min_distance_m = 0.2;
   double insert_min_angle_rad = 0.0175;
-  CorrelativeOptions local_search;
+  // The local correlative search scores a scan by the submap's surface field (SubmapGrid), whose
+  // sigma is the spread of a return's distance to the centre of the cell that holds its wall:
+  // the laser's range noise and two cells' quantization (the point's and the wall's, a cell width
+  // over sqrt(12) each). The local refinement fits the same field (local_refine.hit_field); loop
+  // closures, the relocalizing search and the comparisons of two matches read the probabilities.
+  CorrelativeOptions local_search = [] {
+    CorrelativeOptions c;
+    c.hit_field = true;
+    return c;
+  }();
+  double range_noise_m = 0.02;
+  // Consecutive returns are one surface, joined in the field, when they lie closer than a surface
+  // seen at this incidence (from the beam's direction) would space them, plus 3 range noises
+  // (Borges & Aldon 2004's adaptive breakpoint): a wall's far returns are a line, not dots that a
+  // scan taken from the previous pose would align with.
+  double surface_min_incidence_rad = 0.1745;  // 10 degrees
   // What the robot can do between two scans (m/s^2, rad/s^2): odometry that departs from the last
   // step's velocity by more (beyond the search window) is an outlier.
   double max_acceleration = 2.0;
@@ -50,6 +65,7 @@ struct GraphSlamOptions {
   RefineOptions local_refine = [] {
     RefineOptions r;
     r.fixed_translation_weight = 1.0;
+    r.hit_field = true;
     return r;
   }();
   // Loop closures: searched for a fraction of the (node, finished submap) pairs closer than

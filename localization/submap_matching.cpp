@@ -44,18 +44,21 @@ std::vector<double> window_angles(double window, double step) {
 class GridAdapter {
  public:
   enum { DATA_DIMENSION = 1 };
-  explicit GridAdapter(const SubmapGrid& grid) : grid_(grid) {}
+  // hit_field: the grid's surface field instead of its probabilities.
+  GridAdapter(const SubmapGrid& grid, bool hit_field) : grid_(grid), hit_field_(hit_field) {}
   void GetValue(int row, int column, double* value) const {
-    *value = grid_.probability(column + grid_.min_x(), row + grid_.min_y());
+    const int x = column + grid_.min_x(), y = row + grid_.min_y();
+    *value = hit_field_ ? grid_.hit_field(x, y) : grid_.probability(x, y);
   }
 
  private:
   const SubmapGrid& grid_;
+  bool hit_field_;
 };
 
 struct OccupiedSpaceCost {
-  OccupiedSpaceCost(const SubmapGrid& grid, const PointCloud& points, double weight)
-      : grid_(grid), adapter_(grid), interpolator_(adapter_), points_(points), weight_(weight) {}
+  OccupiedSpaceCost(const SubmapGrid& grid, const PointCloud& points, double weight, bool hit_field)
+      : grid_(grid), adapter_(grid, hit_field), interpolator_(adapter_), points_(points), weight_(weight) {}
 
   template <typename T>
   bool operator()(const T* pose, T* residual) const {
@@ -130,9 +133,10 @@ double match_score(const SubmapGrid& grid, const PointCloud& points, const core:
   return sum / double(points.size());
 }
 
-Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m) {
+Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m,
+                                bool hit_field) {
   // The score read through the refinement's bicubic interpolation: smooth at shifts below a cell.
-  const GridAdapter adapter(grid);
+  const GridAdapter adapter(grid, hit_field);
   const ceres::BiCubicInterpolator<GridAdapter> interpolator(adapter);
   const double r = grid.resolution();
   const auto score = [&](const core::Pose2& p) {
@@ -183,8 +187,12 @@ double score_advantage(const SubmapGrid& grid, const PointCloud& points, const c
   return mean / error;
 }
 
-MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
-                              const CorrelativeOptions& o) {
+namespace {
+
+// correlative_match over a cell reader `value(x, y)` whose values never exceed `top`.
+template <typename Value>
+MatchResult correlative_search(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
+                               const CorrelativeOptions& o, const Value& value, double top) {
   MatchResult best{prior, -1.0};
   if (points.empty()) return {prior, 0.0};
   const double r = grid.resolution();
@@ -192,10 +200,8 @@ MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, 
   const double step = angular_search_step(points, r);
   const std::size_t np = points.size();
   const double n = double(np);
-  // A cell reads at most this (the probabilities are clamped, then stored as floats).
-  const double top = double(float(grid.options().max_probability));
   auto sum_at = [&](const std::vector<Eigen::Vector2i>& cells, int dx, int dy, std::size_t from, std::size_t to, double sum) {
-    for (std::size_t i = from; i < to; ++i) sum += grid.probability(cells[i].x() + dx, cells[i].y() + dy);
+    for (std::size_t i = from; i < to; ++i) sum += value(cells[i].x() + dx, cells[i].y() + dy);
     return sum;
   };
   // The prior pose's own score (penalty 0): a candidate that cannot reach it is never the answer,
@@ -230,6 +236,18 @@ MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, 
   }
   best.pose.theta = core::normalize_angle(best.pose.theta);
   return best;
+}
+
+}  // namespace
+
+MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
+                              const CorrelativeOptions& o) {
+  if (o.hit_field) {
+    return correlative_search(grid, points, prior, o, [&](int x, int y) { return grid.hit_field(x, y); }, 1.0);
+  }
+  // A cell reads at most this (the probabilities are clamped, then stored as floats).
+  const double top = double(float(grid.options().max_probability));
+  return correlative_search(grid, points, prior, o, [&](int x, int y) { return grid.probability(x, y); }, top);
 }
 
 PrecomputedGrids::PrecomputedGrids(const SubmapGrid& grid, int depth) : resolution_(grid.resolution()) {
@@ -495,7 +513,7 @@ core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const
   problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   problem.AddResidualBlock(new ceres::AutoDiffCostFunction<OccupiedSpaceCost, ceres::DYNAMIC, 3>(
-                               new OccupiedSpaceCost(grid, points, o.occupied_weight / std::sqrt(double(points.size()))),
+                               new OccupiedSpaceCost(grid, points, o.occupied_weight / std::sqrt(double(points.size())), o.hit_field),
                                int(points.size())),
                            nullptr, pose);
   Eigen::Matrix2d translation_weights = o.translation_weight * Eigen::Matrix2d::Identity();
@@ -506,7 +524,7 @@ core::Pose2 refine_match(const SubmapGrid& grid, const PointCloud& points, const
     PointCloud spread;
     const std::size_t stride = std::max<std::size_t>(1, points.size() / kCurvaturePoints);
     for (std::size_t i = 0; i < points.size(); i += stride) spread.push_back(points[i]);
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(score_curvature(grid, spread, initial, 0.5 * grid.resolution()));
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(score_curvature(grid, spread, initial, 0.5 * grid.resolution(), o.hit_field));
     const double largest = eigen.eigenvalues()[1];
     Eigen::Vector2d w = Eigen::Vector2d::Constant(o.translation_weight);
     Eigen::Vector2d fixed = Eigen::Vector2d::Zero();

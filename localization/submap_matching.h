@@ -36,10 +36,13 @@ struct CorrelativeOptions {
   // for its distance d (m) and turn a (rad) from the prior, so that ties go to the prior.
   double translation_weight = 0.1;
   double rotation_weight = 0.1;
+  // Score by the grid's hit field (SubmapGrid::hit_field, the mean over the points) instead of
+  // its probabilities; the grid must keep one.
+  bool hit_field = false;
 };
 
 // Real-time correlative scan matching (Olson 2009): every pose of the window around `prior` at
-// the grid's resolution and the angular step.
+// the grid's resolution and the angular step. The result's score is the one the options chose.
 MatchResult correlative_match(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& prior,
                               const CorrelativeOptions& options = {});
 
@@ -107,6 +110,9 @@ struct RefineOptions {
   // where they leave it free (refine_match). Below 0: translation_weight everywhere, toward
   // `target`.
   double fixed_translation_weight = -1.0;
+  // Fit the grid's surface field (SubmapGrid::hit_field) instead of its probabilities, the
+  // curvature too; the grid must keep one.
+  bool hit_field = false;
 };
 
 // How well a placement fixes the scan's position in each direction: the curvature of the mean
@@ -115,7 +121,9 @@ struct RefineOptions {
 // scan moves by +-`step_m` (best below a cell) along eight directions u (per m^2; eigenvalues
 // clamped at 0). Olson 2009 (sec. IV-D) reads a match's covariance off the same score surface: along a
 // corridor whose ends are out of range the score hardly drops, across it it drops fast.
-Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m);
+// hit_field: of the grid's surface field instead.
+Eigen::Matrix2d score_curvature(const SubmapGrid& grid, const PointCloud& points, const core::Pose2& pose, double step_m,
+                                bool hit_field = false);
 
 // Least-squares refinement (Ceres, bicubic interpolation of the grid) from `initial`, its
 // translation pulled toward `target`'s and its rotation toward `initial`'s (as Cartographer: the

@@ -117,12 +117,35 @@ TEST(ScoreCurvature, ACorridorsMatchIsFixedAcrossItAndFreeAlongIt) {
 TEST(RefineMatch, TheScanFixesTheCorridorsWidthAndThePredictionItsLength) {
   const SubmapGrid grid = corridor();
   // The prediction is 0.3 m along and 4 cm across from the truth (the origin).
-  const core::Pose2 prediction(0.3, 0.04, 0.0);
+  const core::Pose2 prediction(0.3, 0.02, 0.0);
   RefineOptions o;
   o.fixed_translation_weight = 1.0;
   const core::Pose2 refined = refine_match(grid, corridor_scan(), prediction, prediction, o);
   EXPECT_NEAR(refined.y, 0.0, 0.015) << refined;  // the walls decide across (a third of a cell)
   EXPECT_NEAR(refined.x, 0.3, 0.02) << refined;   // nothing along: the prediction holds
+}
+
+// As above on a corridor seen once, fitting its surface field: the walls decide across, the
+// prediction along. The field (sigma 2.9 cm) is narrower than the probabilities' blur, so the fit
+// starts within half a cell across, where the correlative search leaves it (from 4 cm off it
+// reaches 1.6 cm).
+TEST(RefineMatch, TheSurfaceFieldFixesTheCorridorsWidthAndThePredictionItsLength) {
+  SubmapGridOptions go;
+  go.hit_field_sigma_m = 0.0286;
+  SubmapGrid grid(go);
+  for (double x0 = -8.0; x0 <= 8.0; x0 += 1.0) {
+    PointCloud walls;
+    for (double t = -3.0; t <= 3.0 + 1e-9; t += 0.05) walls.push_back({x0 + t, 1.025}), walls.push_back({x0 + t, -1.025});
+    grid.insert({x0, 0.0}, walls);
+    for (std::size_t i = 2; i < walls.size(); ++i) grid.add_surface(walls[i - 2], walls[i]);
+  }
+  const core::Pose2 prediction(0.3, 0.02, 0.0);
+  RefineOptions o;
+  o.fixed_translation_weight = 1.0;
+  o.hit_field = true;
+  const core::Pose2 refined = refine_match(grid, corridor_scan(), prediction, prediction, o);
+  EXPECT_NEAR(refined.y, 0.0, 0.015) << refined;
+  EXPECT_NEAR(refined.x, 0.3, 0.02) << refined;
 }
 
 TEST(RefineMatch, TheSearchsAnswerHoldsAlongADeadEndCorridor) {
@@ -222,6 +245,59 @@ TEST(SubmapGrid, AGridThatReleasedItsInsertionStateTakesScansAsBefore) {
   for (int y = kept.min_y(); y < kept.min_y() + kept.height(); ++y) {
     for (int x = kept.min_x(); x < kept.min_x() + kept.width(); ++x) ASSERT_EQ(released.probability(x, y), kept.probability(x, y)) << x << " " << y;
   }
+}
+
+// The surface field of a wall seen once: 1 on the wall (where the probabilities read 0.55), 0 in
+// the free space before it (0.49) and in unknown space (0.1); a segment between two returns
+// raises the cells between them; the field survives the grid's growth.
+TEST(SubmapGrid, TheSurfaceFieldOfAWallSeenOnceStandsOutOfFreeAndUnknownSpace) {
+  SubmapGridOptions o;
+  const double r = o.resolution_m;
+  const double range_noise = 0.02;
+  o.hit_field_sigma_m = std::sqrt(range_noise * range_noise + 2.0 * r * r / 12.0);
+  SubmapGrid grid(o);
+  PointCloud wall;
+  for (double t = -1.0; t <= 1.0 + 1e-9; t += 0.4) wall.push_back({2.025, t});  // dots 8 cells apart
+  grid.insert({0.0, 0.0}, wall);
+  for (std::size_t i = 1; i < wall.size(); ++i) grid.add_surface(wall[i - 1], wall[i]);
+  const Eigen::Vector2i on = grid.cell_of({2.025, 0.2}), between = grid.cell_of({2.025, 0.0});
+  const Eigen::Vector2i free = grid.cell_of({1.0125, 0.1}), unknown = grid.cell_of({3.0, 0.0});
+  EXPECT_FLOAT_EQ(grid.hit_field(on.x(), on.y()), 1.0f);
+  EXPECT_FLOAT_EQ(grid.hit_field(between.x(), between.y()), 1.0f);  // on the segment, no return there
+  EXPECT_FLOAT_EQ(grid.hit_field(free.x(), free.y()), 0.0f);
+  EXPECT_FLOAT_EQ(grid.hit_field(unknown.x(), unknown.y()), 0.0f);
+  // A cell beside the wall reads the Gaussian of a cell's distance.
+  const float beside = grid.hit_field(on.x() - 1, on.y());
+  EXPECT_NEAR(beside, std::exp(-0.5 * r * r / (o.hit_field_sigma_m * o.hit_field_sigma_m)), 1e-6);
+  EXPECT_GT(grid.probability(on.x(), on.y()), 0.5f);
+  EXPECT_GT(grid.probability(free.x(), free.y()), 0.45f);  // the probabilities barely tell them apart
+  // Growing the grid (a scan far away) keeps the field.
+  grid.insert({10.0, 0.0}, {{12.0, 0.0}});
+  const Eigen::Vector2i moved = grid.cell_of({2.025, 0.2});
+  EXPECT_FLOAT_EQ(grid.hit_field(moved.x(), moved.y()), 1.0f);
+  grid.release_insertion_state();
+  EXPECT_FLOAT_EQ(grid.hit_field(moved.x(), moved.y()), 0.0f);
+}
+
+// The local search by the surface field finds a room seen once (its walls in the middle of
+// cells) from a prior off by two cells and one.
+TEST(Correlative, TheSurfaceFieldFindsARoomSeenOnce) {
+  SubmapGridOptions o;
+  o.hit_field_sigma_m = 0.0286;
+  SubmapGrid grid(o);
+  const core::Pose2 truth(0.025, 0.025, 0.0), prior(0.125, -0.025, 0.0);
+  const PointCloud scan = room({0.0, 0.0}, true);
+  PointCloud walls;
+  for (const auto& p : scan) walls.push_back(truth.transform(p));
+  grid.insert(truth.position(), walls);
+  for (const auto& p : walls) grid.add_surface(p, p);
+  CorrelativeOptions c;
+  c.hit_field = true;
+  const MatchResult m = correlative_match(grid, scan, prior, c);
+  EXPECT_NEAR(m.pose.x, truth.x, 0.5 * o.resolution_m) << m.pose;
+  EXPECT_NEAR(m.pose.y, truth.y, 0.5 * o.resolution_m) << m.pose;
+  EXPECT_NEAR(m.pose.theta, truth.theta, 0.01) << m.pose;
+  EXPECT_GT(m.score, 0.9);
 }
 
 }  // namespace
