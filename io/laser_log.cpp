@@ -132,7 +132,7 @@ class Line {
     }
     return std::size_t(v);
   }
-  // A range reading: a NaN or negative one is refused.
+  // A range reading: a NaN or negative one is refused (an infinite one is no return).
   double range(std::size_t i, std::size_t beam) const {
     const double v = number(i, fmt::format("range {}", beam + 1));
     if (std::isnan(v) || v < 0.0) fail(fmt::format("range {} is {}: a range is a distance, 0 or more", beam + 1, std::string(words_[i])));
@@ -313,7 +313,9 @@ std::optional<LogScan> LaserLogReader::read_scan() {
     out.scan.ranges.resize(n);
     for (std::size_t b = 0; b < n; ++b) {
       const double r = line.range(first_range + b, b);
-      out.scan.ranges[b] = max_range > 0.0 && r >= max_range - 1e-6 ? std::nullopt : std::optional<double>(r);
+      // At the maximum range, or infinite (as ROS writes a beam that saw nothing): no return.
+      const bool no_return = std::isinf(r) || (max_range > 0.0 && r >= max_range - 1e-6);
+      out.scan.ranges[b] = no_return ? std::nullopt : std::optional<double>(r);
     }
     if (!dpslam) {
       double v = 0.0;

@@ -71,6 +71,19 @@ TEST(LaserLog, WithoutADeclaredMaximumTheLargestReadingIsNoReturn) {
   EXPECT_EQ(all(told)[0].scan.ranges[1], 8.191);
 }
 
+// A beam logged as inf (ROS's "saw nothing") is no return, also on a line that declares no
+// maximum range (maximum_range 0), where no reading is at the maximum.
+TEST(LaserLog, AnInfiniteRangeIsNoReturn) {
+  const std::string log = "ROBOTLASER1 0 -1.0 2.0 0.5 0.0 0.01 0 3 1 inf 2 0 0 0 0 0 0 0 0 0 0 0 0 0 77.5 host 77.5\n";
+  LaserLogReader reader(log, "test.log");
+  const auto scans = all(reader);
+  ASSERT_EQ(scans.size(), 1u);
+  ASSERT_EQ(scans[0].scan.ranges.size(), 3u);
+  EXPECT_EQ(scans[0].scan.ranges[0], 1.0);
+  EXPECT_FALSE(scans[0].scan.ranges[1].has_value());
+  EXPECT_EQ(scans[0].scan.ranges[2], 2.0);
+}
+
 TEST(LaserLog, EvenBeamCountsEndOneStepShortOfTheLeft) {
   std::vector<std::string> r(180, "1");
   LaserLogReader reader(flaser(r, "0 0 0", "0 0 0", "1"), "test.log");
