@@ -242,7 +242,6 @@ struct Row {
   double peer_error = -1.0, peer_ms = 0.0;
   std::vector<double> x;
   double p = 0.0;
-  double largest_std = 0.0;  // the covariance's largest standard deviation at the overlap, cells
   double mahalanobis2 = -1.0;  // the transform's error (tx, ty, theta) squared in the covariance's metric
   int refusal = 0;           // merging::Refusal, as a number
   double confidence = 0.0;
@@ -276,7 +275,6 @@ Row run(const std::string& map, double overlap, const mapping::OccupancyGrid& a,
     }
   }
   row.x = features_of(r);
-  row.largest_std = r.features.largest_std_cells;
   const double c1 = bench::thread_seconds();
   const bench::PeerResult peer = bench::orb_peer(a, b);
   row.peer_ms = 1e3 * (bench::thread_seconds() - c1);
@@ -434,16 +432,6 @@ int main(int argc, char** argv) {
   }
   fmt::print("Median error of right merges: fleetmap {:.3f} cells, ORB {:.3f} cells. Median CPU time per pair: fleetmap {:.0f} ms, ORB {:.0f} ms.\n",
              median(err_f), median(err_p), median(ms_f), median(ms_p));
-  // The covariance against the errors: the error (mean displacement of b's cells) over the
-  // largest standard deviation at the overlap. Near or below 1 when the covariance is honest; far
-  // above when it is too small (residuals taken as independent).
-  std::vector<double> ratio;
-  for (const auto& r : rows)
-    if (r.merged && r.right && r.largest_std > 0.0) ratio.push_back(r.error / r.largest_std);
-  std::sort(ratio.begin(), ratio.end());
-  if (!ratio.empty())
-    fmt::print("Right merges' error / the covariance's largest std at the overlap: median {:.2f}, 90th percentile {:.2f}.\n",
-               median(ratio), ratio[std::size_t(0.9 * double(ratio.size() - 1))]);
   // An honest covariance makes the squared Mahalanobis distance of the error chi-square with 3
   // degrees of freedom: median 2.366, 95% below 7.815.
   std::vector<double> d2;
