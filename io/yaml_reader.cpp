@@ -35,7 +35,12 @@ YamlMap::YamlMap(const YAML::Node& node, std::string source, std::string prefix)
   if (!node_ || !node_.IsMap()) return;
   std::vector<std::pair<std::string, YAML::Mark>> seen;
   for (const auto& kv : node_) {
-    const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : describe_node(kv.first);
+    // A key must be a name: YAML allows null, list and mapping keys, which no reader looks up.
+    if (!kv.first.IsScalar()) {
+      throw InputError(where_node(kv.first) + ": " + (prefix_.empty() ? std::string("the file") : "key '" + prefix_ + "'") +
+                       ": expected a name as key, got " + describe_node(kv.first));
+    }
+    const std::string key = kv.first.Scalar();
     for (const auto& [other, mark] : seen) {
       if (other != key) continue;
       throw InputError(where_node(kv.first) + ": key '" + full_key(key) + "' is given twice (first on line " +

@@ -19,9 +19,8 @@ namespace fleetmap::io {
 class YamlMap {
  public:
   // `source` names the file in messages; `prefix` is the dotted path of this mapping ("" at top).
-  // Throws InputError when `node` is not a mapping.
-  // Throws InputError when `node` is not a mapping, or holds a key twice (YAML keeps both and
-  // readers would silently take one).
+  // Throws InputError when `node` is not a mapping, has a key that is not a name (null, a list or
+  // a mapping), or holds a key twice (YAML keeps both and readers would silently take one).
   YamlMap(const YAML::Node& node, std::string source, std::string prefix = "");
 
   bool has(const std::string& key) const;

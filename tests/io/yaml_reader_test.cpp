@@ -24,6 +24,17 @@ TEST(YamlMap, AKeyGivenTwiceIsAnErrorAtEveryLevel) {
   EXPECT_NO_THROW(top("a: 1\nb: {a: 2}\n"));
 }
 
+TEST(YamlMap, AKeyMustBeAName) {
+  const auto read = [](const std::string& text) {
+    YamlMap top(parse_yaml(text, "s.yaml"), "s.yaml");
+    top.map("methods");
+  };
+  expect_input_error([&] { read("methods:\n  ~: 3\n"); }, {"s.yaml:2: key 'methods': expected a name as key, got nothing"});
+  expect_input_error([&] { read("null: 1\n"); }, {"s.yaml:1: the file: expected a name as key, got nothing"});
+  expect_input_error([&] { read("methods:\n  [a]: 3\n"); }, {"s.yaml:2: key 'methods': expected a name as key, got a list"});
+  EXPECT_NO_THROW(read("methods:\n  particles: 3\n"));
+}
+
 TEST(YamlMap, NumbersAndSeedsFollowTheirRange) {
   YamlMap m(parse_yaml("beams: 10000000\nseed: 18446744073709551615\nbad_seed: -1\nrange: .inf\n", "f.yaml"), "f.yaml");
   expect_input_error([&] { m.number("beams", 360, Range{1, 100000, true}); },
