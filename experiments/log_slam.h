@@ -25,9 +25,6 @@ struct LogSlamOptions {
   // The method's own parameters (localization::localizer_options), as given.
   core::Settings localizer_settings;
   io::LaserLogOptions log;
-  // Particles and noise. A real robot's odometry over the motion between two scans is far less
-  // sure than the simulator's default: 5 cm and 0.05 rad (3 degrees) per step, the scale of
-  // GMapping's defaults for scans a few tens of centimetres apart.
   // The grid the method maps into (the methods that keep their own start from it). A miss moves a
   // cell's odds by about a fifth of a hit's, as Cartographer's 0.49 against 0.55: a real scan's
   // end points scatter over a cell or two around a wall (range noise, the pose's error, grazing
@@ -38,6 +35,9 @@ struct LogSlamOptions {
     m.miss_probability = 0.45;
     return m;
   }();
+  // Particles and noise. A real robot's odometry over the motion between two scans is far less
+  // sure than the simulator's default: 5 cm and 0.05 rad (3 degrees) per step, the scale of
+  // GMapping's defaults for scans a few tens of centimetres apart.
   localization::LocalizerOptions localizer = [] {
     localization::LocalizerOptions o;
     o.process_noise_xy = 0.05;

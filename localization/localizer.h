@@ -76,7 +76,8 @@ struct LocalizerOptions {
   double process_noise_xy = 0.001;         // m
   double process_noise_theta = 0.000174533;  // rad (0.01 deg)
   // Heading noise per radian the odometry reports turned in the step (the alpha_1 of Thrun et al.'s
-  // odometry model), added to process_noise_theta by `scan-matching`: a real robot's
+  // odometry model): `scan-matching` adds it to process_noise_theta in its prior and widens its
+  // heading window by three of it, `graph-slam` its local search's window. A real robot's
   // odometry errs in heading most while it turns (MIT CSAIL's lags the laser: 11 degrees rms on
   // steps of 20-90 degrees, 1.4 on steps under 2). 0: none.
   double turn_noise_per_rad = 0.0;
