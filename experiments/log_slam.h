@@ -45,6 +45,8 @@ struct LogSlamOptions {
     // MIT CSAIL's odometry (training log): heading errors of 1.4 degrees rms on steps turning under
     // 2 degrees, 3 on steps of 5-20, 11 on steps of 20-90 (up to 19): about 0.3 of the turn.
     o.turn_noise_per_rad = 0.3;
+    // Intel's odometry (training log): 0.075 m rms off GMapping's motion on its steps of about 1 m.
+    o.drive_noise_per_m = 0.075;
     return o;
   }();
 };

@@ -226,6 +226,7 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
     core::Pose2 refined;
     CorrelativeOptions search = o.local_search;
     search.angular_window_rad += 3.0 * o.turn_noise_per_rad * std::abs(odometry.theta);
+    search.linear_window_m += 3.0 * o.drive_noise_per_m * std::hypot(odometry.x, odometry.y);
     auto match_near = [&](const core::Pose2& guess) {
       // The exhaustive search only needs to land in the refinement's basin: the sparser points do.
       const MatchResult coarse = correlative_match(m.grid, loop_points, guess, search);

@@ -13,6 +13,7 @@ namespace {
 GraphSlamOptions options_from(const core::Params& p, const LocalizerOptions& shared) {
   GraphSlamOptions o;
   o.turn_noise_per_rad = shared.turn_noise_per_rad;
+  o.drive_noise_per_m = shared.drive_noise_per_m;
   if (p.specs().empty()) return o;
   o.max_range_m = p.number("max_range");
   o.scans_per_submap = int(p.number("scans_per_submap"));

@@ -81,6 +81,10 @@ struct LocalizerOptions {
   // odometry errs in heading most while it turns (MIT CSAIL's lags the laser: 11 degrees rms on
   // steps of 20-90 degrees, 1.4 on steps under 2). 0: none.
   double turn_noise_per_rad = 0.0;
+  // Translation noise per metre the odometry reports driven in the step (Thrun et al.'s alpha_3):
+  // `graph-slam` widens its local search's translation window by three of it (a step of a log
+  // that keeps scans 1 m apart errs by far more than one 0.2 m apart). 0: none.
+  double drive_noise_per_m = 0.0;
   // Landmark sensor noise (standard deviations).
   double range_noise = 0.02;     // m
   double bearing_noise = 0.0175;  // rad
