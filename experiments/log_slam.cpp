@@ -142,7 +142,8 @@ LogSlamResult run_log_slam(const std::function<std::unique_ptr<io::LaserLogReade
   const bool own_map = !localizer->ignores_own_map();
   // A method that keeps a map of its own is handed a grid of one cell, which it does not read.
   mapping::OccupancyGrid map(core::GridGeometry(o.resolution_m, own_map ? width : 1, own_map ? height : 1,
-                                                core::Pose2(lo_x - margin, lo_y - margin, 0.0)));
+                                                core::Pose2(lo_x - margin, lo_y - margin, 0.0)),
+                             o.map);
   auto log = open_log();
   std::optional<core::Pose2> first_odometry, previous_odometry;
   double previous_time = 0.0, period = 0.0;

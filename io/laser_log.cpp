@@ -230,7 +230,7 @@ void LaserLogReader::open() {
   lines_ = make_lines_();
 }
 
-std::optional<LogScan> LaserLogReader::next() {
+std::optional<LogScan> LaserLogReader::read_counted() {
   std::optional<LogScan> scan = read_scan();
   if (scan) {
     ++scans_;
@@ -239,6 +239,47 @@ std::optional<LogScan> LaserLogReader::next() {
                                "DP-SLAM's Laser lines)");
   }
   return scan;
+}
+
+std::optional<LogScan> LaserLogReader::next() {
+  if (!ahead_.empty()) {
+    LogScan out = std::move(ahead_.front());
+    ahead_.pop_front();
+    return out;
+  }
+  std::optional<LogScan> scan = read_counted();
+  if (!scan) return scan;
+  const std::optional<LogScan> before = std::move(previous_);
+  previous_ = *scan;
+  previous_->scan = {};  // only its odometry and time are needed
+  if (!before || !(scan->odometry == before->odometry)) return scan;
+  // The reading repeats the previous scan's to the last digit: read on to the next scan whose
+  // reading differs, keeping the repeats (as many as there are; a robot at rest repeats its
+  // reading for as long as it rests).
+  ahead_.push_back(std::move(*scan));
+  std::optional<LogScan> fresh;
+  while ((fresh = read_counted())) {
+    if (!(fresh->odometry == before->odometry)) break;
+    ahead_.push_back(std::move(*fresh));
+  }
+  if (fresh) {
+    // The repeats get the odometry interpolated in time between the last reading before them and
+    // the first after (by their order when the times do not tell).
+    const core::Pose2 step = before->odometry.inverse().compose(fresh->odometry);
+    const double t0 = before->time_s, t1 = fresh->time_s;
+    const std::size_t n = ahead_.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      double f = double(k + 1) / double(n + 1);
+      if (t1 > t0 && ahead_[k].time_s >= t0 && ahead_[k].time_s <= t1) f = (ahead_[k].time_s - t0) / (t1 - t0);
+      ahead_[k].odometry = before->odometry.compose(core::Pose2(f * step.x, f * step.y, f * step.theta));
+    }
+    previous_ = *fresh;
+    previous_->scan = {};
+    ahead_.push_back(std::move(*fresh));
+  }
+  LogScan out = std::move(ahead_.front());
+  ahead_.pop_front();
+  return out;
 }
 
 std::optional<LogScan> LaserLogReader::read_scan() {

@@ -4,6 +4,7 @@
 // and the ground-truth relations of Kümmerle et al. 2009 ("On measuring the accuracy of SLAM
 // algorithms").
 #include <cstddef>
+#include <deque>
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -58,6 +59,13 @@ class LaserLogReader {
   LaserLogReader& operator=(const LaserLogReader&) = delete;
 
   // The next scan, or nullopt at the end of the log (InputError when the log had no scan at all).
+  //
+  // A scan whose odometry repeats the previous scan's exactly gets the odometry interpolated in time
+  // between the last reading before it and the first that differs after it (the reader reads ahead
+  // to it). An odometer that reports no new reading for some scans while the robot moves (MIT
+  // CSAIL's, three times for four scans while turning up to 85 degrees) is otherwise read as a
+  // robot that stood still and then jumped; a robot that did stand still gets its next step's
+  // small motion spread over its rest, which no method can tell from standing.
   std::optional<LogScan> next();
   // "CARMEN" or "DP-SLAM" (known after the first scan).
   const std::string& format() const { return format_; }
@@ -70,6 +78,7 @@ class LaserLogReader {
  private:
   void open();
   std::optional<LogScan> read_scan();
+  std::optional<LogScan> read_counted();  // read_scan, counted; InputError for a log with no scan
 
   std::string source_;
   std::function<std::unique_ptr<Lines>()> make_lines_;
@@ -83,6 +92,9 @@ class LaserLogReader {
   std::optional<core::Pose2> chain_, segment_first_, segment_last_;
   std::optional<core::Pose2> pending_odometry_;     // DP-SLAM: the Odometry line before a Laser line
   std::optional<core::Pose2> last_odometry_;        // the previous scan's
+  // next(): the last scan read (its odometry as read, and its time), and the scans read ahead.
+  std::optional<LogScan> previous_;
+  std::deque<LogScan> ahead_;
 };
 
 // One relation of Kümmerle et al. 2009: the true motion from the scan taken at `t1` to the one taken

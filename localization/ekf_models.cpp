@@ -69,6 +69,8 @@ void validate_options(const LocalizerOptions& o) {
   };
   non_negative("process_noise_xy", o.process_noise_xy);
   non_negative("process_noise_theta", o.process_noise_theta);
+  non_negative("turn_noise_per_rad", o.turn_noise_per_rad);
+  non_negative("drive_noise_per_m", o.drive_noise_per_m);
   non_negative("range_noise", o.range_noise);
   non_negative("bearing_noise", o.bearing_noise);
   non_negative("initial_xy", o.initial_xy);

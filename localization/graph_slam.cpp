@@ -224,9 +224,12 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
     // Matching happens in the grid frame, the submap's (its local origin is a translation).
     const core::Pose2 in_grid = m.local.inverse().compose(prior);
     core::Pose2 refined;
+    CorrelativeOptions search = o.local_search;
+    search.angular_window_rad += 3.0 * o.turn_noise_per_rad * std::abs(odometry.theta);
+    search.linear_window_m += 3.0 * o.drive_noise_per_m * std::hypot(odometry.x, odometry.y);
     auto match_near = [&](const core::Pose2& guess) {
       // The exhaustive search only needs to land in the refinement's basin: the sparser points do.
-      const MatchResult coarse = correlative_match(m.grid, loop_points, guess, o.local_search);
+      const MatchResult coarse = correlative_match(m.grid, loop_points, guess, search);
       return refine_match(m.grid, match_points, coarse.pose, guess, o.local_refine);
     };
     // Odometry that did not change at all while the robot was moving is as likely a stale reading

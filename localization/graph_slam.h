@@ -45,6 +45,11 @@ struct GraphSlamOptions {
     return c;
   }();
   double range_noise_m = 0.02;
+  // The local search's heading window grows by 3 x this x the odometry's turn in the step
+  // (LocalizerOptions::turn_noise_per_rad: the heading noise per radian turned), its translation
+  // window by 3 x drive_noise_per_m x the step's length. 0: fixed windows.
+  double turn_noise_per_rad = 0.0;
+  double drive_noise_per_m = 0.0;
   // Consecutive returns are one surface, joined in the field, when they lie closer than a surface
   // seen at this incidence (from the beam's direction) would space them, plus 3 range noises
   // (Borges & Aldon 2004's adaptive breakpoint): a wall's far returns are a line, not dots that a

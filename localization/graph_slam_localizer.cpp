@@ -10,8 +10,10 @@ namespace fleetmap::localization {
 namespace {
 
 // The declared parameters (localizer_registry.cpp) over GraphSlamOptions' defaults.
-GraphSlamOptions options_from(const core::Params& p) {
+GraphSlamOptions options_from(const core::Params& p, const LocalizerOptions& shared) {
   GraphSlamOptions o;
+  o.turn_noise_per_rad = shared.turn_noise_per_rad;
+  o.drive_noise_per_m = shared.drive_noise_per_m;
   if (p.specs().empty()) return o;
   o.max_range_m = p.number("max_range");
   o.scans_per_submap = int(p.number("scans_per_submap"));
@@ -25,7 +27,8 @@ GraphSlamOptions options_from(const core::Params& p) {
 
 class GraphSlamLocalizer final : public Localizer {
  public:
-  explicit GraphSlamLocalizer(const LocalizerContext& c) : slam_(options_from(c.params), c.initial_pose), pose_(c.initial_pose) {
+  explicit GraphSlamLocalizer(const LocalizerContext& c)
+      : slam_(options_from(c.params, c.options), c.initial_pose), pose_(c.initial_pose) {
     const double xy = c.options.initial_xy, th = c.options.initial_theta;
     covariance_ = Eigen::Vector3d(xy * xy, xy * xy, th * th).asDiagonal();
   }

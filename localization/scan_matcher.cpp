@@ -27,7 +27,8 @@ std::vector<Eigen::Vector2d> transform_points(const core::Pose2& pose, const std
   return out;
 }
 
-ScanMatcherOptions scan_matcher_options(const LocalizerOptions& o, double max_range_m, double resolution_m) {
+ScanMatcherOptions scan_matcher_options(const LocalizerOptions& o, double max_range_m, double resolution_m,
+                                        double turn_rad) {
   ScanMatcherOptions m;
   m.field.max_range_m = max_range_m;
   // The field's spread covers the range noise and a cell of discretisation.
@@ -35,7 +36,9 @@ ScanMatcherOptions scan_matcher_options(const LocalizerOptions& o, double max_ra
   // The motion model is the prior (Olson 2009): three standard deviations of a step's odometry
   // noise. Where the scan says nothing (along a featureless corridor) the odometry stays.
   m.prior_xy_m = std::max(1e-3, 3.0 * o.process_noise_xy);
-  m.prior_theta_rad = std::max(1e-4, 3.0 * o.process_noise_theta);
+  const double turn_sigma = o.turn_noise_per_rad * std::abs(turn_rad);
+  m.prior_theta_rad = std::max(1e-4, 3.0 * (o.process_noise_theta + turn_sigma));
+  m.search_theta_rad += 3.0 * turn_sigma;
   return m;
 }
 

@@ -46,8 +46,11 @@ struct ScanMatch {
 };
 
 // The matcher's settings for a localizer on a grid of `resolution_m`: the field's spread from the
-// range noise and the cell size, the prior at least five times the per-step odometry noise.
-ScanMatcherOptions scan_matcher_options(const LocalizerOptions& options, double max_range_m, double resolution_m);
+// range noise and the cell size, the prior three times the odometry noise of a step that turned
+// `turn_rad` (whose heading part grows with the turn by turn_noise_per_rad), and the heading
+// window widened by that growth's three standard deviations.
+ScanMatcherOptions scan_matcher_options(const LocalizerOptions& options, double max_range_m, double resolution_m,
+                                        double turn_rad = 0.0);
 
 // The end points of a scan's returns in the robot frame, every `stride`-th return.
 std::vector<Eigen::Vector2d> scan_end_points(const RangeScan& scan, int stride);

@@ -35,6 +35,7 @@ class ScanMatchingLocalizer final : public Localizer {
     covariance_ = f * covariance_ * f.transpose();
     pending_ = process_noise(options_);
     pose_ = integrate_motion(pose_, u);
+    turned_ += std::abs(u.omega * u.dt);
   }
 
   void update_scan(const RangeScan& scan, const mapping::OccupancyGrid& own_map) override {
@@ -42,7 +43,7 @@ class ScanMatchingLocalizer final : public Localizer {
       map_ = CowGrid::from_occupancy_grid(own_map);
       map_ready_ = true;
     }
-    const ScanMatch match = match_scan_to_grid(map_, scan, pose_, scan_matcher_options(options_, scan.max_range, own_map.resolution()));
+    const ScanMatch match = match_scan_to_grid(map_, scan, pose_, scan_matcher_options(options_, scan.max_range, own_map.resolution(), turned_));
     if (match.matched) {
       pose_ = match.pose;
       pending_ = match.covariance;
@@ -52,6 +53,7 @@ class ScanMatchingLocalizer final : public Localizer {
     }
     covariance_ += pending_;
     pending_.setZero();
+    turned_ = 0.0;
     mapping::insert_scan(map_, pose_, scan);
   }
 
@@ -78,6 +80,7 @@ class ScanMatchingLocalizer final : public Localizer {
   CowGrid map_;
   bool map_ready_ = false;
   int matches_ = 0, skipped_ = 0;
+  double turned_ = 0.0;  // by the odometry since the last scan
 };
 
 }  // namespace

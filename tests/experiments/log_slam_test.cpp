@@ -71,6 +71,22 @@ TEST(LogSlam, GraphSlamMapsTheSimulatorsLogWithinAFractionOfACell) {
   EXPECT_EQ(r.map.state(*path), mapping::CellState::Free);
 }
 
+// Scan matching to the robot's own grid, with a log's settings (misses a fifth of a hit, the
+// heading window growing with the turn): without loop closure its relations stay within half a
+// cell, as graph SLAM's, where the odometry's are beyond.
+TEST(LogSlam, ScanMatchingMapsTheSimulatorsLogWithinAFractionOfACell) {
+  const auto log = testing::sim_laser_log();
+  const auto relations = testing::sim_relations(log);
+  const LogSlamResult r = run_sim_log(log, "scan-matching");
+  const auto slam = localization::relation_errors(timed(r.times_s, r.trajectory), relations);
+  const auto odometry = localization::relation_errors(timed(r.times_s, r.odometry), relations);
+  ASSERT_EQ(slam.matched, relations.size());
+  const double cell = 0.05;
+  EXPECT_LT(slam.translation_mean_m, 0.5 * cell);
+  EXPECT_LT(slam.rotation_mean_rad, 0.01);
+  EXPECT_GT(odometry.translation_mean_m, 0.5 * cell);
+}
+
 TEST(LogSlam, SameLogSameSeedSameTrajectory) {
   const auto log = testing::sim_laser_log({.laps = 1});
   const LogSlamResult a = run_sim_log(log, "graph-slam"), b = run_sim_log(log, "graph-slam");

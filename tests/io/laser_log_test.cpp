@@ -116,6 +116,27 @@ TEST(LaserLog, ACorrectedLogsOdometryIsTheRawMotionNotTheCorrection) {
   EXPECT_NEAR(scans[1].logged_pose->x, 2.0, 1e-12);  // the corrected pose is still there to compare with
 }
 
+TEST(LaserLog, AnOdometerThatRepeatsItsReadingIsInterpolatedToTheNextOne) {
+  // Scans 1-3 repeat scan 0's reading while the robot turns; scan 4 has the reading again. The
+  // repeats get the motion in proportion to their time; the rest is left as read.
+  std::string log = flaser({"1", "2", "3"}, "0 0 0", "0 0 0", "10.0");
+  for (const char* t : {"10.2", "10.4", "10.5"}) log += flaser({"1", "2", "3"}, "0 0 0", "0 0 0", t);
+  log += flaser({"1", "2", "3"}, "0 0 0", "1 0 0.8", "11.0") + flaser({"1", "2", "3"}, "0 0 0", "1.2 0 0.8", "11.2");
+  LaserLogReader reader(log, "test.log");
+  const auto scans = all(reader);
+  ASSERT_EQ(scans.size(), 6u);
+  EXPECT_EQ(scans[0].odometry, core::Pose2(0, 0, 0));
+  EXPECT_NEAR(scans[1].odometry.x, 0.2, 1e-12);
+  EXPECT_NEAR(scans[1].odometry.theta, 0.16, 1e-12);
+  EXPECT_NEAR(scans[2].odometry.theta, 0.32, 1e-12);
+  EXPECT_NEAR(scans[3].odometry.x, 0.5, 1e-12);
+  EXPECT_NEAR(scans[3].odometry.theta, 0.4, 1e-12);
+  EXPECT_EQ(scans[4].odometry, core::Pose2(1, 0, 0.8));
+  EXPECT_EQ(scans[5].odometry, core::Pose2(1.2, 0, 0.8));
+  EXPECT_EQ(scans[3].timestamp, "10.5");
+  EXPECT_EQ(scans[3].line, 4u);
+}
+
 TEST(LaserLog, DpSlamLogsPairOdometryAndLaserLines) {
   const std::string log = "Odometry -2.42 4.80 2.59\nLaser 3 0.64 0.65 8.191\nOdometry -2.40 4.81 2.60\nLaser 3 1 2 3\n";
   LaserLogReader reader(log, "loop5.log");
