@@ -234,12 +234,17 @@ core::Pose2 GraphSlam::add_scan(const core::Pose2& odometry, const mapping::Rang
     };
     // Odometry that did not change at all while the robot was moving is as likely a stale reading
     // (the odometry messages stopped; real logs then catch up with a jump) as a stop: both are
-    // matched and the scan decides, the steady motion first.
+    // matched and the scan decides, the steady motion first. So is a translation that did not
+    // change while the robot was driving, whatever the heading did (the wheels' distance stalled
+    // while the heading kept coming): even when that stop is beyond what the robot can brake, the
+    // steady motion is matched first, with the heading the odometry read.
     const bool still = odometry.x == 0.0 && odometry.y == 0.0 && odometry.theta == 0.0;
     const bool was_moving = s.last_step && (s.last_step->x != 0.0 || s.last_step->y != 0.0 || s.last_step->theta != 0.0);
-    if (!steady && still && was_moving && regular) {
+    const bool stale_translation = !still && odometry.x == 0.0 && odometry.y == 0.0 && s.last_step &&
+                                   (s.last_step->x != 0.0 || s.last_step->y != 0.0);
+    if (regular && ((!steady && still && was_moving) || stale_translation)) {
       const double k = dt_s / s.last_dt;
-      const core::Pose2 step(k * s.last_step->x, k * s.last_step->y, k * s.last_step->theta);
+      const core::Pose2 step(k * s.last_step->x, k * s.last_step->y, still ? k * s.last_step->theta : odometry.theta);
       const core::Pose2 moving = match_near(m.local.inverse().compose(s.nodes.back().local.compose(step)));
       const core::Pose2 stopped = match_near(in_grid);
       refined = match_score(m.grid, match_points, stopped) > match_score(m.grid, match_points, moving) ? stopped : moving;

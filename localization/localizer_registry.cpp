@@ -74,7 +74,7 @@ core::Registry<LocalizerFactory>& localizer_registry() {
            ParamSpec::number("loop_sampling_ratio", 0.1, {0, 1}, "", "share of (scan, submap) pairs searched for closures"),
            ParamSpec::number("loop_rival_errors", 2, {0, 1e3}, "",
                              "a closure is refused unless it beats a rival match elsewhere by this many standard errors"),
-           ParamSpec::number("huber_scale", 30, {1e-3, 1e6}, "",
+           ParamSpec::number("huber_scale", 10, {1e-3, 1e6}, "",
                              "loop closures' robust loss scale, in standard deviations")});
     r.add("fastslam2",
           "FastSLAM 2.0: particles over the path, an EKF per landmark in each, proposal including the readings "
